@@ -1,0 +1,70 @@
+// Newton correctors behind one interface: solve F(x) = 0 from a starting guess, in place.
+//
+// Two backends: "eigen" (dense Gauss-Newton with Moore-Penrose minimum-norm steps, so it also
+// handles under-determined and rank-deficient systems) and "kinsol" (SUNDIALS KINSOL, square
+// systems only, dense linear solver and line search). Both fill the same NewtonSummary, so a
+// run can be compared across backends. Options are a plain struct with defaults and a
+// validate() that names the bad field.
+//
+//   NewtonOptions opt; opt.residual_tolerance = 1e-12;
+//   auto newton = make_corrector("kinsol", opt);      // throws InputError on a bad name
+//   Vector x = guess;
+//   NewtonSummary s = newton->solve(problem, x);
+//   if (!s.converged()) fmt::print("{}\n", s.message);
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/problem.hpp"
+
+namespace backbone::core {
+
+struct NewtonOptions {
+  double residual_tolerance = 1e-10;  // stop when ||F||_inf <= this
+  double step_tolerance = 1e-14;      // stalled when the scaled step falls below this
+  int max_iterations = 25;
+  bool line_search = true;            // backtracking on ||F||_2 (KINSOL: KIN_LINESEARCH)
+  // Relative singular-value cut-off of the minimum-norm step (eigen backend): singular
+  // values below rank_cutoff * sigma_max are treated as zero.
+  double rank_cutoff = 1e-12;
+  void validate() const;  // throws InputError naming the field, e.g. "newton.max_iterations"
+};
+
+enum class NewtonStatus {
+  converged,
+  stalled,               // step below step_tolerance before the residual was small
+  max_iterations,
+  diverged,              // residual grew beyond recovery / line search failed
+  evaluation_failed,     // residual or Jacobian returned non-ok (NaN, failed simulation)
+  linear_solver_failed,
+};
+const char* to_string(NewtonStatus s);
+
+struct NewtonSummary {
+  NewtonStatus status = NewtonStatus::max_iterations;
+  int iterations = 0;
+  std::vector<double> residual_history;  // ||F||_inf at the start and after each iteration
+  long residual_evaluations = 0;
+  long jacobian_evaluations = 0;
+  double seconds = 0;
+  std::string message;  // backend's own words (KINSOL's flag text) plus context
+  bool converged() const { return status == NewtonStatus::converged; }
+  double final_residual() const {
+    return residual_history.empty() ? -1.0 : residual_history.back();
+  }
+};
+
+class Corrector {
+ public:
+  virtual ~Corrector() = default;
+  virtual std::string name() const = 0;
+  // Solves problem(x) = 0 starting from x; x holds the last iterate on return.
+  virtual NewtonSummary solve(const Problem& problem, Vector& x) = 0;
+};
+
+// name: "eigen" or "kinsol". Throws InputError("newton", ...) for anything else.
+std::unique_ptr<Corrector> make_corrector(const std::string& name, const NewtonOptions& options);
+
+}  // namespace backbone::core

@@ -1,0 +1,83 @@
+// A nonlinear system F(x) = 0 with m equations in n unknowns (m <= n is allowed).
+//
+// The interface is deliberately tiny (Ceres' CostFunction is the model): sizes and a residual.
+// The Jacobian defaults to finite differences (see finite_difference.hpp for the step rule);
+// a problem that knows its Jacobian overrides compute_jacobian. Public entry points are
+// non-virtual: they count evaluations, time them and check the output for NaN/Inf, so every
+// solver reports cost the same way. compute_residual must be safe to call concurrently on a
+// const object (finite-difference columns may be evaluated in parallel).
+//
+//   class Circle : public backbone::core::Problem {
+//    public:
+//     int num_unknowns() const override { return 2; }
+//     int num_equations() const override { return 1; }
+//    protected:
+//     EvalStatus compute_residual(const Vector& x, Vector& r) const override {
+//       r.resize(1); r[0] = x.squaredNorm() - 1.0; return EvalStatus::ok;
+//     }
+//   };
+//   Circle c; Vector r; c.residual(Vector::Ones(2), r);   // r = [1], c.counters().residuals == 1
+#pragma once
+
+#include <atomic>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace backbone::core {
+
+// Outcome of one evaluation. Numerical failure is a value, never an exception.
+enum class EvalStatus {
+  ok,
+  non_finite,  // the residual or Jacobian contains NaN or Inf
+  failed,      // the problem could not evaluate at x (e.g. a period <= 0, simulation blew up)
+};
+const char* to_string(EvalStatus s);
+
+// Evaluation counters, safe to update from several threads.
+struct EvaluationCounters {
+  std::atomic<long> residuals{0};
+  std::atomic<long> jacobians{0};
+  std::atomic<long> residual_nanoseconds{0};
+  std::atomic<long> jacobian_nanoseconds{0};
+  void reset();
+};
+
+// A named scalar derived from a solution point (period, energy, frequency...).
+using Observables = std::vector<std::pair<std::string, double>>;
+
+class Problem {
+ public:
+  virtual ~Problem() = default;
+
+  virtual int num_unknowns() const = 0;
+  virtual int num_equations() const = 0;
+  virtual std::string name() const { return "problem"; }
+
+  // Residual r = F(x), resized to num_equations(). Counts, times, checks finiteness.
+  EvalStatus residual(const Vector& x, Vector& r) const;
+  // Jacobian J = dF/dx (num_equations x num_unknowns). Analytic if overridden, else FD.
+  EvalStatus jacobian(const Vector& x, Matrix& J) const;
+
+  // Scalars worth reporting at a solution (written as columns of branch.csv). Default: none.
+  virtual Observables observables(const Vector& x) const { return {}; }
+
+  // Typical magnitude of each unknown, used by the finite-difference step rule and by
+  // scaled norms. Default: ones.
+  virtual Vector typical_scale() const { return Vector::Ones(num_unknowns()); }
+
+  const EvaluationCounters& counters() const { return counters_; }
+  void reset_counters() const { counters_.reset(); }
+
+ protected:
+  virtual EvalStatus compute_residual(const Vector& x, Vector& r) const = 0;
+  // Default: forward finite differences (finite_difference_jacobian).
+  virtual EvalStatus compute_jacobian(const Vector& x, Matrix& J) const;
+
+ private:
+  mutable EvaluationCounters counters_;
+};
+
+}  // namespace backbone::core

@@ -1,0 +1,60 @@
+// How many dimensions does the solution set have near a point? A rank report of the Jacobian.
+//
+// The numerical rank of J (m x n) at a converged point comes from its singular values with a
+// relative threshold (tau * sigma_max, tau documented in RankOptions). nullity = n - rank is
+// the *candidate* dimension of the solution manifold. Because a rank count on a degenerate
+// residual says nothing (DESIGN.md section 3: the paper's shooting residual is a double root),
+// verify_null_directions steps along each candidate null direction, re-corrects with a Newton
+// corrector constrained to the hyperplane orthogonal to that direction, and counts the
+// directions along which nearby solutions really exist.
+//
+//   Matrix J; problem.jacobian(x, J);
+//   RankReport rep = rank_report(J, RankOptions{});
+//   verify_null_directions(problem, x, *newton, VerifyOptions{}, rep);
+//   fmt::print("nullity {} verified {}\n", rep.nullity, rep.verified_dimension);
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/newton.hpp"
+#include "core/types.hpp"
+
+namespace backbone::core {
+
+struct RankOptions {
+  // Relative threshold: sigma_i counts as zero when sigma_i <= relative_threshold * sigma_max.
+  double relative_threshold = 1e-8;
+  void validate() const;
+};
+
+struct VerifyOptions {
+  double step = 1e-3;               // step length along each null direction (scaled units)
+  double residual_tolerance = 1e-9; // re-corrected point must reach this
+  // A direction is real when the re-corrected point stays within drift_ratio * step of the
+  // stepped point in the orthogonal complement (the solution set passes near it).
+  double drift_ratio = 0.1;
+  void validate() const;
+};
+
+struct RankReport {
+  Vector singular_values;      // descending
+  double threshold = 0;        // absolute value used: relative_threshold * sigma_max
+  double relative_threshold = 0;
+  int rank = 0;
+  int nullity = 0;             // num_unknowns - rank: candidate manifold dimension
+  double gap = 0;              // sigma_rank / sigma_{rank+1} (inf when no small one)
+  Matrix null_directions;      // n x nullity, orthonormal
+  int verified_dimension = -1; // -1 until verify_null_directions ran
+  std::vector<bool> direction_verified;
+  std::string summary() const; // one line for logs: "rank 40/41, nullity 1 (verified 1), ..."
+};
+
+RankReport rank_report(const Matrix& J, const RankOptions& options);
+
+// Fills verified_dimension and direction_verified. Evaluates the problem; never throws on
+// numerical failure (a direction that fails to re-correct is simply not verified).
+void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
+                            const VerifyOptions& options, RankReport& report);
+
+}  // namespace backbone::core

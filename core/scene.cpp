@@ -1,0 +1,134 @@
+#include "core/scene.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace backbone::core {
+
+namespace {
+
+// Boost's messages quote the option with its dashes; the user wants the key.
+[[noreturn]] void rethrow_as_input_error(const po::error& e, const std::string& where) {
+  std::string message = e.what();
+  throw InputError("", where.empty() ? message : where + ": " + message);
+}
+
+std::ifstream open_scene(const std::string& ini_path) {
+  std::ifstream in(ini_path);
+  if (!in) throw InputError("scene", fmt::format("cannot read scene file '{}'", ini_path));
+  return in;
+}
+
+}  // namespace
+
+double Scene::number(const std::string& key) const {
+  if (!has(key)) throw InputError(key, "is required but was not given");
+  double v = 0;
+  try {
+    v = values_[key].as<double>();
+  } catch (const boost::bad_any_cast&) {
+    throw InputError(key, "is not a number");
+  }
+  if (!std::isfinite(v)) throw InputError(key, fmt::format("must be a finite number (got {})", v));
+  return v;
+}
+
+double Scene::positive(const std::string& key) const {
+  double v = number(key);
+  if (!(v > 0)) throw InputError(key, fmt::format("must be > 0 (got {})", v));
+  return v;
+}
+
+double Scene::non_negative(const std::string& key) const {
+  double v = number(key);
+  if (!(v >= 0)) throw InputError(key, fmt::format("must be >= 0 (got {})", v));
+  return v;
+}
+
+long Scene::integer(const std::string& key, long min_value) const {
+  if (!has(key)) throw InputError(key, "is required but was not given");
+  long v = 0;
+  try {
+    v = values_[key].as<long>();
+  } catch (const boost::bad_any_cast&) {
+    throw InputError(key, "is not an integer");
+  }
+  if (v < min_value) throw InputError(key, fmt::format("must be >= {} (got {})", min_value, v));
+  return v;
+}
+
+std::string Scene::text(const std::string& key) const {
+  if (!has(key)) throw InputError(key, "is required but was not given");
+  return values_[key].as<std::string>();
+}
+
+std::string Scene::choice(const std::string& key,
+                          std::initializer_list<const char*> allowed) const {
+  std::string v = text(key);
+  std::string list;
+  for (const char* a : allowed) {
+    if (v == a) return v;
+    list += list.empty() ? a : std::string(", ") + a;
+  }
+  throw InputError(key, fmt::format("must be one of {} (got '{}')", list, v));
+}
+
+bool Scene::flag(const std::string& key) const { return has(key) && values_[key].as<bool>(); }
+
+Scene read_scene(const po::options_description& scene_keys, const std::string& ini_path,
+                 const std::vector<std::string>& arguments,
+                 const po::options_description& driver_keys) {
+  po::variables_map vm;
+  // The scene file may name its problem; that key belongs to every scene.
+  po::options_description file_keys;
+  file_keys.add(scene_keys);
+  if (!scene_keys.find_nothrow("problem", false))
+    file_keys.add_options()("problem", po::value<std::string>(), "problem the scene is for");
+  po::options_description cli_keys;
+  cli_keys.add(file_keys).add(driver_keys);
+  try {
+    // Command line first: po::store keeps the first value it sees, so the command line wins.
+    std::vector<std::string> words = arguments;
+    po::store(po::command_line_parser(words).options(cli_keys).style(
+                  po::command_line_style::unix_style ^ po::command_line_style::allow_guessing)
+                  .run(),
+              vm);
+  } catch (const po::error& e) {
+    rethrow_as_input_error(e, "command line");
+  }
+  if (!ini_path.empty()) {
+    std::ifstream in = open_scene(ini_path);
+    try {
+      po::store(po::parse_config_file(in, file_keys, /*allow_unregistered=*/false), vm);
+    } catch (const po::error& e) {
+      rethrow_as_input_error(e, ini_path);
+    }
+  }
+  try {
+    po::notify(vm);
+  } catch (const po::error& e) {
+    rethrow_as_input_error(e, "");
+  }
+  return Scene(std::move(vm), ini_path);
+}
+
+std::string scene_problem_name(const std::string& ini_path) {
+  std::ifstream in = open_scene(ini_path);
+  po::options_description keys;
+  keys.add_options()("problem", po::value<std::string>()->default_value("contact_bar"), "");
+  po::variables_map vm;
+  try {
+    po::store(po::parse_config_file(in, keys, /*allow_unregistered=*/true), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    rethrow_as_input_error(e, ini_path);
+  }
+  return vm["problem"].as<std::string>();
+}
+
+}  // namespace backbone::core

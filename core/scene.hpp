@@ -1,0 +1,62 @@
+// Scenes: INI files of named keys, merged as defaults < scene file < command line.
+//
+// A problem declares its keys (with defaults and a one-line description giving the unit) in a
+// boost::program_options::options_description. read_scene parses the INI file against exactly
+// those keys and then the command-line overrides (`--key value`) against those keys plus the
+// driver's own options. Unknown keys, unreadable files, malformed or non-finite numbers are
+// InputErrors naming the key: the CLI turns them into one line on stderr and exit code 2.
+// Keys are flat (no INI sections) so that every key reads the same in the file and on the
+// command line. The key `problem` names the problem the scene is for (default contact_bar).
+//
+//   namespace po = boost::program_options;
+//   po::options_description keys("contact bar");
+//   keys.add_options()("length", po::value<double>()->default_value(1.0), "bar length L [m]");
+//   Scene scene = read_scene(keys, "paper.ini", {"--length", "2"}, driver_keys);
+//   double L = scene.positive("length");      // 2, or InputError "length: must be > 0 (got -1)"
+#pragma once
+
+#include <boost/program_options.hpp>
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+namespace backbone::core {
+
+namespace po = boost::program_options;
+
+class Scene {
+ public:
+  Scene() = default;
+  Scene(po::variables_map values, std::string path)
+      : values_(std::move(values)), path_(std::move(path)) {}
+
+  bool has(const std::string& key) const { return values_.count(key) > 0; }
+  // Typed, validated accessors. Each throws InputError(key, constraint) on violation.
+  double number(const std::string& key) const;        // finite
+  double positive(const std::string& key) const;      // finite and > 0
+  double non_negative(const std::string& key) const;  // finite and >= 0
+  long integer(const std::string& key, long min_value) const;  // integral and >= min_value
+  std::string text(const std::string& key) const;
+  std::string choice(const std::string& key, std::initializer_list<const char*> allowed) const;
+  bool flag(const std::string& key) const;
+
+  const po::variables_map& values() const { return values_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  po::variables_map values_;
+  std::string path_;
+};
+
+// Parses `ini_path` against `scene_keys` (unknown key -> InputError), then `arguments`
+// (command-line words after the scene path) against scene_keys + driver_keys. Values given on
+// the command line win. An empty ini_path means "defaults + command line only".
+Scene read_scene(const po::options_description& scene_keys, const std::string& ini_path,
+                 const std::vector<std::string>& arguments,
+                 const po::options_description& driver_keys);
+
+// The value of the `problem` key of an INI file ("contact_bar" when absent), read before the
+// problem's keys are known. Throws InputError when the file cannot be read.
+std::string scene_problem_name(const std::string& ini_path);
+
+}  // namespace backbone::core

@@ -1,0 +1,144 @@
+#include "problems/bar/bar.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/errors.hpp"
+
+namespace backbone::bar {
+
+using core::InputError;
+
+const char* to_string(EndType e) {
+  switch (e) {
+    case EndType::fixed: return "fixed";
+    case EndType::free: return "free";
+    case EndType::contact: return "contact";
+  }
+  return "?";
+}
+
+EndType parse_end_type(const std::string& key, const std::string& value) {
+  if (value == "fixed") return EndType::fixed;
+  if (value == "free") return EndType::free;
+  if (value == "contact") return EndType::contact;
+  throw InputError(key, fmt::format("must be one of fixed, free, contact (got '{}')", value));
+}
+
+double Material::wave_speed() const { return std::sqrt(youngs_modulus / density); }
+double Material::axial_stiffness() const { return youngs_modulus * area; }
+double Material::impedance() const { return density * area * wave_speed(); }
+double Material::travel_time() const { return length / wave_speed(); }
+
+PiecewiseLinear::PiecewiseLinear(std::vector<double> x, std::vector<double> y)
+    : x_(std::move(x)), y_(std::move(y)) {
+  if (x_.empty() || x_.size() != y_.size())
+    throw InputError("knots", fmt::format("need as many values as knots, at least one ({} vs {})",
+                                          y_.size(), x_.size()));
+  for (std::size_t i = 0; i < x_.size(); ++i) {
+    if (!std::isfinite(x_[i]) || !std::isfinite(y_[i]))
+      throw InputError("knots", fmt::format("knot {} is not finite ({}, {})", i, x_[i], y_[i]));
+    if (i > 0 && !(x_[i] > x_[i - 1]))
+      throw InputError("knots", fmt::format("knots must increase strictly ({} after {})", x_[i],
+                                            x_[i - 1]));
+  }
+}
+
+double PiecewiseLinear::operator()(double x) const {
+  if (x <= x_.front()) return y_.front();
+  if (x >= x_.back()) return y_.back();
+  auto it = std::upper_bound(x_.begin(), x_.end(), x);
+  const std::size_t i = static_cast<std::size_t>(it - x_.begin());  // x_[i-1] <= x < x_[i]
+  const double w = (x - x_[i - 1]) / (x_[i] - x_[i - 1]);
+  return (1 - w) * y_[i - 1] + w * y_[i];
+}
+
+double PiecewiseLinear::slope(double x, int side) const {
+  if (x_.size() < 2) return 0;
+  if (x < x_.front() || (x == x_.front() && side < 0)) return 0;
+  if (x > x_.back() || (x == x_.back() && side > 0)) return 0;
+  std::size_t i;
+  if (side > 0) {
+    i = static_cast<std::size_t>(std::upper_bound(x_.begin(), x_.end(), x) - x_.begin());
+  } else {
+    i = static_cast<std::size_t>(std::lower_bound(x_.begin(), x_.end(), x) - x_.begin());
+  }
+  i = std::clamp<std::size_t>(i, 1, x_.size() - 1);
+  return (y_[i] - y_[i - 1]) / (x_[i] - x_[i - 1]);
+}
+
+double PiecewiseLinear::integral(double a, double b) const {
+  if (a == b) return 0;
+  if (a > b) return -integral(b, a);
+  // Points where the integrand changes form: a, the knots inside (a, b), b.
+  double total = 0;
+  double left = a;
+  auto piece = [&](double l, double r) { total += 0.5 * ((*this)(l) + (*this)(r)) * (r - l); };
+  for (double k : x_) {
+    if (k <= left) continue;
+    if (k >= b) break;
+    piece(left, k);
+    left = k;
+  }
+  piece(left, b);
+  return total;
+}
+
+void BarSetup::validate() const {
+  auto positive = [](const char* key, double v) {
+    if (!std::isfinite(v) || !(v > 0)) throw InputError(key, fmt::format("must be > 0 (got {})", v));
+  };
+  positive("length", material.length);
+  positive("youngs_modulus", material.youngs_modulus);
+  positive("density", material.density);
+  positive("area", material.area);
+  for (const auto& [key, end] : {std::pair{"gap", left}, std::pair{"gap", right}}) {
+    if (!std::isfinite(end.gap) || end.gap < 0)
+      throw InputError(key, fmt::format("must be >= 0 (got {})", end.gap));
+  }
+  if (!std::isfinite(body_force))
+    throw InputError("body_force", fmt::format("must be finite (got {})", body_force));
+  const double L = material.length;
+  for (const auto& [key, f] : {std::pair{"u0", &u0}, std::pair{"v0", &v0}}) {
+    if (f->knots().front() < 0 || f->knots().back() > L * (1 + 1e-12))
+      throw InputError(key, fmt::format("knots must lie in [0, length] = [0, {}] (got [{}, {}])", L,
+                                        f->knots().front(), f->knots().back()));
+  }
+  // A contact end must start on the admissible side of its wall.
+  if (right.type == EndType::contact && u0(L) > right.gap * (1 + 1e-12) + 1e-300)
+    throw InputError("u0", fmt::format("u0(L) = {} penetrates the wall at gap {}", u0(L), right.gap));
+  if (left.type == EndType::contact && -u0(0.0) > left.gap * (1 + 1e-12) + 1e-300)
+    throw InputError("u0", fmt::format("u0(0) = {} penetrates the wall at gap {}", u0(0.0), left.gap));
+}
+
+bool BarSetup::observed_end_is_right() const {
+  return right.type == EndType::contact || left.type != EndType::contact;
+}
+
+void SimulationOptions::validate() const {
+  if (!std::isfinite(t_end) || !(t_end > 0))
+    throw InputError("t_end", fmt::format("must be > 0 (got {})", t_end));
+  if (!std::isfinite(dt) || !(dt > 0)) throw InputError("dt", fmt::format("must be > 0 (got {})", dt));
+  if (elements < 1) throw InputError("elements", fmt::format("must be >= 1 (got {})", elements));
+  if (history_samples < 2)
+    throw InputError("history_samples", fmt::format("must be >= 2 (got {})", history_samples));
+  for (double p : probes)
+    if (!std::isfinite(p)) throw InputError("probes", "must be finite");
+}
+
+core::Table History::to_table() const {
+  std::vector<std::string> cols{"t", "u_contact", "contact_force", "energy"};
+  for (std::size_t k = 0; k < probes.size(); ++k) cols.push_back(fmt::format("u_probe{}", k));
+  core::Table table(cols);
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    std::vector<double> row{t[i], u_contact[i], contact_force[i],
+                            i < energy.size() ? energy[i] : std::nan("")};
+    for (const auto& p : probe_u) row.push_back(p[i]);
+    table.add_row(row);
+  }
+  return table;
+}
+
+}  // namespace backbone::bar
