@@ -92,10 +92,24 @@ struct History {
   core::Table to_table() const;  // columns t,u_contact,contact_force,energy,u_probe0,...
 };
 
-// Final state on the node grid (what a shooting residual needs).
+// What a shooting residual needs from a simulation: the field at ONE instant t, on the uniform
+// node grid x_i = i L / elements (i = 0..elements). Only the requested parts are computed.
+struct SnapshotRequest {
+  double dt = 1e-3;         // time step of the march (TD-BEM, FEM); the exact solver ignores it
+  int elements = 100;       // node grid: elements + 1 nodes including both ends
+  bool nodal_u = true;      // u(x_i, t)
+  bool nodal_v = false;     // v(x_i, t) (one-sided limits are ambiguous on a front: prefer
+                            // the projection below for residuals)
+  bool projected_u = false; // int_0^L u(x, t) psi_i(x) dx, psi_i the hat function of node i
+  bool projected_v = false; // int_0^L v(x, t) psi_i(x) dx (exact for piecewise fields)
+};
+
 struct FieldSnapshot {
   double t = 0;
-  std::vector<double> x, u, v;
+  std::vector<double> x;                      // node positions (size elements + 1)
+  std::vector<double> u, v, u_projected, v_projected;  // empty unless requested
+  bool ok = true;             // false: the march failed (non-finite values)
+  std::string message;
 };
 
 class BarSolver {
@@ -103,6 +117,9 @@ class BarSolver {
   virtual ~BarSolver() = default;
   virtual std::string name() const = 0;
   virtual History simulate(const BarSetup& setup, const SimulationOptions& options) const = 0;
+  // The field at time t only (no history is kept beyond what the march itself needs).
+  virtual FieldSnapshot snapshot(const BarSetup& setup, double t,
+                                 const SnapshotRequest& request) const = 0;
 };
 
 }  // namespace backbone::bar
