@@ -1,0 +1,136 @@
+#include "core/eigen_newton.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace backbone::core {
+
+int minimum_norm_solve(const Matrix& J, const Vector& rhs, double rank_cutoff, Vector& dx) {
+  // BDCSVD falls back to one-sided Jacobi for small matrices and stays fast for large ones.
+  Eigen::BDCSVD<Matrix> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  svd.setThreshold(rank_cutoff > 0 ? rank_cutoff : std::numeric_limits<double>::epsilon());
+  const Eigen::Index rank = svd.rank();
+  if (rank == 0) {
+    dx = Vector::Zero(J.cols());
+    return 0;
+  }
+  const auto& U = svd.matrixU();
+  const auto& V = svd.matrixV();
+  const auto& sigma = svd.singularValues();
+  Vector coefficients = U.leftCols(rank).transpose() * rhs;
+  coefficients.array() /= sigma.head(rank).array();
+  dx = V.leftCols(rank) * coefficients;
+  return static_cast<int>(rank);
+}
+
+EigenNewton::EigenNewton(const NewtonOptions& options) : options_(options) {
+  options_.validate();
+}
+
+NewtonSummary EigenNewton::solve(const Problem& problem, Vector& x) {
+  const auto start = std::chrono::steady_clock::now();
+  const long residuals_before = problem.counters().residuals;
+  const long jacobians_before = problem.counters().jacobians;
+  NewtonSummary summary;
+  auto finish = [&](NewtonStatus status, std::string message) {
+    summary.status = status;
+    summary.message = std::move(message);
+    summary.residual_evaluations = problem.counters().residuals - residuals_before;
+    summary.jacobian_evaluations = problem.counters().jacobians - jacobians_before;
+    summary.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return summary;
+  };
+
+  if (x.size() != problem.num_unknowns())
+    return finish(NewtonStatus::evaluation_failed,
+                  fmt::format("eigen: starting point has {} entries, problem has {} unknowns",
+                              x.size(), problem.num_unknowns()));
+
+  Vector r;
+  EvalStatus eval = problem.residual(x, r);
+  if (eval != EvalStatus::ok)
+    return finish(NewtonStatus::evaluation_failed,
+                  fmt::format("eigen: residual at the starting point: {}", to_string(eval)));
+  summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
+  if (summary.residual_history.back() <= options_.residual_tolerance)
+    return finish(NewtonStatus::converged,
+                  fmt::format("eigen: starting point already converged, ||F||_inf = {:.3e}",
+                              summary.residual_history.back()));
+
+  const Vector scale = problem.typical_scale().cwiseAbs();
+  Matrix J;
+  Vector dx, trial_x, trial_r;
+  constexpr double armijo = 1e-4;
+  constexpr int max_halvings = 30;
+
+  for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
+    summary.iterations = iteration;
+    eval = problem.jacobian(x, J);
+    if (eval != EvalStatus::ok)
+      return finish(NewtonStatus::evaluation_failed,
+                    fmt::format("eigen: Jacobian at iteration {}: {}", iteration, to_string(eval)));
+    const int rank = minimum_norm_solve(J, -r, options_.rank_cutoff, dx);
+    if (!dx.allFinite())
+      return finish(NewtonStatus::linear_solver_failed,
+                    fmt::format("eigen: non-finite Newton step at iteration {}", iteration));
+
+    const double norm2 = r.norm();
+    double alpha = 1.0;
+    bool accepted = false;
+    EvalStatus last_failure = EvalStatus::ok;
+    for (int halving = 0; halving <= (options_.line_search ? max_halvings : 0); ++halving) {
+      trial_x = x + alpha * dx;
+      const EvalStatus s = problem.residual(trial_x, trial_r);
+      if (s == EvalStatus::ok &&
+          (!options_.line_search || trial_r.norm() <= (1.0 - armijo * alpha) * norm2)) {
+        accepted = true;
+        break;
+      }
+      if (s != EvalStatus::ok) last_failure = s;
+      if (!options_.line_search && s != EvalStatus::ok)
+        return finish(NewtonStatus::evaluation_failed,
+                      fmt::format("eigen: residual at iteration {}: {}", iteration, to_string(s)));
+      alpha *= 0.5;
+    }
+    // Scaled step length: relative to max(|x_j|, typical scale_j).
+    double scaled_step = 0;
+    for (Eigen::Index j = 0; j < x.size(); ++j)
+      scaled_step = std::max(
+          scaled_step, std::abs(alpha * dx[j]) / std::max({std::abs(x[j]), scale[j], 1e-300}));
+    if (!accepted) {
+      if (scaled_step <= options_.step_tolerance || rank == 0)
+        return finish(NewtonStatus::stalled,
+                      fmt::format("eigen: stalled at iteration {} (rank {}), ||F||_inf = {:.3e}",
+                                  iteration, rank, summary.residual_history.back()));
+      if (last_failure != EvalStatus::ok)
+        return finish(NewtonStatus::evaluation_failed,
+                      fmt::format("eigen: line search found no evaluable point at iteration "
+                                  "{} ({})",
+                                  iteration, to_string(last_failure)));
+      return finish(NewtonStatus::diverged,
+                    fmt::format("eigen: line search failed at iteration {}, ||F||_inf = {:.3e}",
+                                iteration, summary.residual_history.back()));
+    }
+    x.swap(trial_x);
+    r.swap(trial_r);
+    summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
+    if (summary.residual_history.back() <= options_.residual_tolerance)
+      return finish(NewtonStatus::converged,
+                    fmt::format("eigen: converged in {} iterations, ||F||_inf = {:.3e}", iteration,
+                                summary.residual_history.back()));
+    if (scaled_step <= options_.step_tolerance)
+      return finish(NewtonStatus::stalled,
+                    fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
+                                "{}, ||F||_inf = {:.3e}",
+                                scaled_step, iteration, summary.residual_history.back()));
+  }
+  return finish(NewtonStatus::max_iterations,
+                fmt::format("eigen: no convergence in {} iterations, ||F||_inf = {:.3e}",
+                            options_.max_iterations, summary.residual_history.back()));
+}
+
+}  // namespace backbone::core

@@ -1,0 +1,39 @@
+#include "core/periodic_orbit.hpp"
+
+#include <fmt/format.h>
+
+#include "core/errors.hpp"
+
+namespace backbone::core {
+
+const char* to_string(ShootingFormulation f) {
+  switch (f) {
+    case ShootingFormulation::displacement_periodicity:
+      return "displacement_periodicity";
+    case ShootingFormulation::half_period_velocity:
+      return "half_period_velocity";
+  }
+  return "?";
+}
+
+ShootingFormulation parse_formulation(const std::string& name) {
+  if (name == "paper" || name == "displacement_periodicity")
+    return ShootingFormulation::displacement_periodicity;
+  if (name == "regular" || name == "half_period_velocity")
+    return ShootingFormulation::half_period_velocity;
+  throw InputError("formulation",
+                   fmt::format("unknown formulation '{}' (expected paper, "
+                               "displacement_periodicity, regular or half_period_velocity)",
+                               name));
+}
+
+Vector PeriodicOrbitProblem::state_coordinates() const {
+  const int s = state_size();
+  return Vector::LinSpaced(s, 0.0, static_cast<double>(s - 1));
+}
+
+Observables PeriodicOrbitProblem::observables(const Vector& x) const {
+  return {{"period", period(x)}, {"frequency", frequency(x)}, {"energy", energy(x)}};
+}
+
+}  // namespace backbone::core
