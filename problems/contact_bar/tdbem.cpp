@@ -1,0 +1,523 @@
+#include "problems/contact_bar/tdbem.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/errors.hpp"
+
+namespace backbone::contact_bar {
+
+using core::InputError;
+
+const char* to_string(ContactMethod m) {
+  return m == ContactMethod::projection ? "projection" : "event";
+}
+
+ContactMethod parse_contact_method(const std::string& key, const std::string& value) {
+  if (value == "projection") return ContactMethod::projection;
+  if (value == "event") return ContactMethod::event;
+  throw InputError(key, fmt::format("must be one of projection, event (got '{}')", value));
+}
+
+namespace {
+
+// F(t, a) = int_0^t min(c s, a) ds and its partial derivatives in t and a.
+double body_integral(double c, double t, double a) {
+  return c * t <= a ? 0.5 * c * t * t : a * t - 0.5 * a * a / c;
+}
+double body_rate(double c, double t, double a) {
+  return std::min(c * t, a);
+}
+double body_slope(double c, double t, double a) {
+  return c * t <= a ? 0.0 : t - a / c;
+}
+
+}  // namespace
+
+TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod method)
+    : setup_(setup), method_(method), dt_(dt) {
+  setup_.validate();
+  L_ = setup_.material.length;
+  c_ = setup_.material.wave_speed();
+  tau_ = L_ / c_;
+  ea_ = setup_.material.axial_stiffness();
+  body_coef_ = setup_.body_force / setup_.material.density / (2 * c_);
+  v0_total_ = setup_.v0.integral(0, L_);
+  if (!std::isfinite(dt) || !(dt > 0))
+    throw InputError("dt", fmt::format("must be > 0 (got {})", dt));
+  if (dt > tau_ * (1 + 1e-12))
+    throw InputError("dt", fmt::format("must be <= length / wave_speed = {} (got {}): one step "
+                                       "may not cross the bar",
+                                       tau_, dt));
+  const bar::End* end_of[2] = {&setup_.left, &setup_.right};
+  for (int e = 0; e < 2; ++e) {
+    EndState& E = ends_[e];
+    E.end = *end_of[e];
+    E.normal = e == 0 ? -1.0 : 1.0;
+    E.wall = E.end.type == bar::EndType::contact ? E.normal * E.end.gap : 0.0;
+    const double u = setup_.u0(e == 0 ? 0.0 : L_);
+    if (E.end.type == bar::EndType::fixed && u != 0)
+      throw InputError("u0", fmt::format("u0 must vanish at the fixed end x = {} (got {})",
+                                         e == 0 ? 0.0 : L_, u));
+    E.knots.push_back({0.0, u, 0.0, 0.5 * u, false});
+    E.closed = E.end.type == bar::EndType::contact && E.normal * (u - E.wall) >= 0;
+    if (method_ == ContactMethod::event) {
+      // Kinks of R_e inside (0, tau]: data knots reaching the end, and the end of the IC term.
+      std::vector<double> times{tau_};
+      for (const auto* f : {&setup_.u0, &setup_.v0})
+        for (double x : f->knots()) {
+          const double time = (e == 0 ? x : L_ - x) / c_;
+          if (time > 0 && time < tau_) times.push_back(time);
+        }
+      std::sort(times.begin(), times.end());
+      times.erase(std::unique(times.begin(), times.end()), times.end());
+      E.pending.assign(times.begin(), times.end());
+    }
+  }
+}
+
+double TdbemMarch::tolerance() const {
+  return 1e-9 * dt_ + 1e-14 * t_;
+}
+
+double TdbemMarch::q_at(int e, double s) const {
+  const auto& k = ends_[e].knots;
+  auto it =
+      std::lower_bound(k.begin(), k.end(), s, [](const Knot& a, double v) { return a.t < v; });
+  if (it == k.end()) return k.back().q;
+  if (it == k.begin()) return it->q;
+  auto prev = it - 1;
+  const double w = (s - prev->t) / (it->t - prev->t);
+  return prev->q + w * (it->q - prev->q);
+}
+
+double TdbemMarch::q_slope(int e, double s) const {
+  const auto& k = ends_[e].knots;
+  if (k.size() < 2) return 0;
+  auto it =
+      std::lower_bound(k.begin(), k.end(), s, [](const Knot& a, double v) { return a.t < v; });
+  if (it == k.end()) it = k.end() - 1;
+  if (it == k.begin()) it = k.begin() + 1;
+  auto prev = it - 1;
+  return (it->q - prev->q) / (it->t - prev->t);
+}
+
+double TdbemMarch::r_end(int e, double t) const {
+  const double ct = c_ * t;
+  const double retarded = t - tau_;
+  double value = body_coef_ * body_integral(c_, t, L_);
+  if (retarded <= 0) {
+    if (e == 1) {
+      value += 0.5 * setup_.u0(std::max(L_ - ct, 0.0));
+      value += setup_.v0.integral(std::max(L_ - ct, 0.0), L_) / (2 * c_);
+    } else {
+      value += 0.5 * setup_.u0(std::min(ct, L_));
+      value += setup_.v0.integral(0.0, std::min(ct, L_)) / (2 * c_);
+    }
+  } else {
+    value += v0_total_ / (2 * c_) + q_at(1 - e, retarded);
+  }
+  return value;
+}
+
+void TdbemMarch::push_knot(int e, double t, double u, double s, bool kink) {
+  EndState& E = ends_[e];
+  E.knots.push_back({t, u, s, 0.5 * c_ * s + 0.5 * u, false});
+  if (!std::isfinite(u) || !std::isfinite(s)) ok_ = false;
+  if (kink) mark_kink(e);
+}
+
+void TdbemMarch::mark_kink(int e) {
+  if (method_ != ContactMethod::event) return;
+  Knot& k = ends_[e].knots.back();
+  if (k.kink) return;
+  k.kink = true;
+  // The echo of this kink reaches the other end tau later.
+  EndState& other = ends_[1 - e];
+  const double echo = k.t + tau_;
+  if (other.knots.back().t >= echo - tolerance()) {
+    if (std::abs(other.knots.back().t - echo) <= tolerance()) mark_kink(1 - e);
+    return;
+  }
+  other.pending.insert(std::upper_bound(other.pending.begin(), other.pending.end(), echo), echo);
+}
+
+void TdbemMarch::step_end(int e, double ta, double tb) {
+  EndState& E = ends_[e];
+  const double h = tb - ta;
+  if (method_ == ContactMethod::projection) {
+    const Knot a = E.knots.back();
+    const double r = r_end(e, tb);
+    switch (E.end.type) {
+      case bar::EndType::fixed: {
+        const double s = -2 * r / c_;
+        E.force = -ea_ * E.normal * (s - a.s) / h;
+        push_knot(e, tb, 0.0, s, false);
+        break;
+      }
+      case bar::EndType::free:
+        E.force = 0;
+        push_knot(e, tb, 2 * r + c_ * a.s, a.s, false);
+        break;
+      case bar::EndType::contact: {
+        const double u_free = 2 * r + c_ * a.s;
+        const double penetration = E.normal * (u_free - E.wall);
+        const bool closed = penetration > 0;
+        if (closed && !E.closed) events_.push_back({tb, e == 1, true});
+        if (!closed && E.closed) events_.push_back({ta, e == 1, false});
+        E.closed = closed;
+        if (closed) {
+          E.force = ea_ * penetration / (c_ * h);
+          push_knot(e, tb, E.wall, (E.wall - 2 * r) / c_, false);
+        } else {
+          E.force = 0;
+          push_knot(e, tb, u_free, a.s, false);
+        }
+        break;
+      }
+    }
+    return;
+  }
+  // Event method: split the step at the kinks of R_e that fall inside it.
+  const double tol = tolerance();
+  std::vector<double> cuts;
+  bool kink_at_end = false;
+  while (!E.pending.empty() && E.pending.front() <= tb + tol) {
+    const double p = E.pending.front();
+    E.pending.pop_front();
+    if (p <= ta + tol) continue;
+    if (p >= tb - tol) {
+      kink_at_end = true;
+      continue;
+    }
+    if (cuts.empty() || p - cuts.back() > tol) cuts.push_back(p);
+  }
+  double a = ta;
+  for (double cut : cuts) {
+    substep_event(e, a, cut, true);
+    a = cut;
+  }
+  substep_event(e, a, tb, kink_at_end);
+}
+
+void TdbemMarch::substep_event(int e, double ta, double tb, bool kink_at_end) {
+  EndState& E = ends_[e];
+  const Knot a = E.knots.back();
+  switch (E.end.type) {
+    case bar::EndType::fixed: {
+      const double s = -2 * r_end(e, tb) / c_;
+      E.force = -ea_ * E.normal * (s - a.s) / (tb - ta);
+      push_knot(e, tb, 0.0, s, kink_at_end);
+      return;
+    }
+    case bar::EndType::free:
+      E.force = 0;
+      push_knot(e, tb, 2 * r_end(e, tb) + c_ * a.s, a.s, kink_at_end);
+      return;
+    case bar::EndType::contact:
+      if (E.closed) {
+        solve_closed_to(e, ta, tb, kink_at_end);
+      } else {
+        solve_open(e, ta, tb, kink_at_end);
+      }
+      return;
+  }
+}
+
+// Open end over [ta, tb] (no kink of R inside): free motion unless the free displacement
+// crosses the wall, in which case the step is split at the crossing.
+void TdbemMarch::solve_open(int e, double ta, double tb, bool kink_at_end) {
+  EndState& E = ends_[e];
+  const Knot a = E.knots.back();
+  const double h = tb - ta;
+  const double n = E.normal;
+  auto gap_violation = [&](double t) { return n * (2 * r_end(e, t) + c_ * a.s - E.wall); };
+  const double pb = gap_violation(tb);
+  if (!(pb > 0)) {
+    E.force = 0;
+    push_knot(e, tb, 2 * r_end(e, tb) + c_ * a.s, a.s, kink_at_end);
+    return;
+  }
+  // Crossing: the free displacement is linear in t (quadratic with a body force).
+  const double pa = std::min(n * (a.u - E.wall), 0.0);
+  const double pm = gap_violation(ta + 0.5 * h);
+  const double alpha = (4 * pm - 3 * pa - pb) / h;
+  const double beta = 2 * (pa - 2 * pm + pb) / (h * h);
+  double root = h * (-pa) / (pb - pa);
+  if (std::abs(beta) * h * h > 1e-10 * (std::abs(pa) + std::abs(pb))) {
+    for (int it = 0; it < 20; ++it) {
+      const double p = pa + root * (alpha + beta * root);
+      const double dp = alpha + 2 * beta * root;
+      if (!(dp > 0)) break;
+      const double next = std::clamp(root - p / dp, 0.0, h);
+      if (next == root) break;
+      root = next;
+    }
+  }
+  const double tol = tolerance();
+  double t_close = ta + root;
+  E.closed = true;
+  if (t_close - ta <= tol) {
+    t_close = ta;
+    mark_kink(e);
+  } else if (tb - t_close <= tol) {
+    events_.push_back({tb, e == 1, true});
+    E.force = 0;
+    push_knot(e, tb, E.wall, a.s, true);
+    return;
+  } else {
+    push_knot(e, t_close, E.wall, a.s, true);
+  }
+  events_.push_back({t_close, e == 1, true});
+  // Closed from t_close; a release in the same sub-step is not looked for right after closing
+  // when no time has passed (that would loop), otherwise it is.
+  if (t_close == ta) {
+    const double s = (E.wall - 2 * r_end(e, tb)) / c_;
+    E.force = -ea_ * n * (s - a.s) / h;
+    push_knot(e, tb, E.wall, s, kink_at_end);
+  } else {
+    solve_closed_to(e, t_close, tb, kink_at_end);
+  }
+}
+
+// Closed end over [ta, tb]: stays on the wall while the force is compressive; the release
+// instant is the sign change of the force (at ta, or inside the sub-step with a body force).
+void TdbemMarch::solve_closed_to(int e, double ta, double tb, bool kink_at_end) {
+  EndState& E = ends_[e];
+  const Knot a = E.knots.back();
+  const double h = tb - ta;
+  const double n = E.normal;
+  auto gap_violation = [&](double t) { return n * (2 * r_end(e, t) + c_ * a.s - E.wall); };
+  // gap_violation(ta) = 0 on the wall; the force over [ta, t] is EA * violation(t) / (c (t-ta)).
+  const double pm = gap_violation(ta + 0.5 * h);
+  const double pb = gap_violation(tb);
+  const double alpha = (4 * pm - pb) / h;  // instantaneous force at ta+ is EA alpha / c
+  const double beta = 2 * (pb - 2 * pm) / (h * h);
+  const double tol = tolerance();
+  auto closed_step = [&](double t_end, bool kink) {
+    const double s = (E.wall - 2 * r_end(e, t_end)) / c_;
+    E.force = -ea_ * n * (s - a.s) / (t_end - ta);
+    push_knot(e, t_end, E.wall, s, kink);
+  };
+  if (alpha < 0 && pb < 0) {
+    events_.push_back({ta, e == 1, false});
+    E.closed = false;
+    mark_kink(e);
+    solve_open(e, ta, tb, kink_at_end);
+    return;
+  }
+  const double force_end_rate = alpha + 2 * beta * h;
+  if (alpha >= 0 && force_end_rate < 0 && beta != 0) {
+    const double t_release = ta - alpha / (2 * beta);
+    if (t_release - ta > tol && tb - t_release > tol) {
+      closed_step(t_release, true);
+      events_.push_back({t_release, e == 1, false});
+      E.closed = false;
+      solve_open(e, t_release, tb, kink_at_end);
+      return;
+    }
+  }
+  if (pb < 0) {  // tensile over the whole sub-step: release at ta
+    events_.push_back({ta, e == 1, false});
+    E.closed = false;
+    mark_kink(e);
+    solve_open(e, ta, tb, kink_at_end);
+    return;
+  }
+  closed_step(tb, kink_at_end);
+}
+
+bool TdbemMarch::advance_to(double target) {
+  if (!std::isfinite(target)) throw InputError("t", "must be finite");
+  while (ok_ && t_ < target) {
+    const double k = std::floor(t_ / dt_ + 1e-9);
+    double next = std::min((k + 1) * dt_, target);
+    if (next <= t_) next = std::min(t_ + dt_, target);
+    step_end(0, t_, next);
+    step_end(1, t_, next);
+    t_ = next;
+    // Keep exactly the window [t - tau, t] (plus one knot before it).
+    for (auto& E : ends_)
+      while (E.knots.size() > 2 && E.knots[1].t <= t_ - tau_) E.knots.pop_front();
+  }
+  return ok_;
+}
+
+double TdbemMarch::end_displacement(bool right) const {
+  return ends_[right ? 1 : 0].knots.back().u;
+}
+double TdbemMarch::end_force(bool right) const {
+  return ends_[right ? 1 : 0].force;
+}
+bool TdbemMarch::in_contact(bool right) const {
+  return ends_[right ? 1 : 0].closed;
+}
+std::size_t TdbemMarch::stored_knots() const {
+  return ends_[0].knots.size() + ends_[1].knots.size();
+}
+
+double TdbemMarch::displacement(double x) const {
+  const double s0 = t_ - x / c_, sL = t_ - (L_ - x) / c_;
+  const double lo = x - c_ * t_, hi = x + c_ * t_;
+  double value = body_coef_ * (body_integral(c_, t_, x) + body_integral(c_, t_, L_ - x));
+  value += sL <= 0 ? 0.5 * setup_.u0(std::min(hi, L_)) : q_at(1, sL);
+  value += s0 <= 0 ? 0.5 * setup_.u0(std::max(lo, 0.0)) : q_at(0, s0);
+  value += setup_.v0.integral(std::max(lo, 0.0), std::min(hi, L_)) / (2 * c_);
+  return value;
+}
+
+double TdbemMarch::velocity(double x) const {
+  const double s0 = t_ - x / c_, sL = t_ - (L_ - x) / c_;
+  const double lo = x - c_ * t_, hi = x + c_ * t_;
+  double value = body_coef_ * (body_rate(c_, t_, x) + body_rate(c_, t_, L_ - x));
+  value += sL <= 0 ? 0.5 * c_ * setup_.u0.slope(hi, -1) + 0.5 * setup_.v0(hi) : q_slope(1, sL);
+  value += s0 <= 0 ? -0.5 * c_ * setup_.u0.slope(lo, +1) + 0.5 * setup_.v0(lo) : q_slope(0, s0);
+  return value;
+}
+
+double TdbemMarch::strain(double x) const {
+  const double s0 = t_ - x / c_, sL = t_ - (L_ - x) / c_;
+  const double lo = x - c_ * t_, hi = x + c_ * t_;
+  double value = body_coef_ * (body_slope(c_, t_, x) - body_slope(c_, t_, L_ - x));
+  value += sL <= 0 ? 0.5 * setup_.u0.slope(hi, -1) + setup_.v0(hi) / (2 * c_) : q_slope(1, sL) / c_;
+  value +=
+      s0 <= 0 ? 0.5 * setup_.u0.slope(lo, +1) - setup_.v0(lo) / (2 * c_) : -q_slope(0, s0) / c_;
+  return value;
+}
+
+// Every x where the field (a quadratic in x at most) changes form at the current time.
+std::vector<double> TdbemMarch::breakpoints(int elements) const {
+  std::vector<double> pts;
+  const double ct = c_ * t_;
+  for (int i = 0; i <= elements; ++i) pts.push_back(L_ * i / elements);
+  for (const auto* f : {&setup_.u0, &setup_.v0})
+    for (double k : f->knots()) {
+      pts.push_back(k - ct);
+      pts.push_back(k + ct);
+    }
+  pts.push_back(ct);
+  pts.push_back(L_ - ct);
+  for (const auto& k : ends_[0].knots) pts.push_back(c_ * (t_ - k.t));
+  for (const auto& k : ends_[1].knots) pts.push_back(L_ - c_ * (t_ - k.t));
+  std::vector<double> inside;
+  inside.reserve(pts.size());
+  for (double p : pts)
+    if (p >= 0 && p <= L_) inside.push_back(p);
+  std::sort(inside.begin(), inside.end());
+  inside.erase(std::unique(inside.begin(), inside.end()), inside.end());
+  return inside;
+}
+
+// Calls f(x, weight, element) at the two Gauss points of every piece: exact for cubics in x.
+template <class F>
+void TdbemMarch::integrate_pieces(int elements, F&& f) const {
+  const std::vector<double> pts = breakpoints(elements);
+  const double dx = L_ / elements;
+  const double g = 0.5 / std::sqrt(3.0);
+  for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+    const double a = pts[i], b = pts[i + 1], h = b - a;
+    if (!(h > 1e-15 * L_)) continue;
+    const double mid = 0.5 * (a + b);
+    const int j = std::clamp(static_cast<int>(std::floor(mid / dx)), 0, elements - 1);
+    f(mid - g * h, 0.5 * h, j);
+    f(mid + g * h, 0.5 * h, j);
+  }
+}
+
+std::vector<double> TdbemMarch::project(int elements, bool use_velocity) const {
+  std::vector<double> result(static_cast<std::size_t>(elements) + 1, 0.0);
+  const double dx = L_ / elements;
+  integrate_pieces(elements, [&](double x, double w, int j) {
+    const double value = use_velocity ? velocity(x) : displacement(x);
+    const double theta = (x - j * dx) / dx;
+    result[j] += w * value * (1 - theta);
+    result[j + 1] += w * value * theta;
+  });
+  return result;
+}
+
+std::vector<double> TdbemMarch::projected_displacement(int elements) const {
+  return project(elements, false);
+}
+std::vector<double> TdbemMarch::projected_velocity(int elements) const {
+  return project(elements, true);
+}
+
+double TdbemMarch::energy() const {
+  const auto& m = setup_.material;
+  double total = 0;
+  integrate_pieces(1, [&](double x, double w, int) {
+    const double v = velocity(x), ux = strain(x);
+    total += w * (0.5 * m.density * m.area * v * v + 0.5 * ea_ * ux * ux);
+    if (setup_.body_force != 0) total -= w * setup_.body_force * m.area * displacement(x);
+  });
+  return total;
+}
+
+bar::History TdbemSolver::simulate(const bar::BarSetup& setup,
+                                   const bar::SimulationOptions& options) const {
+  options.validate();
+  for (double p : options.probes)
+    if (p < 0 || p > setup.material.length)
+      throw InputError("probes", fmt::format("must lie in [0, length] = [0, {}] (got {})",
+                                             setup.material.length, p));
+  TdbemMarch march(setup, options.dt, method_);
+  const bool right = setup.observed_end_is_right();
+  const long steps = std::max(1L, static_cast<long>(std::ceil(options.t_end / options.dt - 1e-9)));
+  const long stride = std::max(
+      1L, static_cast<long>(std::ceil(static_cast<double>(steps) / (options.history_samples - 1))));
+  bar::History h;
+  h.probes = options.probes;
+  h.probe_u.resize(options.probes.size());
+  auto record = [&] {
+    h.t.push_back(march.time());
+    h.u_contact.push_back(march.end_displacement(right));
+    h.contact_force.push_back(march.end_force(right));
+    if (options.energy) h.energy.push_back(march.energy());
+    for (std::size_t k = 0; k < options.probes.size(); ++k)
+      h.probe_u[k].push_back(march.displacement(options.probes[k]));
+  };
+  record();
+  for (long k = stride;; k += stride) {
+    const double t = k >= steps ? options.t_end : std::min(k * options.dt, options.t_end);
+    if (!march.advance_to(t)) break;
+    record();
+    if (k >= steps) break;
+  }
+  return h;
+}
+
+bar::FieldSnapshot TdbemSolver::snapshot(const bar::BarSetup& setup, double t,
+                                         const bar::SnapshotRequest& request) const {
+  if (!std::isfinite(t) || t < 0) throw InputError("t", fmt::format("must be >= 0 (got {})", t));
+  if (request.elements < 1)
+    throw InputError("elements", fmt::format("must be >= 1 (got {})", request.elements));
+  TdbemMarch march(setup, request.dt, method_);
+  bar::FieldSnapshot s;
+  s.t = t;
+  const int n = request.elements;
+  for (int i = 0; i <= n; ++i) s.x.push_back(setup.material.length * i / n);
+  if (!march.advance_to(t)) {
+    s.ok = false;
+    s.message = fmt::format("tdbem: non-finite end values before t = {}", t);
+    return s;
+  }
+  if (request.nodal_u)
+    for (double x : s.x) s.u.push_back(march.displacement(x));
+  if (request.nodal_v)
+    for (double x : s.x) s.v.push_back(march.velocity(x));
+  if (request.projected_u) s.u_projected = march.projected_displacement(n);
+  if (request.projected_v) s.v_projected = march.projected_velocity(n);
+  for (const auto* field : {&s.u, &s.v, &s.u_projected, &s.v_projected})
+    for (double value : *field)
+      if (!std::isfinite(value)) {
+        s.ok = false;
+        s.message = "tdbem: non-finite field value";
+      }
+  return s;
+}
+
+}  // namespace backbone::contact_bar

@@ -1,0 +1,137 @@
+// Time-domain boundary element method (TD-BEM) for the 1D bar with unilateral contact.
+//
+// The internal point equation of the wave equation u_tt = c^2 u_xx + b (b = body_force / rho)
+// on [0, L], with tau = L / c, reads for xi in [0, L]
+//   u(xi, t) = IC(xi, t) + Q_L(t - (L - xi) / c) + Q_0(t - xi / c) + Body(xi, t),
+//   Q_e(s) = (c/2) S_e(s) + 1/2 U_e(s) for s > 0 and 0 for s <= 0,
+// U_e the end displacement, S_e(s) = int_0^s du/dn(e) the time integral of the outward normal
+// derivative, IC the d'Alembert term of u0, v0 extended by zero outside [0, L], and
+// Body(xi, t) = b/(2c) [F(t, xi) + F(t, L - xi)], F(t, a) = int_0^t min(c s, a) ds.
+// At xi = e it gives one boundary equation per end, 1/2 U_e(t) - (c/2) S_e(t) = R_e(t), where
+// R_e depends only on the data and on the OTHER end's history at t - tau: the two ends march
+// independently, O(1) work per step, and only the last tau of history (a ring of about
+// tau / dt + 2 knots) is kept. Tractions are piecewise constant in time (S, U, Q piecewise
+// linear). Each end has one unknown per step: U (free, open contact) or S (fixed, closed
+// contact). Interior u, v, u_x and exact hat-function projections come from the same equation
+// on demand. Contact force lambda = -EA u_x = -EA n dS/dt >= 0 (compressive).
+//
+// Contact: `projection` is the paper's Algorithm 1 (free prediction; on penetration the end is
+// put on the wall for the whole step; release when the step force would be tensile). Exactly:
+// the closed-step force is EA n (U_free - wall) / (c dt), so "penetration" and "positive force"
+// are the same test. `event` splits the step at the closing instant (root of the free
+// displacement, exact for linear data), at the release instant (sign change of the force) and
+// at the echoes of every such kink arriving from the other end (tau later), so that piecewise
+// linear solutions (mode 1 of DESIGN.md) are reproduced to round-off off the time grid too.
+// Requires dt <= L / c (one step may not cross the bar).
+//
+//   contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
+//   bar::SimulationOptions o; o.t_end = 3.1; o.dt = 1e-2;
+//   bar::History h = tdbem.simulate(setup, o);          // t, u_contact, contact_force, energy
+//   bar::SnapshotRequest r; r.dt = 1e-2; r.elements = 100; r.projected_v = true;
+//   bar::FieldSnapshot s = tdbem.snapshot(setup, 1.55, r);  // marches to 1.55 only
+//   contact_bar::TdbemMarch m(setup, 1e-2, contact_bar::ContactMethod::event);
+//   m.advance_to(2.5);  double v = m.velocity(0.3);  auto events = m.events();
+#pragma once
+
+#include <deque>
+#include <string>
+#include <vector>
+
+#include "problems/bar/bar.hpp"
+
+namespace backbone::contact_bar {
+
+enum class ContactMethod { projection, event };
+const char* to_string(ContactMethod m);
+ContactMethod parse_contact_method(const std::string& key, const std::string& value);  // InputError
+
+// A change of contact state of one end.
+struct ContactEvent {
+  double t = 0;
+  bool right_end = true;
+  bool closing = true;  // false: release
+};
+
+// The boundary march with its history window; the field at the current time on demand.
+class TdbemMarch {
+ public:
+  // Throws InputError for a bad setup or dt (dt must be finite, > 0 and <= L / c).
+  TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod method);
+
+  // Marches on the grid k dt and takes a last partial step to t (t need not be on the grid).
+  // Returns false (and stays false) when the march produced non-finite values.
+  bool advance_to(double t);
+  double time() const { return t_; }
+  bool ok() const { return ok_; }
+
+  double end_displacement(bool right) const;  // U_e at the current time [m]
+  double end_force(bool right) const;  // compressive end force -EA u_x over the last sub-step [N]
+  bool in_contact(bool right) const;
+  const std::vector<ContactEvent>& events() const { return events_; }
+
+  // Field at the current time, x in [0, L]. On a front (jump of v or u_x) the value is one of
+  // the one-sided limits; projections below are exact and unambiguous.
+  double displacement(double x) const;
+  double velocity(double x) const;
+  double strain(double x) const;
+  // int_0^L w psi_i dx on the uniform grid of `elements` intervals (exact integration).
+  std::vector<double> projected_displacement(int elements) const;
+  std::vector<double> projected_velocity(int elements) const;
+  // 1/2 int (rho A v^2 + EA u_x^2) dx - int body_force A u dx, integrated exactly.
+  double energy() const;
+  std::size_t stored_knots() const;  // history window size (both ends)
+
+ private:
+  struct Knot {
+    double t, u, s, q;  // time, U, S, Q = (c/2) S + U/2
+    bool kink;          // a slope change whose echo must be tracked (event method)
+  };
+  struct EndState {
+    bar::End end;
+    double normal = 1;  // outward normal
+    double wall = 0;    // wall position n * gap
+    std::deque<Knot> knots;
+    std::deque<double> pending;  // times of kinks of R_e still ahead (event method)
+    double force = 0;
+    bool closed = false;
+  };
+
+  double r_end(int e, double t) const;  // R_e(t), t > 0
+  double q_at(int e, double s) const;   // Q_e(s), s > 0
+  double q_slope(int e, double s) const;
+  void step_end(int e, double ta, double tb);
+  void substep_event(int e, double ta, double tb, bool kink_at_end);
+  void push_knot(int e, double t, double u, double s, bool kink);
+  void mark_kink(int e);  // flags the last knot of end e as a kink and schedules its echo
+  void solve_open(int e, double ta, double tb, bool kink_at_end);
+  void solve_closed_to(int e, double ta, double tb, bool kink_at_end);
+  std::vector<double> breakpoints(int elements) const;
+  template <class F>
+  void integrate_pieces(int elements, F&& f) const;
+  std::vector<double> project(int elements, bool velocity) const;
+  double tolerance() const;
+
+  bar::BarSetup setup_;
+  ContactMethod method_;
+  double dt_, L_, c_, tau_, ea_, body_coef_, v0_total_;
+  double t_ = 0;
+  bool ok_ = true;
+  EndState ends_[2];  // 0: x = 0, 1: x = L
+  std::vector<ContactEvent> events_;
+};
+
+class TdbemSolver : public bar::BarSolver {
+ public:
+  explicit TdbemSolver(ContactMethod method = ContactMethod::event) : method_(method) {}
+  std::string name() const override { return "tdbem"; }
+  ContactMethod method() const { return method_; }
+  bar::History simulate(const bar::BarSetup& setup,
+                        const bar::SimulationOptions& options) const override;
+  bar::FieldSnapshot snapshot(const bar::BarSetup& setup, double t,
+                              const bar::SnapshotRequest& request) const override;
+
+ private:
+  ContactMethod method_;
+};
+
+}  // namespace backbone::contact_bar
