@@ -26,6 +26,7 @@
 namespace backbone::continuation {
 
 struct BranchPoint {
+  int index = 0;                  // 0 for the corrected starting guess
   core::Vector x;                 // corrected solution, layout of the problem
   core::Observables observables;  // problem.observables(x)
   int dimension = -1;             // verified manifold dimension (-1: rank not checked here)
@@ -49,7 +50,7 @@ enum class StopReason {
   newton_failed,      // the very first point did not converge
   evaluation_failed,  // the residual returned NaN/Inf or failed where a point was needed
   singular_tangent,   // no well-defined tangent (null space of J not one-dimensional)
-  cancelled,          // a callback asked to stop
+  cancelled,          // ContinuationHooks::cancel_requested returned true
 };
 const char* to_string(StopReason r);
 

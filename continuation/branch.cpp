@@ -1,0 +1,60 @@
+#include "continuation/branch.hpp"
+
+#include <limits>
+
+namespace backbone::continuation {
+
+double BranchPoint::observable(const std::string& name) const {
+  for (const auto& [key, value] : observables)
+    if (key == name) return value;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+const char* to_string(StopReason r) {
+  switch (r) {
+    case StopReason::max_points:
+      return "max_points";
+    case StopReason::bound_reached:
+      return "bound_reached";
+    case StopReason::step_floor:
+      return "step_floor";
+    case StopReason::newton_failed:
+      return "newton_failed";
+    case StopReason::evaluation_failed:
+      return "evaluation_failed";
+    case StopReason::singular_tangent:
+      return "singular_tangent";
+    case StopReason::cancelled:
+      return "cancelled";
+  }
+  return "?";
+}
+
+core::Table branch_table(const Branch& branch) {
+  std::vector<std::string> names;
+  if (!branch.points.empty())
+    for (const auto& [key, value] : branch.points.front().observables) names.push_back(key);
+  std::vector<std::string> columns{"point"};
+  columns.insert(columns.end(), names.begin(), names.end());
+  for (const char* c : {"dimension", "nullity", "residual", "newton_iterations", "step_size",
+                        "arclength", "seconds", "jacobian_evaluations", "residual_evaluations"})
+    columns.push_back(c);
+  core::Table table(columns);
+  for (const BranchPoint& p : branch.points) {
+    std::vector<double> row{static_cast<double>(p.index)};
+    for (const std::string& n : names) row.push_back(p.observable(n));
+    row.push_back(p.dimension);
+    row.push_back(p.rank ? p.rank->nullity : -1);
+    row.push_back(p.residual);
+    row.push_back(p.newton_iterations);
+    row.push_back(p.step_size);
+    row.push_back(p.arclength);
+    row.push_back(p.seconds);
+    row.push_back(static_cast<double>(p.jacobian_evaluations));
+    row.push_back(static_cast<double>(p.residual_evaluations));
+    table.add_row(row);
+  }
+  return table;
+}
+
+}  // namespace backbone::continuation

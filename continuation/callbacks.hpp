@@ -1,0 +1,37 @@
+// Callbacks of a continuation run: the loop prints nothing, it calls back.
+//
+// on_point is called once per accepted point (the first, corrected guess included), in order;
+// a reporter prints a line, appends to a file or plots. on_attempt is called after every
+// correction attempt, accepted or not, so a progress display can show rejected steps.
+// cancel_requested, when set, is polled before each step: returning true ends the branch with
+// StopReason::cancelled (e.g. a wall-clock budget).
+//
+//   ContinuationHooks hooks;
+//   hooks.on_point = [](const BranchPoint& p) {
+//     fmt::print("{:4d}  E = {:.6g}  dim {}\n", p.index, p.observable("energy"), p.dimension);
+//   };
+//   hooks.on_attempt = [](const StepAttempt& a) { if (!a.accepted) ++rejections; };
+//   Branch b = pseudo_arclength(problem, x0, hint, *newton, options, hooks);
+#pragma once
+
+#include <functional>
+
+#include "continuation/branch.hpp"
+#include "core/newton.hpp"
+
+namespace backbone::continuation {
+
+struct StepAttempt {
+  int point = 0;  // index the point would get if accepted
+  double ds = 0;  // step size tried
+  bool accepted = false;
+  core::NewtonSummary newton;  // of the augmented system
+};
+
+struct ContinuationHooks {
+  std::function<void(const BranchPoint&)> on_point;
+  std::function<void(const StepAttempt&)> on_attempt;
+  std::function<bool()> cancel_requested;
+};
+
+}  // namespace backbone::continuation

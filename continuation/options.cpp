@@ -1,0 +1,72 @@
+#include "continuation/options.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/errors.hpp"
+
+namespace backbone::continuation {
+
+const char* to_string(Method m) {
+  return m == Method::natural ? "natural" : "arclength";
+}
+const char* to_string(Predictor p) {
+  return p == Predictor::secant ? "secant" : "tangent";
+}
+
+Method parse_method(const std::string& name) {
+  if (name == "natural") return Method::natural;
+  if (name == "arclength" || name == "pseudo_arclength" || name == "palc") return Method::arclength;
+  throw core::InputError("method", fmt::format("must be natural or arclength (got '{}')", name));
+}
+
+Predictor parse_predictor(const std::string& name) {
+  if (name == "secant") return Predictor::secant;
+  if (name == "tangent") return Predictor::tangent;
+  throw core::InputError("predictor", fmt::format("must be secant or tangent (got '{}')", name));
+}
+
+namespace {
+void require_positive(const char* key, double v) {
+  if (!(v > 0) || !std::isfinite(v))
+    throw core::InputError(key, fmt::format("must be finite and > 0 (got {})", v));
+}
+}  // namespace
+
+void ContinuationOptions::validate() const {
+  require_positive("ds", ds);
+  require_positive("ds_min", ds_min);
+  require_positive("ds_max", ds_max);
+  if (ds_min > ds)
+    throw core::InputError("ds_min", fmt::format("must be <= ds ({} > {})", ds_min, ds));
+  if (ds > ds_max)
+    throw core::InputError("ds", fmt::format("must be <= ds_max ({} > {})", ds, ds_max));
+  if (fast_iterations < 0)
+    throw core::InputError("fast_iterations",
+                           fmt::format("must be >= 0 (got {})", fast_iterations));
+  if (slow_iterations <= fast_iterations)
+    throw core::InputError("slow_iterations", fmt::format("must be > fast_iterations ({} vs {})",
+                                                          slow_iterations, fast_iterations));
+  if (!(grow_factor >= 1) || !std::isfinite(grow_factor))
+    throw core::InputError("grow_factor",
+                           fmt::format("must be finite and >= 1 (got {})", grow_factor));
+  if (!(shrink_factor > 0 && shrink_factor < 1))
+    throw core::InputError("shrink_factor",
+                           fmt::format("must be in (0, 1) (got {})", shrink_factor));
+  if (max_points < 1)
+    throw core::InputError("max_points", fmt::format("must be >= 1 (got {})", max_points));
+  if (rank_check_every < 0)
+    throw core::InputError("rank_check_every",
+                           fmt::format("must be >= 0 (got {})", rank_check_every));
+  for (const Bound& b : bounds) {
+    if (b.observable.empty()) throw core::InputError("bound", "observable name is empty");
+    if (std::isnan(b.min) || std::isnan(b.max) || !(b.min < b.max))
+      throw core::InputError(b.observable + "_min", fmt::format("must be < {}_max ({} vs {})",
+                                                                b.observable, b.min, b.max));
+  }
+  rank.validate();
+  verification.validate();
+}
+
+}  // namespace backbone::continuation

@@ -1,0 +1,64 @@
+// Options of a continuation run: a plain struct with defaults and a validate() naming the field.
+//
+// Step control follows the usual Newton-iteration heuristic (AUTO, BifurcationKit): after an
+// accepted point ds grows by grow_factor when Newton needed at most fast_iterations, shrinks by
+// shrink_factor when it needed at least slow_iterations; a failed correction shrinks ds and
+// retries from the same point, and the branch ends with StopReason::step_floor once ds would
+// fall below ds_min. Bounds end the branch when an observable leaves [min, max]; the last point
+// is then re-corrected onto the bound itself. Distances (ds, arclength) are Euclidean in the
+// problem's unknowns.
+//
+//   ContinuationOptions opt;
+//   opt.ds = 0.01; opt.ds_max = 0.5; opt.max_points = 200;
+//   opt.bounds.push_back({"energy", 0.0, 2550.0});
+//   opt.rank_check_every = 5;   // verified rank report at every 5th point (0: never)
+//   opt.validate();             // throws core::InputError("ds_min", "must be <= ds (...)")
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/rank_report.hpp"
+
+namespace backbone::continuation {
+
+enum class Method { natural, arclength };
+enum class Predictor { secant, tangent };
+const char* to_string(Method m);
+const char* to_string(Predictor p);
+Method parse_method(const std::string& name);        // InputError("method", ...)
+Predictor parse_predictor(const std::string& name);  // InputError("predictor", ...)
+
+// The branch ends when observable leaves [min, max].
+struct Bound {
+  std::string observable;
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+};
+
+struct ContinuationOptions {
+  Method method = Method::arclength;
+  Predictor predictor = Predictor::tangent;
+  double ds = 1e-2;      // first step
+  double ds_min = 1e-8;  // below this the branch ends (step_floor)
+  double ds_max = 1.0;
+  // Adaptation on the Newton iteration count of the last accepted point.
+  int fast_iterations = 3;     // grow when iterations <= this
+  int slow_iterations = 8;     // shrink when iterations >= this
+  double grow_factor = 1.5;    // > 1
+  double shrink_factor = 0.5;  // in (0, 1); also used after a failed correction
+  int max_points = 100;        // including the first (corrected guess)
+  std::vector<Bound> bounds;
+  bool land_on_bounds = true;  // re-correct the crossing point onto the bound
+  // Rank report of the problem's Jacobian at every k-th point (and always at the first and
+  // last); 0 disables it. verify: also step along the candidate null directions.
+  int rank_check_every = 1;
+  bool verify = true;
+  core::RankOptions rank;
+  core::VerifyOptions verification;
+
+  void validate() const;  // throws core::InputError naming the field
+};
+
+}  // namespace backbone::continuation

@@ -1,0 +1,54 @@
+// Internal to backbone::continuation: what both continuation loops do with a corrected point.
+//
+// PointRecorder measures the cost of a point (wall time, evaluations of the base problem since
+// begin()), evaluates its observables and residual, runs the rank report (+ verification) when
+// due, and checks the bounds. Keeping this in one place makes natural and pseudo-arclength
+// branches record exactly the same columns.
+//
+//   PointRecorder rec(problem, options);
+//   rec.begin();
+//   ... predict, correct ...
+//   BranchPoint p = rec.finish(x, index, newton_iterations, ds, arclength, /*last=*/false);
+//   if (const Bound* b = rec.violated_bound(p)) { ... }
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "continuation/branch.hpp"
+#include "continuation/options.hpp"
+#include "core/newton.hpp"
+#include "core/problem.hpp"
+
+namespace backbone::continuation {
+
+class PointRecorder {
+ public:
+  PointRecorder(const core::Problem& problem, const ContinuationOptions& options);
+  void begin();
+  // Fills a BranchPoint; runs the rank report when index % rank_check_every == 0 or force_rank.
+  BranchPoint finish(const core::Vector& x, int index, int newton_iterations, double ds,
+                     double arclength, bool force_rank);
+  // Rank report (and verification) at an already recorded point.
+  void check_rank(BranchPoint& point);
+  // First bound the point violates, or nullptr; `value` receives the bound value crossed.
+  const Bound* violated_bound(const BranchPoint& point, double& value) const;
+  double elapsed_seconds() const;
+
+ private:
+  const core::Problem& problem_;
+  const ContinuationOptions& options_;
+  std::unique_ptr<core::Corrector> verifier_;  // eigen: handles non-square constrained systems
+  std::chrono::steady_clock::time_point start_;
+  long residuals_at_start_ = 0, jacobians_at_start_ = 0;
+};
+
+// "x = (0.5, 6.1)" for messages (at most 4 entries shown).
+std::string describe_point(const core::Vector& x);
+
+// Throws InputError unless guess (and direction, when non-empty) have num_unknowns entries.
+void check_sizes(const core::Problem& problem, const core::Vector& guess,
+                 const core::Vector& direction);
+
+}  // namespace backbone::continuation

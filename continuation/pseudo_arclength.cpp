@@ -1,0 +1,219 @@
+#include "continuation/pseudo_arclength.hpp"
+
+#include <fmt/format.h>
+
+#include <Eigen/QR>
+#include <cmath>
+
+#include "continuation/natural.hpp"
+#include "continuation/point_recorder.hpp"
+#include "core/errors.hpp"
+
+namespace backbone::continuation {
+
+ArclengthSystem::ArclengthSystem(const core::Problem& base, core::Vector anchor,
+                                 core::Vector tangent, double ds)
+    : base_(base), anchor_(std::move(anchor)), tangent_(std::move(tangent)), ds_(ds) {}
+
+core::EvalStatus ArclengthSystem::compute_residual(const core::Vector& x, core::Vector& r) const {
+  core::Vector f;
+  core::EvalStatus s = base_.residual(x, f);
+  if (s != core::EvalStatus::ok) return s;
+  const int m = base_.num_equations();
+  r.resize(m + 1);
+  r.head(m) = f;
+  r[m] = tangent_.dot(x - anchor_) - ds_;
+  return core::EvalStatus::ok;
+}
+
+core::EvalStatus ArclengthSystem::compute_jacobian(const core::Vector& x, core::Matrix& J) const {
+  core::Matrix Jf;
+  core::EvalStatus s = base_.jacobian(x, Jf);
+  if (s != core::EvalStatus::ok) return s;
+  const int m = base_.num_equations();
+  J.resize(m + 1, base_.num_unknowns());
+  J.topRows(m) = Jf;
+  J.row(m) = tangent_.transpose();
+  return core::EvalStatus::ok;
+}
+
+core::EvalStatus curve_tangent(const core::Problem& problem, const core::Vector& x,
+                               const core::Vector& orientation, double relative_threshold,
+                               core::Vector& tangent) {
+  core::Matrix J;
+  core::EvalStatus s = problem.jacobian(x, J);
+  if (s != core::EvalStatus::ok) return s;
+  const int m = static_cast<int>(J.rows());
+  const int n = static_cast<int>(J.cols());
+  core::Matrix bordered(m + 1, n);
+  bordered.topRows(m) = J;
+  bordered.row(m) = orientation.normalized().transpose();
+  core::Vector rhs = core::Vector::Zero(m + 1);
+  rhs[m] = 1.0;
+  // Complete orthogonal decomposition: rank-revealing, minimum-norm solution. The threshold is
+  // relative to the largest pivot, like the rank report's.
+  Eigen::CompleteOrthogonalDecomposition<core::Matrix> cod;
+  cod.setThreshold(relative_threshold);
+  cod.compute(bordered);
+  tangent = cod.solve(rhs);
+  const double norm = tangent.norm();
+  if (!std::isfinite(norm) || norm == 0) return core::EvalStatus::non_finite;
+  tangent /= norm;
+  if (tangent.dot(orientation) < 0) tangent = -tangent;
+  return core::EvalStatus::ok;
+}
+
+namespace {
+
+StopReason failure_reason(core::NewtonStatus s) {
+  return s == core::NewtonStatus::evaluation_failed ? StopReason::evaluation_failed
+                                                    : StopReason::step_floor;
+}
+
+}  // namespace
+
+Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
+                        const core::Vector& direction, core::Corrector& corrector,
+                        const ContinuationOptions& options, const ContinuationHooks& hooks) {
+  options.validate();
+  check_sizes(problem, guess, direction);
+  const int n = problem.num_unknowns();
+  const int m = problem.num_equations();
+  if (n - m != 1)
+    throw core::InputError("method", fmt::format("pseudo-arclength follows curves: it needs one "
+                                                 "more unknown than equations ({} unknowns vs "
+                                                 "{} equations)",
+                                                 n, m));
+  core::Vector hint = direction.size() ? direction : core::Vector::Unit(n, n - 1);
+  if (!(hint.norm() > 0) || !hint.allFinite())
+    throw core::InputError("direction", "must be a finite non-zero vector");
+  hint.normalize();
+
+  Branch branch;
+  PointRecorder recorder(problem, options);
+  const double threshold = options.rank.relative_threshold;
+
+  // First point: the guess corrected on the hyperplane through it orthogonal to the hint.
+  recorder.begin();
+  core::Vector x = guess;
+  {
+    ArclengthSystem first(problem, guess, hint, 0.0);
+    core::NewtonSummary s = corrector.solve(first, x);
+    if (hooks.on_attempt) hooks.on_attempt({0, 0.0, s.converged(), s});
+    if (!s.converged()) {
+      branch.reason = s.status == core::NewtonStatus::evaluation_failed
+                          ? StopReason::evaluation_failed
+                          : StopReason::newton_failed;
+      branch.message = fmt::format("the starting guess did not converge ({}; {}): {}",
+                                   core::to_string(s.status), describe_point(guess), s.message);
+      return branch;
+    }
+    branch.points.push_back(recorder.finish(x, 0, s.iterations, 0.0, 0.0, true));
+    if (hooks.on_point) hooks.on_point(branch.points.back());
+  }
+  core::Vector tangent;
+  if (curve_tangent(problem, x, hint, threshold, tangent) != core::EvalStatus::ok) {
+    branch.reason = StopReason::evaluation_failed;
+    branch.message =
+        fmt::format("the Jacobian could not be evaluated at point 0 ({})", describe_point(x));
+    return branch;
+  }
+
+  double ds = options.ds;
+  double arclength = 0;
+  core::Vector previous = x;
+  bool have_previous = false;
+  while (static_cast<int>(branch.points.size()) < options.max_points) {
+    if (hooks.cancel_requested && hooks.cancel_requested()) {
+      branch.reason = StopReason::cancelled;
+      branch.message = fmt::format("cancelled after {} points", branch.points.size());
+      return branch;
+    }
+    const int index = static_cast<int>(branch.points.size());
+    recorder.begin();
+    // Predictor direction: the secant through the last two points, or the tangent.
+    core::Vector step_direction = tangent;
+    if (options.predictor == Predictor::secant && have_previous) {
+      core::Vector secant = x - previous;
+      if (secant.norm() > 0) step_direction = secant.normalized();
+    }
+    core::Vector y;
+    core::NewtonSummary s;
+    core::NewtonStatus last_failure = core::NewtonStatus::converged;
+    std::string last_message;
+    bool accepted = false;
+    while (true) {
+      y = x + ds * step_direction;
+      ArclengthSystem system(problem, x, step_direction, ds);
+      s = corrector.solve(system, y);
+      accepted = s.converged() && y.allFinite();
+      if (hooks.on_attempt) hooks.on_attempt({index, ds, accepted, s});
+      if (accepted) break;
+      last_failure = s.status;
+      last_message = s.message;
+      const double smaller = ds * options.shrink_factor;
+      if (smaller < options.ds_min) break;
+      ds = smaller;
+    }
+    if (!accepted) {
+      branch.reason = failure_reason(last_failure);
+      branch.message = fmt::format(
+          "no point {} could be corrected with ds >= ds_min = {:.3g} from {} (last Newton "
+          "status {}: {})",
+          index, options.ds_min, describe_point(x), core::to_string(last_failure), last_message);
+      return branch;
+    }
+    core::Vector next_tangent;
+    const core::EvalStatus tangent_status =
+        curve_tangent(problem, y, step_direction, threshold, next_tangent);
+    arclength += (y - x).norm();
+    const bool last = index + 1 == options.max_points || tangent_status != core::EvalStatus::ok;
+    BranchPoint point = recorder.finish(y, index, s.iterations, ds, arclength, last);
+
+    double bound_value = 0;
+    if (const Bound* bound = recorder.violated_bound(point, bound_value)) {
+      // Land on the bound: correct [F; observable - bound] from the crossing point.
+      branch.reason = StopReason::bound_reached;
+      branch.message = fmt::format("{} reached its bound {:.6g} after point {}", bound->observable,
+                                   bound_value, index - 1);
+      if (options.land_on_bounds) {
+        recorder.begin();
+        NaturalParameter p = NaturalParameter::of_observable(bound->observable);
+        ParameterConstraintSystem on_bound(problem, p, bound_value);
+        core::Vector z = y;
+        core::NewtonSummary sb = corrector.solve(on_bound, z);
+        if (hooks.on_attempt) hooks.on_attempt({index, ds, sb.converged(), sb});
+        if (sb.converged() && (z - x).dot(step_direction) > 0) {
+          arclength += (z - x).norm() - (y - x).norm();
+          branch.points.push_back(
+              recorder.finish(z, index, sb.iterations, (z - x).norm(), arclength, true));
+          if (hooks.on_point) hooks.on_point(branch.points.back());
+          branch.message = fmt::format("{} reached its bound {:.6g} (point {} lies on it)",
+                                       bound->observable, bound_value, index);
+        }
+      }
+      return branch;
+    }
+    branch.points.push_back(std::move(point));
+    if (hooks.on_point) hooks.on_point(branch.points.back());
+    if (tangent_status != core::EvalStatus::ok) {
+      branch.reason = StopReason::evaluation_failed;
+      branch.message = fmt::format("the Jacobian could not be evaluated at point {} ({}: {})",
+                                   index, core::to_string(tangent_status), describe_point(y));
+      return branch;
+    }
+    previous = x;
+    have_previous = true;
+    x = y;
+    tangent = next_tangent;
+    if (s.iterations <= options.fast_iterations)
+      ds = std::min(ds * options.grow_factor, options.ds_max);
+    else if (s.iterations >= options.slow_iterations)
+      ds = std::max(ds * options.shrink_factor, options.ds_min);
+  }
+  branch.reason = StopReason::max_points;
+  branch.message = fmt::format("{} points computed", branch.points.size());
+  return branch;
+}
+
+}  // namespace backbone::continuation

@@ -1,0 +1,66 @@
+// Pseudo-arclength continuation (PALC) of a solution curve F(x) = 0, F: R^n -> R^(n-1).
+//
+// From a point x_k with unit tangent t_k the predictor is x_k + ds t_k (or the secant
+// direction), and the corrector solves the augmented system
+//     F(x) = 0,    t_k . (x - x_k) - ds = 0,
+// which is itself a core::Problem (ArclengthSystem, the LOCA habit): any corrector solves it,
+// KINSOL included, since it is square when m = n - 1. The tangent at a point is the solution
+// of [J; t_prev^T] t = [0; 1], normalised: it spans the null space of J and keeps the
+// orientation of the previous tangent, so the branch goes through folds without reversing.
+// The first point is the guess corrected on the hyperplane through it orthogonal to the
+// direction hint. The loop prints nothing (see callbacks.hpp); failures are a StopReason.
+//
+//   auto newton = core::make_corrector("kinsol", core::NewtonOptions{});
+//   ContinuationOptions opt; opt.ds = 0.01; opt.ds_max = 0.5; opt.max_points = 60;
+//   core::Vector guess(2), hint(2);
+//   guess << 0.01, 6.283;  hint << 1.0, 0.0;          // Duffing: start at A = 0.01, A grows
+//   Branch b = pseudo_arclength(duffing, guess, hint, *newton, opt, hooks);
+//   // b.points[i].x, b.points[i].dimension, b.reason, b.message
+#pragma once
+
+#include "continuation/branch.hpp"
+#include "continuation/callbacks.hpp"
+#include "continuation/options.hpp"
+#include "core/newton.hpp"
+#include "core/problem.hpp"
+
+namespace backbone::continuation {
+
+// [F(x); tangent . (x - anchor) - ds]: n equations in n unknowns when F has n - 1.
+// Observables and typical scale are the base problem's. Holds a reference to base.
+class ArclengthSystem : public core::Problem {
+ public:
+  ArclengthSystem(const core::Problem& base, core::Vector anchor, core::Vector tangent, double ds);
+  int num_unknowns() const override { return base_.num_unknowns(); }
+  int num_equations() const override { return base_.num_equations() + 1; }
+  std::string name() const override { return base_.name() + " + arclength"; }
+  core::Observables observables(const core::Vector& x) const override {
+    return base_.observables(x);
+  }
+  core::Vector typical_scale() const override { return base_.typical_scale(); }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
+  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
+
+ private:
+  const core::Problem& base_;
+  core::Vector anchor_, tangent_;
+  double ds_;
+};
+
+// Unit tangent of F = 0 at x oriented like `orientation` (t . orientation > 0): minimum-norm
+// solution of [J; orientation^T] t = [0; 1], singular values below relative_threshold *
+// sigma_max dropped (so a degenerate J, e.g. the paper's shooting residual, yields the
+// orientation's component in the numerical null space rather than noise).
+core::EvalStatus curve_tangent(const core::Problem& problem, const core::Vector& x,
+                               const core::Vector& orientation, double relative_threshold,
+                               core::Vector& tangent);
+
+// Throws core::InputError for bad options, sizes (guess and direction must have n entries,
+// n - m must be 1) or a zero direction. Never throws on numerical failure.
+Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
+                        const core::Vector& direction, core::Corrector& corrector,
+                        const ContinuationOptions& options, const ContinuationHooks& hooks = {});
+
+}  // namespace backbone::continuation

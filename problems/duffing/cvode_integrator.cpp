@@ -1,0 +1,114 @@
+// Every CVODE call of backbone::duffing. SUNDIALS objects are owned by RAII handles; Eigen maps
+// over N_VGetArrayPointer instead of copying.
+#include "problems/duffing/cvode_integrator.hpp"
+
+#include <cvode/cvode.h>
+#include <fmt/format.h>
+#include <nvector/nvector_serial.h>
+#include <sundials/sundials_context.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+
+namespace backbone::duffing {
+
+namespace {
+
+struct ContextDeleter {
+  void operator()(SUNContext c) const { SUNContext_Free(&c); }
+};
+struct VectorDeleter {
+  void operator()(N_Vector v) const { N_VDestroy(v); }
+};
+struct SolverDeleter {
+  void operator()(SUNNonlinearSolver s) const { SUNNonlinSolFree(s); }
+};
+struct CvodeDeleter {
+  void operator()(void* mem) const { CVodeFree(&mem); }
+};
+using ContextHandle = std::unique_ptr<std::remove_pointer_t<SUNContext>, ContextDeleter>;
+using VectorHandle = std::unique_ptr<std::remove_pointer_t<N_Vector>, VectorDeleter>;
+using SolverHandle = std::unique_ptr<std::remove_pointer_t<SUNNonlinearSolver>, SolverDeleter>;
+using CvodeHandle = std::unique_ptr<void, CvodeDeleter>;
+
+int rhs_trampoline(sunrealtype t, N_Vector y, N_Vector dy, void* user_data) {
+  const auto* f = static_cast<const RightHandSide*>(user_data);
+  (*f)(t, N_VGetArrayPointer(y), N_VGetArrayPointer(dy));
+  const long n = N_VGetLength(dy);
+  const double* d = N_VGetArrayPointer(dy);
+  for (long i = 0; i < n; ++i)
+    if (!std::isfinite(d[i])) return 1;  // recoverable: CVODE retries with a smaller step
+  return 0;
+}
+
+// CVODE allocates the name; copy and free it.
+std::string flag_name(int flag) {
+  char* raw = CVodeGetReturnFlagName(flag);
+  std::string name = raw ? raw : "unknown flag";
+  std::free(raw);
+  return name;
+}
+
+IntegrationResult failure(const char* what, int flag) {
+  IntegrationResult r;
+  r.ok = false;
+  r.message = fmt::format("cvode: {} failed ({})", what, flag_name(flag));
+  return r;
+}
+
+}  // namespace
+
+IntegrationResult integrate(const RightHandSide& rhs, core::Vector& y, double t_end,
+                            const CvodeOptions& options) {
+  const auto n = static_cast<sunindextype>(y.size());
+  SUNContext raw_context = nullptr;
+  if (SUNContext_Create(nullptr, &raw_context) != 0)
+    return {false, 0, "cvode: SUNContext_Create failed"};
+  ContextHandle context(raw_context);
+  VectorHandle state(N_VNew_Serial(n, raw_context));
+  VectorHandle abs_tol(N_VNew_Serial(n, raw_context));
+  if (!state || !abs_tol) return {false, 0, "cvode: N_VNew_Serial failed"};
+  Eigen::Map<core::Vector>(N_VGetArrayPointer(state.get()), n) = y;
+  Eigen::Map<core::Vector> tolerance(N_VGetArrayPointer(abs_tol.get()), n);
+  if (options.absolute_tolerance.size() == n)
+    tolerance = options.absolute_tolerance;
+  else
+    tolerance.setConstant(1e-3 * options.relative_tolerance);
+
+  CvodeHandle memory(CVodeCreate(CV_ADAMS, raw_context));
+  if (!memory) return {false, 0, "cvode: CVodeCreate failed"};
+  void* mem = memory.get();
+  int flag = CVodeInit(mem, rhs_trampoline, 0.0, state.get());
+  if (flag != CV_SUCCESS) return failure("CVodeInit", flag);
+  flag = CVodeSetUserData(mem, const_cast<RightHandSide*>(&rhs));
+  if (flag != CV_SUCCESS) return failure("CVodeSetUserData", flag);
+  flag = CVodeSVtolerances(mem, options.relative_tolerance, abs_tol.get());
+  if (flag != CV_SUCCESS) return failure("CVodeSVtolerances", flag);
+  SolverHandle fixed_point(SUNNonlinSol_FixedPoint(state.get(), 0, raw_context));
+  if (!fixed_point) return {false, 0, "cvode: SUNNonlinSol_FixedPoint failed"};
+  flag = CVodeSetNonlinearSolver(mem, fixed_point.get());
+  if (flag != CV_SUCCESS) return failure("CVodeSetNonlinearSolver", flag);
+  flag = CVodeSetMaxNumSteps(mem, options.max_steps);
+  if (flag != CV_SUCCESS) return failure("CVodeSetMaxNumSteps", flag);
+  flag = CVodeSetStopTime(mem, t_end);
+  if (flag != CV_SUCCESS) return failure("CVodeSetStopTime", flag);
+
+  sunrealtype t = 0;
+  flag = CVode(mem, t_end, state.get(), &t, CV_NORMAL);
+  IntegrationResult result;
+  long steps = 0;
+  CVodeGetNumSteps(mem, &steps);
+  result.steps = steps;
+  if (flag < 0) {
+    result.message =
+        fmt::format("cvode: CVode failed at t = {} of {} ({})", t, t_end, flag_name(flag));
+    return result;
+  }
+  y = Eigen::Map<core::Vector>(N_VGetArrayPointer(state.get()), n);
+  result.ok = true;
+  return result;
+}
+
+}  // namespace backbone::duffing
