@@ -54,6 +54,11 @@ RankReport rank_report(const Matrix& J, const RankOptions& options);
 
 // Fills verified_dimension and direction_verified. Evaluates the problem; never throws on
 // numerical failure (a direction that fails to re-correct is simply not verified).
+// When some candidate direction fails, the basis of the candidate null space is rotated
+// (same span, still orthonormal) onto the secants of the successful probes and probed again,
+// because the SVD basis need not be aligned with the solution set (J = 0 at a double root):
+// null_directions is then replaced by the rotated basis, and direction_verified refers to it.
+// The corrector must handle m + 1 equations in n unknowns: KINSOL only when m + 1 == n.
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
                             const VerifyOptions& options, RankReport& report);
 

@@ -1,1 +1,169 @@
+// Rank reports on known matrices and verification of candidate null directions: a regular
+// circle and sphere (candidate = verified) and the double-root parabola, whose Jacobian is
+// identically zero on the solution curve (candidate nullity 2, verified dimension 1).
 #include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/eigen_newton.hpp"
+#include "core/errors.hpp"
+#include "core/kinsol_newton.hpp"
+#include "core/rank_report.hpp"
+#include "tests/core/test_problems.hpp"
+
+namespace backbone::core {
+namespace {
+
+using testing::DoubleRootParabola;
+using testing::Sphere;
+
+TEST(RankReport, DiagonalMatrixWithAClearGap) {
+  Matrix J = Matrix::Zero(3, 4);
+  J.diagonal() << 2.0, 1.0, 1e-10;
+  const RankReport r = rank_report(J, RankOptions{});  // threshold 1e-8 * 2 = 2e-8
+  EXPECT_EQ(r.rank, 2);
+  EXPECT_EQ(r.nullity, 2);
+  EXPECT_DOUBLE_EQ(r.threshold, 2e-8);
+  EXPECT_NEAR(r.gap, 1e10, 1.0);  // sigma_2 / sigma_3 = 1 / 1e-10
+  ASSERT_EQ(r.null_directions.rows(), 4);
+  ASSERT_EQ(r.null_directions.cols(), 2);
+  // Orthonormal and spanning {e3, e4}: J * N = 1e-10 at most, N^T N = I.
+  EXPECT_LT((r.null_directions.transpose() * r.null_directions - Matrix::Identity(2, 2)).norm(),
+            1e-14);
+  EXPECT_LT(r.null_directions.topRows(2).norm(), 1e-14);
+  EXPECT_EQ(r.verified_dimension, -1);
+  EXPECT_NE(r.summary().find("rank 2/4, nullity 2"), std::string::npos) << r.summary();
+}
+
+TEST(RankReport, ThresholdIsRelative) {
+  // Same matrix scaled by 1e-6: the count must not change (a relative threshold).
+  Matrix J(2, 3);
+  J << 1, 2, 3, 2, 4, 6.000001;  // nearly rank 1: sigma_2 / sigma_1 ~ 3.2e-8
+  for (double s : {1.0, 1e-6, 1e6}) {
+    RankOptions o;
+    o.relative_threshold = 1e-10;
+    EXPECT_EQ(rank_report(s * J, o).rank, 2) << s;
+    o.relative_threshold = 1e-5;
+    EXPECT_EQ(rank_report(s * J, o).rank, 1) << s;
+  }
+}
+
+TEST(RankReport, ZeroMatrixHasFullNullity) {
+  const RankReport r = rank_report(Matrix::Zero(1, 2), RankOptions{});
+  EXPECT_EQ(r.rank, 0);
+  EXPECT_EQ(r.nullity, 2);
+  EXPECT_EQ(r.null_directions.cols(), 2);
+}
+
+TEST(RankReport, OptionsValidationNamesTheField) {
+  RankOptions r;
+  r.relative_threshold = 0;
+  try {
+    r.validate();
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "rank.relative_threshold");
+  }
+  VerifyOptions v;
+  v.drift_ratio = 2;
+  try {
+    v.validate();
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "verify.drift_ratio");
+  }
+  v = {};
+  v.step = -1e-3;
+  EXPECT_THROW(v.validate(), InputError);
+}
+
+// Rank report + verification at a solution point x of `problem`.
+RankReport verified_report(const Problem& problem, const Vector& x, Corrector& corrector) {
+  Matrix J;
+  EXPECT_EQ(problem.jacobian(x, J), EvalStatus::ok);
+  RankReport r = rank_report(J, RankOptions{});
+  verify_null_directions(problem, x, corrector, VerifyOptions{}, r);
+  return r;
+}
+
+NewtonOptions tight() {
+  NewtonOptions o;
+  o.residual_tolerance = 1e-12;  // below VerifyOptions::residual_tolerance (1e-9)
+  o.max_iterations = 60;         // the double root converges linearly (error halves)
+  return o;
+}
+
+TEST(VerifyNullDirections, CircleIsACurve) {
+  Sphere circle(2);
+  Vector x(2);
+  x << 0.6, 0.8;
+  EigenNewton eigen(tight());
+  KinsolNewton kinsol(tight());  // m + 1 == n: the constrained system is square
+  for (Corrector* c : {static_cast<Corrector*>(&eigen), static_cast<Corrector*>(&kinsol)}) {
+    const RankReport r = verified_report(circle, x, *c);
+    EXPECT_EQ(r.nullity, 1);
+    EXPECT_EQ(r.verified_dimension, 1) << c->name() << ": " << r.summary();
+    ASSERT_EQ(r.direction_verified.size(), 1u);
+    EXPECT_TRUE(r.direction_verified[0]);
+  }
+}
+
+TEST(VerifyNullDirections, SphereIsASurface) {
+  Sphere sphere(3);
+  Vector x(3);
+  x << 0.0, 0.6, 0.8;
+  EigenNewton eigen(tight());  // constrained system 2 x 3: needs minimum-norm steps
+  const RankReport r = verified_report(sphere, x, eigen);
+  EXPECT_EQ(r.nullity, 2);
+  EXPECT_EQ(r.verified_dimension, 2) << r.summary();
+}
+
+TEST(VerifyNullDirections, DoubleRootAtTheVertexIsACurve) {
+  // J(0, 0) = 0: candidate nullity 2. Along e_x the parabola y = x^2 is within h^2 of the
+  // stepped point; along e_y the only solutions on the hyperplane y = h are x = +-sqrt(h),
+  // ~30 h away, far beyond drift_ratio * h.
+  DoubleRootParabola p;
+  const Vector x = Vector::Zero(2);
+  EigenNewton eigen(tight());
+  const RankReport r = verified_report(p, x, eigen);
+  EXPECT_EQ(r.rank, 0);
+  EXPECT_EQ(r.nullity, 2);
+  EXPECT_EQ(r.verified_dimension, 1) << r.summary();
+  // The verified direction is the tangent (1, 0), up to sign.
+  int verified_column = r.direction_verified[0] ? 0 : 1;
+  EXPECT_NEAR(std::abs(r.null_directions(0, verified_column)), 1.0, 1e-6);
+}
+
+TEST(VerifyNullDirections, DoubleRootWithMisalignedBasisIsACurve) {
+  // At (1, 1) J = 0 again and the SVD basis is (e_x, e_y), but the tangent is (1, 2)/sqrt(5):
+  // neither candidate is tangent, stepping along each drifts by 2h resp. h/2. Verification
+  // must rotate the basis onto the secants and still find exactly one real direction.
+  DoubleRootParabola p;
+  const Vector x = Vector::Ones(2);
+  EigenNewton eigen(tight());
+  KinsolNewton kinsol(tight());
+  for (Corrector* c : {static_cast<Corrector*>(&eigen), static_cast<Corrector*>(&kinsol)}) {
+    const RankReport r = verified_report(p, x, *c);
+    EXPECT_EQ(r.nullity, 2);
+    EXPECT_EQ(r.verified_dimension, 1) << c->name() << ": " << r.summary();
+    for (int j = 0; j < 2; ++j) {
+      if (!r.direction_verified[static_cast<std::size_t>(j)]) continue;
+      const Vector tangent = Eigen::Vector2d(1.0, 2.0).normalized();
+      // Secants from h = 1e-3 probes: the tangent is recovered to O(h).
+      EXPECT_NEAR(std::abs(r.null_directions.col(j).dot(tangent)), 1.0, 1e-2);
+    }
+  }
+}
+
+TEST(VerifyNullDirections, IsolatedRootHasNothingToVerify) {
+  Matrix J = Matrix::Identity(2, 2);
+  RankReport r = rank_report(J, RankOptions{});
+  EigenNewton eigen({});
+  Sphere circle(2);  // any problem of the right size: nothing is evaluated
+  verify_null_directions(circle, Vector::Zero(2), eigen, VerifyOptions{}, r);
+  EXPECT_EQ(r.nullity, 0);
+  EXPECT_EQ(r.verified_dimension, 0);
+}
+
+}  // namespace
+}  // namespace backbone::core

@@ -1,0 +1,192 @@
+#include "core/rank_report.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+
+#include "core/errors.hpp"
+
+namespace backbone::core {
+
+void RankOptions::validate() const {
+  if (!(relative_threshold > 0 && relative_threshold < 1))
+    throw InputError("rank.relative_threshold",
+                     fmt::format("must be in (0, 1) (got {})", relative_threshold));
+}
+
+void VerifyOptions::validate() const {
+  if (!(step > 0) || !std::isfinite(step))
+    throw InputError("verify.step", fmt::format("must be finite and > 0 (got {})", step));
+  if (!(residual_tolerance > 0) || !std::isfinite(residual_tolerance))
+    throw InputError("verify.residual_tolerance",
+                     fmt::format("must be finite and > 0 (got {})", residual_tolerance));
+  if (!(drift_ratio > 0 && drift_ratio < 1))
+    throw InputError("verify.drift_ratio", fmt::format("must be in (0, 1) (got {})", drift_ratio));
+}
+
+RankReport rank_report(const Matrix& J, const RankOptions& options) {
+  options.validate();
+  const Eigen::Index n = J.cols();
+  RankReport report;
+  report.relative_threshold = options.relative_threshold;
+  // Full V: for m < n the null space includes the n - m directions without a singular value.
+  Eigen::BDCSVD<Matrix> svd(J, Eigen::ComputeFullV);
+  report.singular_values = svd.singularValues();
+  const double sigma_max = report.singular_values.size() > 0 ? report.singular_values[0] : 0.0;
+  report.threshold = options.relative_threshold * sigma_max;
+  int rank = 0;
+  for (Eigen::Index i = 0; i < report.singular_values.size(); ++i)
+    if (report.singular_values[i] > report.threshold) ++rank;
+  report.rank = rank;
+  report.nullity = static_cast<int>(n) - rank;
+  if (rank == 0) {
+    report.gap = 0;
+  } else if (rank < report.singular_values.size() && report.singular_values[rank] > 0) {
+    report.gap = report.singular_values[rank - 1] / report.singular_values[rank];
+  } else {
+    report.gap = std::numeric_limits<double>::infinity();
+  }
+  report.null_directions = svd.matrixV().rightCols(report.nullity);
+  return report;
+}
+
+std::string RankReport::summary() const {
+  const double sigma_max = singular_values.size() > 0 ? singular_values[0] : 0.0;
+  const std::string verified =
+      verified_dimension >= 0 ? fmt::format(" (verified {})", verified_dimension) : "";
+  return fmt::format(
+      "rank {}/{}, nullity {}{}, sigma_max {:.3e}, threshold {:.3e} (relative {:.1e}), gap "
+      "{:.3e}",
+      rank, rank + nullity, nullity, verified, sigma_max, threshold, relative_threshold, gap);
+}
+
+namespace {
+
+// F(y) = 0 restricted to the hyperplane direction . (y - anchor) = 0: m + 1 equations.
+class HyperplaneConstrained : public Problem {
+ public:
+  HyperplaneConstrained(const Problem& base, Vector direction, Vector anchor)
+      : base_(base), direction_(std::move(direction)), anchor_(std::move(anchor)) {}
+  int num_unknowns() const override { return base_.num_unknowns(); }
+  int num_equations() const override { return base_.num_equations() + 1; }
+  std::string name() const override { return base_.name() + " on a hyperplane"; }
+  Vector typical_scale() const override { return base_.typical_scale(); }
+
+ protected:
+  EvalStatus compute_residual(const Vector& y, Vector& r) const override {
+    Vector f;
+    const EvalStatus s = base_.residual(y, f);
+    if (s != EvalStatus::ok) return s;
+    const Eigen::Index m = f.size();
+    r.head(m) = f;
+    r[m] = direction_.dot(y - anchor_);
+    return EvalStatus::ok;
+  }
+  EvalStatus compute_jacobian(const Vector& y, Matrix& J) const override {
+    Matrix base_jacobian;
+    const EvalStatus s = base_.jacobian(y, base_jacobian);
+    if (s != EvalStatus::ok) return s;
+    const Eigen::Index m = base_jacobian.rows();
+    J.topRows(m) = base_jacobian;
+    J.row(m) = direction_.transpose();
+    return EvalStatus::ok;
+  }
+
+ private:
+  const Problem& base_;
+  Vector direction_, anchor_;
+};
+
+struct Probe {
+  bool converged = false;
+  Vector secant;                                           // (corrected point - x) / h
+  double drift = std::numeric_limits<double>::infinity();  // |corrected - stepped| / h
+};
+
+// Steps from x by h along d, re-corrects on the hyperplane through the stepped point.
+Probe probe(const Problem& problem, const Vector& x, const Vector& d, double h,
+            Corrector& corrector, const VerifyOptions& options) {
+  Probe result;
+  const Vector stepped = x + h * d;
+  HyperplaneConstrained constrained(problem, d, stepped);
+  Vector y = stepped;
+  const NewtonSummary s = corrector.solve(constrained, y);
+  if (!y.allFinite()) return result;
+  Vector f;
+  // Judge the corrected point by F itself (the corrector's own tolerance may be looser).
+  if (problem.residual(y, f) != EvalStatus::ok) return result;
+  result.converged = (s.converged() || s.status == NewtonStatus::stalled) &&
+                     f.lpNorm<Eigen::Infinity>() <= options.residual_tolerance &&
+                     std::abs(d.dot(y - stepped)) <= options.residual_tolerance + 1e-12 * h;
+  result.secant = (y - x) / h;
+  result.drift = (y - stepped).norm() / h;
+  return result;
+}
+
+}  // namespace
+
+void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
+                            const VerifyOptions& options, RankReport& report) {
+  options.validate();
+  const int n = problem.num_unknowns();
+  if (x.size() != n || report.null_directions.rows() != n)
+    throw InputError("verify", fmt::format("sizes do not match: x has {} entries, null "
+                                           "directions {} rows, problem {} unknowns",
+                                           x.size(), report.null_directions.rows(), n));
+  const int k = static_cast<int>(report.null_directions.cols());
+  report.direction_verified.assign(static_cast<std::size_t>(k), false);
+  report.verified_dimension = 0;
+  if (k == 0) return;
+
+  const Vector scale = problem.typical_scale().cwiseAbs();
+  // Step length in the problem's units: `step` times the typical scale seen along d.
+  auto step_along = [&](const Vector& d) {
+    const double s = d.cwiseProduct(scale).norm();
+    return options.step * (s > 0 ? s : 1.0);
+  };
+
+  // Pass 1: probe the candidate basis as given.
+  Matrix D = report.null_directions;
+  std::vector<Probe> first(static_cast<std::size_t>(k));
+  bool all_verified = true;
+  for (int i = 0; i < k; ++i) {
+    auto& p = first[static_cast<std::size_t>(i)];
+    p = probe(problem, x, D.col(i), step_along(D.col(i)), corrector, options);
+    all_verified = all_verified && p.converged && p.drift <= options.drift_ratio;
+  }
+  if (all_verified) {
+    report.direction_verified.assign(static_cast<std::size_t>(k), true);
+    report.verified_dimension = k;
+    return;
+  }
+
+  // The candidate space N may be larger than the tangent space T of the solution set, and
+  // the SVD's basis of N need not be aligned with T (a double root has J = 0 and V = I). Each
+  // converged probe whose secant is not too long (the hyperplane met the solution set near
+  // the stepped point, possibly obliquely) gives a secant close to T. Rotate the basis of N
+  // so that its first columns span those secants, then probe again: along the rotated
+  // directions the drift criterion is meaningful.
+  Matrix secants(k, k);
+  int good = 0;
+  for (int i = 0; i < k; ++i) {
+    const auto& p = first[static_cast<std::size_t>(i)];
+    if (p.converged && p.secant.norm() <= 1.0 / options.drift_ratio)
+      secants.col(good++) = D.transpose() * p.secant;  // coordinates in N
+  }
+  if (good > 0) {
+    Eigen::JacobiSVD<Matrix> svd(secants.leftCols(good), Eigen::ComputeFullU);
+    D = D * svd.matrixU();  // still an orthonormal basis of N, principal secants first
+  }
+  int verified = 0;
+  for (int i = 0; i < k; ++i) {
+    const Probe p = probe(problem, x, D.col(i), step_along(D.col(i)), corrector, options);
+    const bool real = p.converged && p.drift <= options.drift_ratio;
+    report.direction_verified[static_cast<std::size_t>(i)] = real;
+    verified += real ? 1 : 0;
+  }
+  report.null_directions = D;
+  report.verified_dimension = verified;
+}
+
+}  // namespace backbone::core
