@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -77,12 +80,17 @@ Table Table::read_csv(const std::filesystem::path& path) {
     std::stringstream ss(line);
     std::string cell;
     while (std::getline(ss, cell, ',')) {
-      try {
-        row.push_back(std::stod(cell));
-      } catch (const std::exception&) {
+      // strtod, not stod: stod throws on subnormals (ERANGE on underflow) although they are
+      // written by write_csv, and it accepts trailing garbage ("1x").
+      if (!cell.empty() && cell.back() == '\r') cell.pop_back();
+      char* end = nullptr;
+      errno = 0;
+      const double value = std::strtod(cell.c_str(), &end);
+      const bool overflow = errno == ERANGE && std::isinf(value);
+      if (cell.empty() || end != cell.c_str() + cell.size() || overflow)
         throw InputError("csv", fmt::format("{}:{}: '{}' is not a number", path.string(),
                                             line_number, cell));
-      }
+      row.push_back(value);
     }
     if (row.size() != columns.size())
       throw InputError("csv", fmt::format("{}:{}: {} values for {} columns", path.string(),
