@@ -13,6 +13,9 @@ void RankOptions::validate() const {
   if (!(relative_threshold > 0 && relative_threshold < 1))
     throw InputError("rank.relative_threshold",
                      fmt::format("must be in (0, 1) (got {})", relative_threshold));
+  if (!(absolute_threshold >= 0) || !std::isfinite(absolute_threshold))
+    throw InputError("rank.absolute_threshold",
+                     fmt::format("must be finite and >= 0 (got {})", absolute_threshold));
 }
 
 void VerifyOptions::validate() const {
@@ -34,7 +37,7 @@ RankReport rank_report(const Matrix& J, const RankOptions& options) {
   Eigen::BDCSVD<Matrix> svd(J, Eigen::ComputeFullV);
   report.singular_values = svd.singularValues();
   const double sigma_max = report.singular_values.size() > 0 ? report.singular_values[0] : 0.0;
-  report.threshold = options.relative_threshold * sigma_max;
+  report.threshold = std::max(options.relative_threshold * sigma_max, options.absolute_threshold);
   int rank = 0;
   for (Eigen::Index i = 0; i < report.singular_values.size(); ++i)
     if (report.singular_values[i] > report.threshold) ++rank;

@@ -25,6 +25,11 @@ namespace backbone::core {
 struct RankOptions {
   // Relative threshold: sigma_i counts as zero when sigma_i <= relative_threshold * sigma_max.
   double relative_threshold = 1e-8;
+  // Absolute floor: sigma_i also counts as zero when sigma_i <= absolute_threshold. A double
+  // root has J ~ 0, so sigma_max itself is noise (finite-difference error ~ 1e-8) and a purely
+  // relative threshold would count that noise as rank; set this to the Jacobian's noise level
+  // there. Default 0: relative only.
+  double absolute_threshold = 0;
   void validate() const;
 };
 
@@ -39,7 +44,7 @@ struct VerifyOptions {
 
 struct RankReport {
   Vector singular_values;      // descending
-  double threshold = 0;        // absolute value used: relative_threshold * sigma_max
+  double threshold = 0;  // value used: max(relative_threshold * sigma_max, absolute_threshold)
   double relative_threshold = 0;
   int rank = 0;
   int nullity = 0;             // num_unknowns - rank: candidate manifold dimension

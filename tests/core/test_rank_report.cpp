@@ -48,6 +48,20 @@ TEST(RankReport, ThresholdIsRelative) {
   }
 }
 
+TEST(RankReport, AbsoluteFloorIgnoresNoiseOfAVanishingJacobian) {
+  // A Jacobian that is zero up to finite-difference noise (~1e-8): relative-only reports
+  // rank 1; with an absolute floor above the noise it reports the true candidate nullity 2.
+  Matrix J(1, 2);
+  J << 3e-9, -1e-8;
+  EXPECT_EQ(rank_report(J, RankOptions{}).rank, 1);
+  RankOptions o;
+  o.absolute_threshold = 1e-6;
+  const RankReport r = rank_report(J, o);
+  EXPECT_EQ(r.rank, 0);
+  EXPECT_EQ(r.nullity, 2);
+  EXPECT_EQ(r.threshold, 1e-6);
+}
+
 TEST(RankReport, ZeroMatrixHasFullNullity) {
   const RankReport r = rank_report(Matrix::Zero(1, 2), RankOptions{});
   EXPECT_EQ(r.rank, 0);
@@ -72,6 +86,9 @@ TEST(RankReport, OptionsValidationNamesTheField) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "verify.drift_ratio");
   }
+  r = {};
+  r.absolute_threshold = -1;
+  EXPECT_THROW(r.validate(), InputError);
   v = {};
   v.step = -1e-3;
   EXPECT_THROW(v.validate(), InputError);
