@@ -1,0 +1,156 @@
+// The exact motion of the bar (d'Alembert / characteristics), built once, queried cheaply.
+//
+// For piecewise-linear u0, v0 and a constant body force the Riemann invariants
+// R+ = v - c u_x and R- = v + c u_x are piecewise-linear along the characteristics, so the
+// whole motion is carried by two piecewise-linear signals of time: A(t), the R+ arriving at
+// x = L, and B(t), the R- arriving at x = 0 (jumps allowed). Each end reflects its incoming
+// signal (free: unchanged, fixed or closed contact: sign flip); a contact end switches
+// free -> closed when its displacement reaches the wall (exact root of a quadratic) and
+// closed -> free when the contact force EA (n * incoming) / c turns negative (linear root).
+// Nothing is discretised in time: every value is exact to round-off, and the cost is the
+// number of signal segments (never a number of time steps). This is the reference of every
+// test and the accuracy limit of every benchmark.
+//
+//   bar::BarSetup s;                                        // mode 1 of DESIGN.md
+//   s.right = {bar::EndType::contact, 1e-3};
+//   s.u0 = bar::PiecewiseLinear({0.0, 1.0}, {0.0, -0.01});
+//   exact_bar::ExactBarSolution sol = exact_bar::solve(s, 3.1);
+//   sol.contact_intervals();          // {[1.1, 2)}
+//   sol.contact_force(1.5);           // 0.01 = EA |eps|
+//   sol.u(0.5, 3.1);                  // -0.005: back to u0
+//   sol.energy(2.0);                  // EA L eps^2 / 2
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "problems/bar/bar.hpp"
+
+namespace backbone::exact_bar {
+
+enum class Side { left, right };
+
+// One closed-contact episode of an end: closed on [t_close, t_release).
+struct ContactInterval {
+  double t_close = 0;
+  double t_release = 0;  // +infinity if the end is still closed at the solution's t_end
+};
+
+class ExactBarSolution {
+ public:
+  // Solves on [0, t_end]. Throws core::InputError for a bad setup or t_end (key "t_end").
+  ExactBarSolution(const bar::BarSetup& setup, double t_end);
+
+  // false if the event march failed (non-finite signal or runaway event count).
+  bool ok() const { return ok_; }
+  const std::string& message() const { return message_; }
+  const bar::BarSetup& setup() const { return setup_; }
+  double t_end() const { return t_end_; }
+
+  // Fields at (x, t), x in [0, L], t in [0, t_end] (else InputError, key "x" or "t").
+  // v and the strain jump across fronts: at a jump they return the average of the two
+  // one-sided limits (a node within a few ulps of a front counts as on it).
+  double u(double x, double t) const;
+  double v(double x, double t) const;
+  double strain(double x, double t) const;
+
+  // End quantities; without a Side, the observed end of bar::BarSetup.
+  double u_end(double t) const;
+  double u_end(Side side, double t) const;
+  // Compressive force -EA u_x at the end (contact force if the end is a contact end, the
+  // reaction if fixed, 0 if free). Right-continuous in t (0 at the release instant).
+  double contact_force(double t) const;
+  double contact_force(Side side, double t) const;
+  bool in_contact(Side side, double t) const;
+
+  // E = 1/2 int (rho A v^2 + EA u_x^2) dx - int body_force A u dx, integrated exactly.
+  double energy(double t) const;
+
+  // Closed-contact episodes starting before t_end, in time order (empty for non-contact ends).
+  std::vector<ContactInterval> contact_intervals() const;
+  std::vector<ContactInterval> contact_intervals(Side side) const;
+
+  // The field on the uniform grid of request.elements intervals at time t; every projection
+  // int f psi_i dx is exact (Simpson on each polynomial piece). request.dt is ignored.
+  bar::FieldSnapshot snapshot(double t, const bar::SnapshotRequest& request) const;
+
+  // Number of linear pieces stored (both signals and both end tracks): the cost measure.
+  std::size_t segment_count() const;
+
+ private:
+  // Times are stored window-relative: window k = [k tau, (k+1) tau), local time r in [0, tau].
+  // Crossing the bar is then an exact shift (k -> k + 1), so round-off does not accumulate
+  // with the number of windows.
+  struct Segment {  // value y0 + slope (r - r0) on [r0, r1) of window k
+    long k;
+    double r0, r1, y0, slope;
+    double at(double r) const { return y0 + slope * (r - r0); }
+  };
+  // One piece of an end's history: incoming and outgoing invariants, displacement at r0.
+  struct EndSegment {
+    long k;
+    double r0, r1;
+    double in0, in_slope, out0, out_slope;
+    double u0;
+    bool closed;
+  };
+  // Segments in time order with the index of the first segment of each window.
+  template <class Seg>
+  struct Chunked {
+    std::vector<Seg> segments;
+    std::vector<std::size_t> first;
+    std::size_t end_of(long k) const {
+      const auto next = static_cast<std::size_t>(k) + 1;
+      return next < first.size() ? first[next] : segments.size();
+    }
+    const Seg& locate(long k, double r) const;
+  };
+  struct EndState {
+    bool closed = false;
+    double u = 0;  // displacement of the end
+  };
+  struct Local {
+    long k;
+    double r;
+  };
+  // Field on one x-interval at a fixed time: u quadratic, v and strain linear.
+  struct Piece {
+    double xa, xb, ua, va, dv, ea, de;
+    double u_at(double x) const {
+      const double h = x - xa;
+      return ua + ea * h + 0.5 * de * h * h;
+    }
+    double v_at(double x) const { return va + dv * (x - xa); }
+    double e_at(double x) const { return ea + de * (x - xa); }
+  };
+
+  void march();
+  void march_end(Side side, long k, EndState& state);
+  void emit(Side side, long k, double r0, double r1, double in0, double in_slope,
+            bool reflect_negative, bool closed, EndState& state);
+  void check_time(double t) const;
+  double front_tolerance(double t) const;  // fronts closer than this in x are one front
+  Local to_local(double t) const;
+  double global_time(long k, double r) const;
+  std::vector<Piece> profile(double t) const;
+  const EndSegment& end_segment(Side side, double t, double& r) const;
+  double end_strain(const EndSegment& seg, Side side, double r) const;
+  Side observed() const;
+
+  bar::BarSetup setup_;
+  double t_end_ = 0;
+  double c_ = 1, tau_ = 1, b_ = 0;  // wave speed, travel time L/c, body acceleration f/rho
+  Chunked<Segment> a_, b_sig_;      // A (R+ arriving at L), B (R- arriving at 0)
+  Chunked<EndSegment> left_, right_;
+  bool ok_ = true;
+  std::string message_;
+};
+
+// Convenience: ExactBarSolution(setup, t_end).
+ExactBarSolution solve(const bar::BarSetup& setup, double t_end);
+
+// Closed-contact episodes of the observed end over [0, t_end].
+std::vector<ContactInterval> contact_intervals(const bar::BarSetup& setup, double t_end);
+
+}  // namespace backbone::exact_bar
