@@ -119,8 +119,12 @@ TEST(ExactBarContact, EnergyConservedOver20PeriodsWithGenericData) {
   double worst = 0;
   for (double t = 0; t <= t_end; t += 0.0731) worst = std::max(worst, std::abs(sol.energy(t) - e0));
   EXPECT_LT(worst / e0, 1e-13) << "relative energy drift " << worst / e0;
-  // The displacement never penetrates the wall.
-  for (double t = 0; t <= t_end; t += 0.0173) EXPECT_LE(sol.u_end(t), 2e-3 * (1 + 1e-14));
+  // The displacement never penetrates the wall, and u(L, t) integrated through the bar from
+  // u(0, t) (the field path) agrees with the end's own time integral (the event path).
+  for (double t = 0; t <= t_end; t += 0.0173) {
+    EXPECT_LE(sol.u_end(t), 2e-3 * (1 + 1e-14));
+    EXPECT_NEAR(sol.u(1.0, t), sol.u_end(Side::right, t), 1e-13 * 4e-3);
+  }
   // Cost is per segment, not per step: bounded growth per window.
   EXPECT_LT(sol.segment_count(), 200u * static_cast<std::size_t>(t_end));
 }

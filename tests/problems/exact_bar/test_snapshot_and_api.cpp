@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
@@ -40,32 +41,53 @@ TEST(ExactBarSnapshot, ProjectionsOfModeOneAtItsPeriodAreThoseOfU0) {
   }
 }
 
-TEST(ExactBarSnapshot, HalfPeriodVelocityProjectionOfModeOne) {
-  // At T/2 = 1.55 the bar is in contact and fronts cross the grid cells: the exact
-  // projections must agree with a brute-force quadrature of the solution's own pointwise
-  // v and u (this checks the projection code path, not the dynamics).
+TEST(ExactBarSnapshot, ProjectionsWithFrontsInsideCellsMatchTheHandSolution) {
+  // Mode 1 (L = c = 1, eps = -0.01, g0 = 1e-3) at t = 1.3, in contact since 1.1. By hand from
+  // the characteristics: R+ = -0.01 for x < 0.3 (released by the fixed end after t = 1),
+  // +0.01 beyond; R- = +0.01 for x < 0.8, -0.01 beyond (reflected by the wall since 1.1). So
+  //   v = 0 on [0, 0.3), 0.01 on (0.3, 0.8), 0 on (0.8, 1];
+  //   u = 0.01 x up to 0.3, 0.003 up to 0.8, then 0.003 - 0.01 (x - 0.8) (u(1) = g0).
+  // Projections of these on 7 hats (fronts inside cells), integrated exactly by Simpson on
+  // the pieces between fronts and nodes.
+  auto u_hand = [](double x) {
+    return x < 0.3 ? 0.01 * x : x < 0.8 ? 0.003 : 0.003 - 0.01 * (x - 0.8);
+  };
+  auto v_hand = [](double x) { return x > 0.3 && x < 0.8 ? 0.01 : 0.0; };
+  const int n = 7;
+  const double h = 1.0 / n;
+  std::vector<double> pu(n + 1, 0.0), pv(n + 1, 0.0);
+  for (int j = 0; j < n; ++j) {
+    std::vector<double> cuts{j * h, (j + 1) * h};
+    for (double f : {0.3, 0.8})
+      if (f > j * h && f < (j + 1) * h) cuts.insert(cuts.end() - 1, f);
+    for (std::size_t q = 0; q + 1 < cuts.size(); ++q) {
+      const double a = cuts[q], b = cuts[q + 1], m = 0.5 * (a + b), w = (b - a) / 6;
+      auto hat_left = [&](double x) { return ((j + 1) * h - x) / h; };
+      auto hat_right = [&](double x) { return (x - j * h) / h; };
+      // v is constant inside (a, b): evaluate it at the midpoint only.
+      const double vm = v_hand(m);
+      pu[j] +=
+          w * (u_hand(a) * hat_left(a) + 4 * u_hand(m) * hat_left(m) + u_hand(b) * hat_left(b));
+      pu[j + 1] +=
+          w * (u_hand(a) * hat_right(a) + 4 * u_hand(m) * hat_right(m) + u_hand(b) * hat_right(b));
+      pv[j] += vm * 0.5 * (hat_left(a) + hat_left(b)) * (b - a);
+      pv[j + 1] += vm * 0.5 * (hat_right(a) + hat_right(b)) * (b - a);
+    }
+  }
   const ExactBarSolution sol = solve(mode_one(), 3.1);
   bar::SnapshotRequest r;
-  r.elements = 10;
-  r.nodal_u = false;
-  r.projected_v = true;
-  r.projected_u = true;
-  const bar::FieldSnapshot f = sol.snapshot(1.55, r);
-  const double h = 0.1;
-  for (int i = 0; i <= 10; ++i) {
-    double pv = 0, pu = 0;
-    const int n = 20000;  // midpoint rule on a fine grid: error O(h^2 / n^2) away from fronts
-    for (int k = 0; k < n; ++k) {
-      const double x = std::max(0.0, (i - 1) * h) +
-                       (k + 0.5) / n * (std::min(1.0, (i + 1) * h) - std::max(0.0, (i - 1) * h));
-      const double w = (std::min(1.0, (i + 1) * h) - std::max(0.0, (i - 1) * h)) / n;
-      const double hat = 1 - std::abs(x - i * h) / h;
-      pv += sol.v(x, 1.55) * hat * w;
-      pu += sol.u(x, 1.55) * hat * w;
-    }
-    EXPECT_NEAR(f.v_projected[i], pv, 1e-7 * 0.01 * h) << i;
-    EXPECT_NEAR(f.u_projected[i], pu, 1e-9 * 0.01 * h) << i;
+  r.elements = n;
+  r.nodal_u = r.nodal_v = r.projected_u = r.projected_v = true;
+  const bar::FieldSnapshot f = sol.snapshot(1.3, r);
+  ASSERT_TRUE(f.ok);
+  for (int i = 0; i <= n; ++i) {
+    // Scale 0.01 h (field ~0.01 times the hat's integral): 1e-13 relative to it.
+    EXPECT_NEAR(f.u_projected[i], pu[i], 1e-13 * 0.01 * h) << i;
+    EXPECT_NEAR(f.v_projected[i], pv[i], 1e-13 * 0.01 * h) << i;
+    EXPECT_NEAR(f.u[i], u_hand(f.x[i]), 1e-17) << i;
+    EXPECT_NEAR(f.v[i], v_hand(f.x[i]), 1e-17) << i;
   }
+  EXPECT_GT(f.v_projected[3], 1e-4);  // the moving band is seen by the projection
 }
 
 TEST(ExactBarSnapshot, VelocityOnAFrontIsTheAverageOfBothSides) {
