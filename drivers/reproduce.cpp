@@ -2,10 +2,10 @@
 // results/, by calling the other subcommands exactly as a user would, and writes a summary
 // of what ran, how long it took and whether it succeeded (results/reproduce.csv).
 #include <fmt/format.h>
+#include <fmt/ostream.h>
 
 #include <chrono>
 #include <filesystem>
-#include <fmt/ostream.h>
 
 #include "core/errors.hpp"
 #include "core/scene.hpp"
@@ -26,11 +26,15 @@ struct Step {
 std::vector<Step> plan(const std::string& out, bool quick) {
   const std::string contact = "problems/contact_bar/scenes/";
   std::vector<Step> steps{
-      {"bouncing_bar", "simulate",
-       {contact + "bouncing_bar.ini", "--compare", "--periods", "2", "--out", out + "/bouncing_bar"}},
-      {"mode1_orbit", "simulate",
+      {"bouncing_bar",
+       "simulate",
+       {contact + "bouncing_bar.ini", "--compare", "--periods", "2", "--out",
+        out + "/bouncing_bar"}},
+      {"mode1_orbit",
+       "simulate",
        {contact + "paper.ini", "--compare", "--periods", "1", "--out", out + "/mode1_orbit"}},
-      {"duffing", "trace",
+      {"duffing",
+       "trace",
        {"problems/duffing/scenes/duffing.ini", "--branch", "backbone", "--out", out + "/duffing"}},
       {"mode1", "trace", {contact + "paper.ini", "--branch", "mode1", "--out", out + "/mode1"}},
       {"mode2", "trace", {contact + "paper.ini", "--branch", "mode2", "--out", out + "/mode2"}},
@@ -44,8 +48,8 @@ int run_reproduce(const std::vector<std::string>& args) {
   po::options_description keys("backbone reproduce [--out DIR] [--quick] [--only NAME]");
   keys.add_options()("help", "describe the command")(
       "out", po::value<std::string>()->default_value("results"), "output folder")(
-      "quick", po::bool_switch(), "skip the benchmarks (bench)")(
-      "only", po::value<std::string>(), "run one step by name");
+      "quick", po::bool_switch(), "skip the benchmarks (bench)")("only", po::value<std::string>(),
+                                                                 "run one step by name");
   po::variables_map vm;
   try {
     po::store(po::command_line_parser(args).options(keys).run(), vm);
@@ -97,7 +101,8 @@ int run_reproduce(const std::vector<std::string>& args) {
     if (rc != 0) failed.push_back(s.name);
   }
   std::string names;
-  for (std::size_t i = 0; i < steps.size(); ++i) names += fmt::format("{} = {}\n", i, steps[i].name);
+  for (std::size_t i = 0; i < steps.size(); ++i)
+    names += fmt::format("{} = {}\n", i, steps[i].name);
   backbone::core::write_text_atomically(std::filesystem::path(out) / "reproduce_steps.txt", names);
   summary.write_csv(std::filesystem::path(out) / "reproduce.csv");
   if (!failed.empty()) {
