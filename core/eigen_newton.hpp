@@ -9,9 +9,9 @@
 //
 //   NewtonOptions opt; opt.residual_tolerance = 1e-12;
 //   EigenNewton newton(opt);
-//   Vector x(2); x << 2.0, 0.1;              // on the circle x^2 + y^2 = 1? not yet
-//   NewtonSummary s = newton.solve(circle, x);  // x is now on the circle, close to (1, 0.05)
-//   // s.residual_history shows quadratic convergence; s.iterations, s.seconds, s.message
+//   Vector x(2); x << 2.0, 0.1;                 // circle: 1 equation x^2 + y^2 - 1, 2 unknowns
+//   NewtonSummary s = newton.solve(circle, x);  // minimum-norm steps are radial:
+//   // x == (2, 0.1) / |(2, 0.1)|; s.residual_history shows quadratic convergence
 #pragma once
 
 #include <string>
