@@ -207,6 +207,7 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
         if (sc <= tol) {
           state.closed = true;
           state.u = n * model.gap;
+          state.u_compensation = 0;
           continue;
         }
         if (sc >= len - tol) {
@@ -218,6 +219,7 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
         rc += sc;
         state.closed = true;
         state.u = n * model.gap;  // the wall position, exactly
+        state.u_compensation = 0;
       }
     }
   }
@@ -236,7 +238,11 @@ void ExactBarSolution::emit(Side side, long k, double r0, double r1, double in0,
   track.segments.push_back({k, r0, r1, in0, in_slope, out0, out_slope, state.u, closed});
   if (!reflect_negative) {  // free: the end moves with v = incoming
     const double len = r1 - r0;
-    state.u += in0 * len + 0.5 * in_slope * len * len;
+    // Compensated sum: a free end adds one increment per segment for the whole run.
+    const double increment = in0 * len + 0.5 * in_slope * len * len - state.u_compensation;
+    const double sum = state.u + increment;
+    state.u_compensation = (sum - state.u) - increment;
+    state.u = sum;
   }
   const Segment next{k + 1, r0, r1, out0 + b_ * tau_, out_slope};
   // A breakpoint across which the signal is continuous with the same slope (a front that has

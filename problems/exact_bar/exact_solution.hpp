@@ -108,7 +108,8 @@ class ExactBarSolution {
   };
   struct EndState {
     bool closed = false;
-    double u = 0;  // displacement of the end
+    double u = 0;               // displacement of the end
+    double u_compensation = 0;  // Kahan: low-order part lost when adding to u
   };
   struct Local {
     long k;
