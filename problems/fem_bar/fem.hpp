@@ -9,7 +9,10 @@
 // lumped mass the constraint decouples, so this is exact, not iterative). The body force enters
 // as the consistent nodal load (for a constant force it equals the lumped one). Stability:
 // dt <= dx / c (InputError "dt" otherwise). At Courant number c dt / dx = 1 the scheme is the
-// exact d'Alembert update at the nodes for fixed and free ends (v0 = 0 start-up included).
+// exact d'Alembert update at the nodes for fixed and free ends (v0 = 0 start-up included),
+// but if both ends are free (or a contact end is open) the grid-scale mode u_i = (-1)^i then
+// has a double amplification factor -1 and grows linearly from round-off and contact kicks
+// (measured: `backbone bench --case bouncing_bar`); use Courant < 1 for long runs.
 //
 //   fem_bar::FemBarSolver fem;                       // FemOptions{} defaults
 //   bar::SimulationOptions o; o.t_end = 3.1; o.elements = 100; o.dt = 1e-2;  // dt <= dx / c
@@ -41,12 +44,12 @@ class FemBarSolver : public bar::BarSolver {
   std::string name() const override { return "fem"; }
 
   // Rows at t_n = n dt for n = 0..floor(t_end / dt) (decimated to history_samples). u_contact
-  // is u at the observed end, contact_force the multiplier lambda_n acting between t_n and
-  // t_{n+1}; energy uses v_n = (u_{n+1} - u_{n-1}) / (2 dt) with the lumped mass (so it
-  // fluctuates by (omega_h dt / 2)^2 of each mode's energy and is blind to the kinetic energy of
-  // a grid-scale (period 2 dt) oscillation, e.g. after a release at Courant 1). If the march
-  // produces a non-finite value the history stops at the last finite row.
-  // Throws InputError for an invalid setup / options or dt > dx / c.
+  // is u at the observed end, contact_force the multiplier lambda_n of the balance at t_n (its
+  // impulse lambda_n dt acts between t_n - dt/2 and t_n + dt/2); energy uses v_n = (u_{n+1} -
+  // u_{n-1}) / (2 dt) with the lumped mass (so it fluctuates by (omega_h dt / 2)^2 of each mode's
+  // energy and is blind to the kinetic energy of a grid-scale (period 2 dt) oscillation, e.g. after
+  // a release at Courant 1). If the march produces a non-finite value the history stops at the last
+  // finite row. Throws InputError for an invalid setup / options or dt > dx / c.
   bar::History simulate(const bar::BarSetup& setup,
                         const bar::SimulationOptions& options) const override;
 
