@@ -4,7 +4,7 @@
 //
 // Coordinates: x in [0, L]. Outward normal n = -1 at x = 0 and +1 at x = L. An end is fixed
 // (u = 0), free (u_x = 0) or in unilateral contact with a rigid wall at outward gap g:
-//     g(t) = gap - n u(end, t) >= 0,  lambda = -EA u_x n >= 0,  g * lambda = 0   (Signorini)
+//     g(t) = gap - n u(end, t) >= 0,  lambda = -EA u_x >= 0,  g * lambda = 0   (Signorini)
 // so at x = L the wall sits at u = +gap, at x = 0 at u = -gap. lambda is the compressive
 // contact force [N]. body_force is a constant force per unit volume along +x [N/m^3]; its
 // potential enters the energy: E = 1/2 int (rho A v^2 + EA u_x^2) dx - int body_force A u dx.
