@@ -327,13 +327,15 @@ int case_bouncing_bar(const fs::path& out) {
     panels += "\n";
   }
   const fs::path png = out / "bouncing_bar.png";
-  report_plot(core::render_png(png,
-                               "set multiplot layout 1,3 title 'Bouncing bar, 10 periods: "
-                               "work-precision (elements 25..1600)'\nset logscale xy\nset grid\n"
-                               "set xlabel 'CPU seconds'\nset key bottom left noenhanced\n" +
-                                   panels + "unset multiplot\n",
-                               {1800, 600}),
-              png);
+  report_plot(
+      core::render_png(
+          png,
+          "set multiplot layout 1,3 title 'Bouncing bar, 10 periods: "
+          "work-precision (elements 25..1600)'\nset logscale xy\nset grid\nset format y '%.0e'\n"
+          "set xlabel 'CPU seconds'\nset key bottom left noenhanced\n" +
+              panels + "unset multiplot\n",
+          {1800, 600}),
+      png);
 
   // History figure (paper Fig. 3): first 2 periods on 50 elements (dt = 1/150).
   {
@@ -524,13 +526,14 @@ int case_mode1_convergence(const fs::path& out) {
     panels += ", x title 'order 1' dt 2 lc rgb 'gray'\n";
   }
   const fs::path png = out / "mode1_convergence.png";
-  report_plot(core::render_png(png,
-                               "set multiplot layout 2,2 title 'Mode 1: errors vs dt (zero = "
-                               "round-off, not drawn)'\nset logscale xy\nset grid\n"
-                               "set xlabel 'dt [s]'\nset key bottom right noenhanced\n" +
-                                   panels + "unset multiplot\n",
-                               {1400, 1000}),
-              png);
+  report_plot(
+      core::render_png(png,
+                       "set multiplot layout 2,2 title 'Mode 1: errors vs dt (zero = "
+                       "round-off, not drawn)'\nset logscale xy\nset grid\nset format y '%.0e'\n"
+                       "set xlabel 'dt [s]'\nset key bottom right noenhanced\n" +
+                           panels + "unset multiplot\n",
+                       {1400, 1000}),
+      png);
   return 0;
 }
 
