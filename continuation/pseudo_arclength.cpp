@@ -180,9 +180,15 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
         recorder.begin();
         NaturalParameter p = NaturalParameter::of_observable(bound->observable);
         ParameterConstraintSystem on_bound(problem, p, bound_value);
+        // From the crossing point first, then from the last point inside the bound.
         core::Vector z = y;
         core::NewtonSummary sb = corrector.solve(on_bound, z);
         if (hooks.on_attempt) hooks.on_attempt({index, ds, sb.converged(), sb});
+        if (!sb.converged()) {
+          z = x;
+          sb = corrector.solve(on_bound, z);
+          if (hooks.on_attempt) hooks.on_attempt({index, ds, sb.converged(), sb});
+        }
         if (sb.converged() && (z - x).dot(step_direction) > 0) {
           arclength += (z - x).norm() - (y - x).norm();
           branch.points.push_back(

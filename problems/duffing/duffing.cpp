@@ -104,16 +104,27 @@ bool Duffing::flow(double x0, double t, double& x, double& v, double* dx_dx0,
   return true;
 }
 
+ResidualScale residual_scale(double amplitude, core::ShootingFormulation formulation) {
+  const double a = std::max(std::abs(amplitude), 1e-300);
+  const double sign = amplitude < 0 ? -1.0 : 1.0;
+  if (formulation == core::ShootingFormulation::half_period_velocity) {
+    const double speed = std::sqrt(2.0 * potential(a));
+    return {speed, sign * (a + a * a * a) / speed};
+  }
+  return {a, sign};
+}
+
 core::EvalStatus Duffing::compute_residual(const core::Vector& x, core::Vector& r) const {
   const double period = x[period_index()];
   if (!(period > 0) || !std::isfinite(x[0])) return core::EvalStatus::failed;
   double position = 0, velocity = 0;
+  const ResidualScale scale = residual_scale(x[0], formulation());
   if (formulation() == core::ShootingFormulation::half_period_velocity) {
     if (!flow(x[0], 0.5 * period, position, velocity)) return core::EvalStatus::failed;
-    r[0] = velocity;
+    r[0] = velocity / scale.value;
   } else {
     if (!flow(x[0], period, position, velocity)) return core::EvalStatus::failed;
-    r[0] = x[0] - position;
+    r[0] = (x[0] - position) / scale.value;
   }
   return core::EvalStatus::ok;
 }
@@ -121,7 +132,7 @@ core::EvalStatus Duffing::compute_residual(const core::Vector& x, core::Vector& 
 core::EvalStatus Duffing::compute_jacobian(const core::Vector& x, core::Matrix& J) const {
   const double period = x[period_index()];
   if (!(period > 0) || !std::isfinite(x[0])) return core::EvalStatus::failed;
-  double position = 0, velocity = 0, dx_dx0 = 0, dv_dx0 = 0;
+  double position = 0, velocity = 0, dx_dx0 = 0, dv_dx0 = 0, raw = 0;
   const auto acceleration = [](double q) { return -q - q * q * q; };
   if (formulation() == core::ShootingFormulation::half_period_velocity) {
     // r = v(T/2): dr/dx0 = dv/dx0 (T/2), dr/dT = a(T/2) / 2.
@@ -129,12 +140,18 @@ core::EvalStatus Duffing::compute_jacobian(const core::Vector& x, core::Matrix& 
       return core::EvalStatus::failed;
     J(0, 0) = dv_dx0;
     J(0, 1) = 0.5 * acceleration(position);
+    raw = velocity;
   } else {
     // r = x0 - x(T): dr/dx0 = 1 - dx/dx0 (T), dr/dT = -v(T).
     if (!flow(x[0], period, position, velocity, &dx_dx0, &dv_dx0)) return core::EvalStatus::failed;
     J(0, 0) = 1.0 - dx_dx0;
     J(0, 1) = -velocity;
+    raw = x[0] - position;
   }
+  // d(raw / s)/dx0 = raw'/s - raw s'/s^2 (product rule; the second term vanishes on orbits).
+  const ResidualScale scale = residual_scale(x[0], formulation());
+  J /= scale.value;
+  J(0, 0) -= raw * scale.derivative / (scale.value * scale.value);
   return core::EvalStatus::ok;
 }
 

@@ -2,8 +2,11 @@
 //
 // Unknowns [x0 | T] (core::PeriodicOrbitProblem layout, state size 1, no parameters): the orbit
 // starts at rest at amplitude x0 (v0 = 0). Residuals (DESIGN.md section 3):
-//   displacement_periodicity ("paper"):  x0 - x(T)      (a double root on the backbone)
-//   half_period_velocity ("regular"):    v(T/2)         (simple root, Jacobian ~ [2, 1])
+//   displacement_periodicity ("paper"):  (x0 - x(T)) / |x0|       (double root on the backbone)
+//   half_period_velocity ("regular"):    v(T/2) / v_max(x0)       (simple root, J ~ [2, 1])
+// Both are made dimensionless by the orbit's own scale (v_max = sqrt(2 V(x0)), the largest
+// speed on the orbit), so one Newton tolerance means the same relative accuracy from
+// amplitude 0.01 to 10 (an absolute ||v|| <= 1e-10 would pin T to 2e-8 at A = 0.01).
 // The flow comes from CVODE (cvode_integrator.hpp, Adams, rtol 1e-13); the Jacobian is
 // analytic, from the variational equations integrated alongside. exact_period is the oracle:
 // T(A) = 4 int_0^A dx / sqrt(2 (V(A) - V(x))), V = x^2/2 + x^4/4, by quadrature.
@@ -12,7 +15,7 @@
 //   core::Vector x(2); x << 1.0, exact_period(1.0);      // on the backbone
 //   core::Vector r; core::Matrix J;
 //   duffing.residual(x, r);                              // |r[0]| ~ 1e-13
-//   duffing.jacobian(x, J);                              // ~ [-2.5, 1]: simple root
+//   duffing.jacobian(x, J);                              // ~ [2.0, 1.0] / 1.22: simple root
 //   duffing.set_formulation(core::ShootingFormulation::displacement_periodicity);
 //   duffing.jacobian(x, J);                              // ~ [0, 0]: double root
 //   double E = duffing.energy(x);                        // V(1) = 0.75
@@ -34,6 +37,13 @@ double potential(double x);
 // until two successive values agree to 1e-15 (relative). Closed form for cross-checks:
 // 4 K(k) / sqrt(1 + A^2), k^2 = A^2 / (2 (1 + A^2)).
 double exact_period(double amplitude);
+
+// Divisor of the residual and its derivative with respect to x0 (see above).
+struct ResidualScale {
+  double value = 1;
+  double derivative = 0;
+};
+ResidualScale residual_scale(double amplitude, core::ShootingFormulation formulation);
 
 struct DuffingOptions {
   double relative_tolerance = 1e-13;  // CVODE rtol; absolute tolerances scale with the orbit

@@ -1,0 +1,172 @@
+// Pseudo-arclength and natural continuation on algebraic curves with known shape: folds,
+// closed curves, failures that must end the branch cleanly.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "continuation/natural.hpp"
+#include "continuation/pseudo_arclength.hpp"
+#include "core/errors.hpp"
+#include "problems/algebraic/algebraic.hpp"
+
+using namespace backbone;
+using continuation::Branch;
+using continuation::StopReason;
+
+namespace {
+
+core::Vector vec(double a, double b) {
+  core::Vector v(2);
+  v << a, b;
+  return v;
+}
+
+continuation::ContinuationOptions quick(int points) {
+  continuation::ContinuationOptions o;
+  o.ds = 0.05;
+  o.ds_max = 0.2;
+  o.max_points = points;
+  o.rank_check_every = 5;
+  return o;
+}
+
+// The fold curve, but the residual becomes NaN once x passes a threshold.
+class PoisonedFold : public algebraic::FoldCurve {
+ public:
+  explicit PoisonedFold(double threshold) : threshold_(threshold) {}
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    FoldCurve::compute_residual(x, r);
+    if (x[0] > threshold_) r[0] = std::numeric_limits<double>::quiet_NaN();
+    return core::EvalStatus::ok;
+  }
+
+ private:
+  double threshold_;
+};
+
+}  // namespace
+
+class BothBackends : public ::testing::TestWithParam<const char*> {};
+
+// x^2 + lambda = 1 from x = -1.5 with x increasing: lambda rises to 1 at the fold x = 0 and
+// falls again. The branch must pass the fold without turning back (x strictly increasing).
+TEST_P(BothBackends, PassesTheFoldWithoutReversing) {
+  algebraic::FoldCurve fold;
+  auto newton = core::make_corrector(GetParam(), core::NewtonOptions{});
+  Branch b =
+      continuation::pseudo_arclength(fold, vec(-1.5, -1.25), vec(1.0, 0.0), *newton, quick(40));
+  ASSERT_EQ(b.reason, StopReason::max_points) << b.message;
+  ASSERT_EQ(b.points.size(), 40u);
+  double lambda_max = -1e9;
+  for (std::size_t i = 1; i < b.points.size(); ++i) {
+    EXPECT_GT(b.points[i].x[0], b.points[i - 1].x[0]) << "reversed at point " << i;
+    EXPECT_GT(b.points[i].arclength, b.points[i - 1].arclength);
+    EXPECT_LE(b.points[i].residual, 1e-10);
+    lambda_max = std::max(lambda_max, b.points[i].x[1]);
+  }
+  EXPECT_LT(b.points.front().x[1], 0.0);
+  EXPECT_GT(b.points.back().x[0], 0.5);  // well past the fold
+  EXPECT_LT(b.points.back().x[1], 0.9);  // lambda came down again
+  EXPECT_GT(lambda_max, 0.98);           // and went up to the fold value 1 first
+  for (const auto& p : b.points)
+    if (p.rank) {
+      EXPECT_EQ(p.dimension, 1);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Continuation, BothBackends, ::testing::Values("eigen", "kinsol"));
+
+// Along the unit circle from angle 0 to 3 (landing exactly on the bound): the summed chords
+// fall short of the arc by ~ s^3/24 per step of arc s <= 0.1, i.e. < 2e-3 over ~30 steps.
+TEST(PseudoArclength, FollowsTheCircleToABound) {
+  algebraic::Circle circle;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(200);
+  opt.ds_max = 0.1;
+  opt.bounds.push_back({"angle", -std::numbers::pi + 1e-9, 3.0});
+  Branch b = continuation::pseudo_arclength(circle, vec(1.0, 0.0), vec(0.0, 1.0), *newton, opt);
+  EXPECT_EQ(b.reason, StopReason::bound_reached) << b.message;
+  EXPECT_NEAR(b.points.back().observable("angle"), 3.0, 1e-9);  // landed on the bound
+  EXPECT_LT(b.points.back().arclength, 3.0);
+  EXPECT_GT(b.points.back().arclength, 3.0 - 2e-3);
+  for (const auto& p : b.points) EXPECT_NEAR(p.x.norm(), 1.0, 1e-10);
+}
+
+TEST(Natural, StopsAtTheFoldKeepingItsPoints) {
+  algebraic::FoldCurve fold;
+  auto newton = core::make_corrector("kinsol", core::NewtonOptions{});
+  auto opt = quick(100);
+  opt.ds_min = 1e-4;
+  Branch b =
+      continuation::natural(fold, vec(-1.5, -1.25),
+                            continuation::NaturalParameter::of_unknown(1, "lambda"), *newton, opt);
+  EXPECT_EQ(b.reason, StopReason::step_floor) << b.message;
+  ASSERT_GT(b.points.size(), 5u);
+  EXPECT_GT(b.points.back().x[1], 0.99);  // reached the fold lambda = 1 before failing
+  EXPECT_LE(b.points.back().x[1], 1.0 + 1e-12);
+}
+
+TEST(PseudoArclength, NanResidualEndsTheBranchCleanly) {
+  PoisonedFold fold(0.3);
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(100);
+  opt.ds_min = 0.01;
+  Branch b = continuation::pseudo_arclength(fold, vec(-1.5, -1.25), vec(1.0, 0.0), *newton, opt);
+  EXPECT_EQ(b.reason, StopReason::evaluation_failed) << b.message;
+  ASSERT_GT(b.points.size(), 10u);
+  for (const auto& p : b.points) EXPECT_LE(p.x[0], 0.3);
+  EXPECT_NE(b.message.find("evaluation_failed"), std::string::npos) << b.message;
+}
+
+TEST(PseudoArclength, NewtonDivergenceEndsAtTheStepFloor) {
+  algebraic::FoldCurve fold;
+  core::NewtonOptions tight;
+  tight.residual_tolerance = 1e-300;  // unreachable: every correction fails after 1 iteration
+  tight.max_iterations = 1;
+  tight.step_tolerance = 0;
+  auto newton = core::make_corrector("eigen", tight);
+  auto opt = quick(10);
+  // Start exactly on the curve so the first point converges with zero residual.
+  Branch b = continuation::pseudo_arclength(fold, vec(0.5, 0.75), vec(1.0, 0.0), *newton, opt);
+  EXPECT_TRUE(b.reason == StopReason::step_floor || b.reason == StopReason::newton_failed)
+      << b.message;
+  EXPECT_LE(b.points.size(), 1u);
+  EXPECT_FALSE(b.message.empty());
+}
+
+TEST(PseudoArclength, StartThatDoesNotConvergeReportsNewtonFailed) {
+  PoisonedFold fold(-10.0);  // NaN everywhere the branch starts
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  Branch b =
+      continuation::pseudo_arclength(fold, vec(-1.5, -1.25), vec(1.0, 0.0), *newton, quick(10));
+  EXPECT_EQ(b.reason, StopReason::evaluation_failed) << b.message;
+  EXPECT_TRUE(b.points.empty());
+}
+
+TEST(Options, ValidateNamesTheField) {
+  continuation::ContinuationOptions o;
+  o.ds_min = 1.0;
+  o.ds = 0.1;
+  try {
+    o.validate();
+    FAIL() << "no exception";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.key(), "ds_min");
+  }
+  o = {};
+  o.max_points = 0;
+  EXPECT_THROW(o.validate(), core::InputError);
+}
+
+TEST(PseudoArclength, SphereIsNotACurve) {
+  algebraic::Sphere sphere;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  core::Vector x(3);
+  x << 1, 0, 0;
+  EXPECT_THROW(
+      continuation::pseudo_arclength(sphere, x, core::Vector::Unit(3, 1), *newton, quick(5)),
+      core::InputError);
+}
