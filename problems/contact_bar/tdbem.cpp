@@ -125,7 +125,22 @@ double TdbemMarch::r_end(int e, double t) const {
 
 void TdbemMarch::push_knot(int e, double t, double u, double s, bool kink) {
   EndState& E = ends_[e];
-  E.knots.push_back({t, u, s, 0.5 * c_ * s + 0.5 * u, false});
+  const double q = 0.5 * c_ * s + 0.5 * u;
+  // A tracked kink whose slope change turns out to vanish (to round-off) is no kink: drop its
+  // echo, so that echo trains do not accumulate over long runs (one per contact event).
+  if (method_ == ContactMethod::event && E.knots.size() >= 2 && E.knots.back().kink) {
+    Knot& k1 = E.knots.back();
+    const Knot& k0 = E.knots[E.knots.size() - 2];
+    const double before = (k1.q - k0.q) / (k1.t - k0.t), after = (q - k1.q) / (t - k1.t);
+    if (std::abs(after - before) <= 1e-11 * std::max(std::abs(before), std::abs(after))) {
+      k1.kink = false;
+      auto& pending = ends_[1 - e].pending;
+      const double echo = k1.t + tau_;
+      auto it = std::lower_bound(pending.begin(), pending.end(), echo - tolerance());
+      if (it != pending.end() && std::abs(*it - echo) <= tolerance()) pending.erase(it);
+    }
+  }
+  E.knots.push_back({t, u, s, q, false});
   if (!std::isfinite(u) || !std::isfinite(s)) ok_ = false;
   if (kink) mark_kink(e);
 }
