@@ -66,8 +66,8 @@ struct Branch {
 };
 
 // Columns: point, then every observable by name (in the order of the first point), then
-// dimension, residual, newton_iterations, step_size, arclength, seconds, jacobian_evaluations,
-// residual_evaluations, nullity (candidate, -1 when unchecked).
+// dimension, nullity (candidate, -1 when unchecked), residual, newton_iterations, step_size,
+// arclength, seconds, jacobian_evaluations, residual_evaluations.
 core::Table branch_table(const Branch& branch);
 
 }  // namespace backbone::continuation
