@@ -263,6 +263,31 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
   return x;
 }
 
+ReturnError return_error(const ContactBarOrbitProblem& problem, const Vector& x,
+                         const bar::BarSolver& oracle, int elements) {
+  const double nan = std::nan("");
+  if (elements < 1) throw InputError("elements", fmt::format("must be >= 1 (got {})", elements));
+  const double period = x[problem.period_index()];
+  const bar::BarSetup s = problem.setup_at(x);
+  bar::SnapshotRequest request;
+  request.elements = elements;
+  request.dt = problem.time_step(period);
+  request.nodal_u = true;
+  request.projected_v = true;
+  const bar::FieldSnapshot snap = oracle.snapshot(s, period, request);
+  if (!snap.ok || static_cast<int>(snap.u.size()) != elements + 1) return {nan, nan};
+  const double dx = s.material.length / elements;
+  double u_max = 0, du = 0, v_max = 0;
+  for (int i = 0; i <= elements; ++i) {
+    const double mass = (i == 0 || i == elements) ? 0.5 * dx : dx;
+    u_max = std::max(u_max, std::abs(s.u0(snap.x[i])));
+    du = std::max(du, std::abs(snap.u[i] - s.u0(snap.x[i])));
+    v_max = std::max(v_max, std::abs(snap.v_projected[i] / mass));
+  }
+  if (!(u_max > 0)) return {nan, nan};
+  return {du / u_max, s.material.travel_time() * v_max / u_max};
+}
+
 // Mode 2 closed form. With c = L = 1 and u = F(t + x) - F(t - x), let H(t) = F'(t - 1) be the
 // wave arriving at x = L. Free end: H(t + 2) = -H(t) and the end moves at -2 H(t); closed
 // contact: H(t + 2) = H(t) while H(t) <= 0. v0 = 0 makes H symmetric about t = 1 on [0, 2],

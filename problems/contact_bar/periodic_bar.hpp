@@ -29,6 +29,7 @@
 //   double E = orbit.energy(x), w = orbit.frequency(x);
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -100,6 +101,19 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   const bar::BarSolver& solver_;
   OrbitOptions options_;
 };
+
+// How far the orbit at x is from periodic, re-simulated over one period T by `oracle` (the
+// exact solver for validation) and sampled on a uniform grid of `elements` intervals:
+// displacement = max_i |u(x_i, T) - u0(x_i)| / max_i |u0(x_i)|, velocity = (L/c) max_i
+// |hat-averaged v(x_i, T)| / max_i |u0(x_i)| (relative, like the acceptance criteria).
+// NaN when the simulation fails.
+struct ReturnError {
+  double displacement = 0;
+  double velocity = 0;
+  double worst() const { return std::max(displacement, velocity); }
+};
+ReturnError return_error(const ContactBarOrbitProblem& problem, const core::Vector& x,
+                         const bar::BarSolver& oracle, int elements = 1000);
 
 // Closed forms of the contact family (c = sqrt(E/rho), EA, g0 from the setup), for tests and
 // reports. Mode 1: DESIGN.md section 1, T = (3L + g0 sqrt(EA L / (2E))) / c above grazing
