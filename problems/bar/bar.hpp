@@ -6,7 +6,7 @@
 // (u = 0), free (u_x = 0) or in unilateral contact with a rigid wall at outward gap g:
 //     g(t) = gap - n u(end, t) >= 0,  lambda = -EA u_x >= 0,  g * lambda = 0   (Signorini)
 // so at x = L the wall sits at u = +gap, at x = 0 at u = -gap. lambda is the compressive
-// contact force [N]. body_force is a constant force per unit volume along +x [N/m^3]; its
+// contact force [N] (compression, u_x < 0, at either end). body_force is a constant force per unit volume along +x [N/m^3]; its
 // potential enters the energy: E = 1/2 int (rho A v^2 + EA u_x^2) dx - int body_force A u dx.
 // Initial displacement and velocity are piecewise linear (knots may be anywhere in [0, L]).
 //
