@@ -1,0 +1,189 @@
+// Known-solution tests of the contact-bar shooting problem (problems/contact_bar/periodic_bar):
+// the exact mode-1 orbit u0 = eps x, T = (3L + g0/|eps|)/c (DESIGN.md section 1) and the
+// mode-2 tent (closed form derived in periodic_bar.cpp) are roots of both formulations; the
+// regular Jacobian is regular (nullity 1), the paper's T column vanishes; Newton returns to
+// the family; short branches match the closed forms.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "continuation/pseudo_arclength.hpp"
+#include "core/finite_difference.hpp"
+#include "core/newton.hpp"
+#include "core/rank_report.hpp"
+#include "problems/contact_bar/periodic_bar.hpp"
+#include "problems/contact_bar/tdbem.hpp"
+#include "problems/exact_bar/exact_bar_solver.hpp"
+
+namespace {
+
+using namespace backbone;
+using contact_bar::ContactBarOrbitProblem;
+using contact_bar::OrbitOptions;
+using core::ShootingFormulation;
+using core::Vector;
+
+constexpr double kGap = 1e-3;
+
+bar::BarSetup paper_setup() {
+  bar::BarSetup s;  // E = rho = L = A = 1 (c = 1)
+  s.left = {bar::EndType::fixed, 0};
+  s.right = {bar::EndType::contact, kGap};
+  return s;
+}
+
+OrbitOptions grid(int elements, int steps, int free_knots = 0) {
+  OrbitOptions o;
+  o.elements = elements;
+  o.steps_per_period = steps;
+  o.free_knots = free_knots;
+  return o;
+}
+
+constexpr ShootingFormulation kBoth[] = {ShootingFormulation::displacement_periodicity,
+                                         ShootingFormulation::half_period_velocity};
+
+TEST(ContactBarOrbit, ExactModeOneIsARootOfBothFormulations) {
+  const exact_bar::ExactBarSolver exact;
+  const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
+  for (const bar::BarSolver* solver :
+       {static_cast<const bar::BarSolver*>(&exact), static_cast<const bar::BarSolver*>(&event)}) {
+    ContactBarOrbitProblem p(paper_setup(), *solver, grid(20, 40));
+    for (double ratio : {1.2, 10.0, 141.0}) {
+      const Vector x = p.contact_family_guess(1, ratio);  // u0 = eps x, |eps| = ratio g0 / L
+      EXPECT_NEAR(x[p.period_index()], 3 + 1 / ratio, 1e-15);
+      for (ShootingFormulation f : kBoth) {
+        p.set_formulation(f);
+        Vector r;
+        ASSERT_EQ(p.residual(x, r), core::EvalStatus::ok);
+        // Both solvers are exact for piecewise-linear data (event contact located inside the
+        // step): only round-off of O(steps) operations on values of size |eps| L remains.
+        EXPECT_LE(r.lpNorm<Eigen::Infinity>(), 1e-12 * ratio * kGap)
+            << solver->name() << " " << core::to_string(f) << " ratio " << ratio;
+      }
+    }
+  }
+}
+
+TEST(ContactBarOrbit, ProjectionContactResidualIsFirstOrderInDt) {
+  // The paper's Algorithm 1 puts contact onset on the time grid: the end lags by up to one
+  // step at speed c|eps|, so the paper residual is bounded by about c |eps| dt.
+  const contact_bar::TdbemSolver projection(contact_bar::ContactMethod::projection);
+  const double ratio = 7.3;
+  for (int steps : {100, 1000}) {
+    ContactBarOrbitProblem p(paper_setup(), projection, grid(20, steps));
+    p.set_formulation(ShootingFormulation::displacement_periodicity);
+    const Vector x = p.contact_family_guess(1, ratio);
+    Vector r;
+    ASSERT_EQ(p.residual(x, r), core::EvalStatus::ok);
+    const double dt = p.time_step(x[p.period_index()]);
+    EXPECT_LE(r.lpNorm<Eigen::Infinity>(), 2 * ratio * kGap * dt) << steps;
+    EXPECT_GT(r.lpNorm<Eigen::Infinity>(), 1e-3 * ratio * kGap * dt) << steps;  // not exact
+  }
+}
+
+TEST(ContactBarOrbit, RegularJacobianHasNullityOnePaperPeriodColumnVanishes) {
+  const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
+  const int n = 20;
+  ContactBarOrbitProblem p(paper_setup(), event, grid(n, 40));
+  const Vector x = p.contact_family_guess(1, 3.0);
+  core::FiniteDifferenceOptions central;
+  central.scheme = core::FiniteDifferenceOptions::Scheme::central;
+
+  p.set_formulation(ShootingFormulation::half_period_velocity);
+  core::Matrix regular;
+  ASSERT_EQ(core::finite_difference_jacobian(p, x, regular, central), core::EvalStatus::ok);
+  const core::RankReport rep = core::rank_report(regular, core::RankOptions{});
+  EXPECT_EQ(rep.nullity, 1) << rep.summary();
+  // Not a threshold artefact: the smallest kept singular value is far above the cut-off
+  // (measured 3.5e-3 of sigma_max 19; the cut-off is 1e-8 relative).
+  EXPECT_GT(rep.singular_values[n - 1], 1e-5 * rep.singular_values[0]) << rep.summary();
+  EXPECT_GT(regular.col(n).norm(), 1e-2);  // the period matters at T/2
+
+  p.set_formulation(ShootingFormulation::displacement_periodicity);
+  core::Matrix paper;
+  ASSERT_EQ(core::finite_difference_jacobian(p, x, paper, central), core::EvalStatus::ok);
+  // df/dT = -v(., T) = 0 on the orbit (v0 = 0 and energy conservation); central differences
+  // because the end turns at T (its velocity jumps from eps c to -eps c). FD noise bound:
+  // round-off 1e-16 |u| / h with h ~ 6e-6 T.
+  EXPECT_LE(paper.col(n).lpNorm<Eigen::Infinity>(), 1e-8) << paper.col(n).transpose();
+}
+
+TEST(ContactBarOrbit, NewtonReturnsToModeOneFromAPerturbedOrbit) {
+  const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
+  const int n = 20;
+  ContactBarOrbitProblem p(paper_setup(), event, grid(n, 40));
+  Vector x = p.contact_family_guess(1, 3.0);
+  for (int i = 0; i < n; ++i) x[i] *= 1 + 0.02 * std::sin(3.14159 * (i + 1.0) / n);  // smooth
+  x[n] += 0.01;
+  core::NewtonOptions options;
+  options.residual_tolerance = 1e-14;
+  auto newton = core::make_corrector("eigen", options);
+  const core::NewtonSummary s = newton->solve(p, x);
+  ASSERT_TRUE(s.converged()) << s.message;
+  EXPECT_LE(s.iterations, 8);
+  // Back on the family: u0 = eps x and T = 3 + g0/|eps| at the eps Newton chose.
+  const double eps = x[n - 1];
+  // Tolerances: |F| <= 1e-14 through a Jacobian of condition ~5e3 (sigma 19 / 3.5e-3).
+  for (int i = 0; i < n; ++i) EXPECT_NEAR(x[i], eps * (i + 1.0) / n, 1e-10);
+  EXPECT_NEAR(x[n], 3 + kGap / std::abs(eps), 1e-8);
+  const exact_bar::ExactBarSolver exact;
+  const contact_bar::ReturnError re = contact_bar::return_error(p, x, exact);
+  EXPECT_LE(re.displacement, 1e-8);
+  EXPECT_LE(re.velocity, 1e-4);  // a 1e-12 kink left in u0 sends fronts of v ~ c 1e-12 / dx
+}
+
+double worst_branch_error(const ContactBarOrbitProblem& p, int mode, int points, double ds,
+                          int* count) {
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  continuation::ContinuationOptions o;
+  o.ds = o.ds_max = ds;
+  o.max_points = points;
+  o.rank_check_every = 0;
+  const Vector guess = p.contact_family_guess(mode, 1.05);
+  const Vector direction = p.contact_family_guess(mode, 1.06) - guess;
+  const continuation::Branch b = continuation::pseudo_arclength(p, guess, direction, *newton, o);
+  *count = static_cast<int>(b.points.size());
+  double worst = 0;
+  for (const auto& point : b.points) {
+    const double energy = point.observable("energy");
+    const double exact =
+        mode == 1 ? contact_bar::mode1_frequency(p.setup_template().material, kGap, energy)
+                  : contact_bar::mode2_frequency(p.setup_template().material, kGap, energy);
+    worst = std::max(worst, std::abs(point.observable("frequency") / exact - 1));
+  }
+  return worst;
+}
+
+TEST(ContactBarOrbit, ShortModeOneBranchMatchesTheClosedForm) {
+  const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
+  ContactBarOrbitProblem p(paper_setup(), event, grid(10, 20));
+  int count = 0;
+  const double worst = worst_branch_error(p, 1, 30, 0.02, &count);
+  EXPECT_EQ(count, 30);
+  EXPECT_LE(worst, 1e-5);  // acceptance; measured ~1e-10 (Newton tolerance 1e-10 on |F|)
+}
+
+TEST(ContactBarOrbit, ModeTwoTentIsExactWithAFreeKnotAndOnlyO_dx_OnAUniformGrid) {
+  const exact_bar::ExactBarSolver exact;
+  ContactBarOrbitProblem knot(paper_setup(), exact, grid(20, 40, 1));
+  ContactBarOrbitProblem uniform(paper_setup(), exact, grid(20, 40, 0));
+  for (ShootingFormulation f : kBoth) {
+    knot.set_formulation(f);
+    uniform.set_formulation(f);
+    Vector r;
+    const Vector xk = knot.contact_family_guess(2, 10.0);
+    ASSERT_EQ(knot.residual(xk, r), core::EvalStatus::ok);
+    EXPECT_LE(r.lpNorm<Eigen::Infinity>(), 1e-14);
+    const Vector xu = uniform.contact_family_guess(2, 10.0);  // crest between nodes
+    ASSERT_EQ(uniform.residual(xu, r), core::EvalStatus::ok);
+    EXPECT_GT(r.lpNorm<Eigen::Infinity>(), 1e-5);
+  }
+  const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
+  ContactBarOrbitProblem p(paper_setup(), event, grid(12, 20, 1));
+  int count = 0;
+  EXPECT_LE(worst_branch_error(p, 2, 20, 0.02, &count), 1e-5);
+  EXPECT_EQ(count, 20);
+}
+
+}  // namespace
