@@ -119,8 +119,15 @@ bar::SimulationOptions simulation_from_scene(const core::Scene& scene, double pe
   bar::SimulationOptions o;
   o.t_end = periods * scene.positive("period");
   o.dt = scene.positive("dt");
-  o.elements = static_cast<int>(scene.integer("elements", 1));
-  o.history_samples = static_cast<int>(scene.integer("history_samples", 2));
+  const long elements = scene.integer("elements", 1);
+  const long samples = scene.integer("history_samples", 2);
+  constexpr long most = 100'000'000;
+  if (elements > most)
+    throw InputError("elements", fmt::format("must be <= {} (got {})", most, elements));
+  if (samples > most)
+    throw InputError("history_samples", fmt::format("must be <= {} (got {})", most, samples));
+  o.elements = static_cast<int>(elements);
+  o.history_samples = static_cast<int>(samples);
   o.probes = parse_numbers("probes", scene.has("probes") ? scene.text("probes") : "");
   const double length = scene.positive("length");
   for (double p : o.probes)

@@ -57,6 +57,9 @@ TEST(ContactBarScene, CommandLineWinsAndBadValuesNameTheKey) {
   EXPECT_EQ(key_of({"--u0", "0:0 2:1"}).rfind("u0:", 0), 0u);
   EXPECT_EQ(key_of({"--u0", "0:0 1:0.5"}).rfind("u0:", 0), 0u);  // penetrates the wall
   EXPECT_EQ(key_of({"--probes", "0.5 x"}).rfind("probes:", 0), 0u);
+  EXPECT_EQ(key_of({"--elements", "0"}).rfind("elements:", 0), 0u);
+  EXPECT_EQ(key_of({"--elements", "30000000000"}).rfind("elements:", 0), 0u);
+  EXPECT_EQ(key_of({"--u0", "0:0 1:nan"}).rfind("u0:", 0), 0u);
   EXPECT_NE(key_of({"--no_such_key", "1"}).find("no_such_key"), std::string::npos);
 }
 
