@@ -50,11 +50,13 @@ po::options_description orbit_scene_keys() {
       ("free_knots", po::value<long>()->default_value(-1),
        "movable knots of the u0 grid: 0, 1, or -1 = auto (0 for mode1, 1 for mode2)")         //
       ("energy_max", po::value<double>()->default_value(1e-2), "stop above this energy [J]")  //
+      ("max_points", po::value<long>()->default_value(1000),
+       "points on the branch, first included")  //
       ("rank_check_every", po::value<long>()->default_value(10),
        "verified rank report every k points (0: never)")  //
-      ("ds", po::value<double>()->default_value(0.01),
+      ("ds", po::value<double>()->default_value(0.005),
        "first step (Euclidean, in unknowns [m] and [s])")  //
-      ("ds_max", po::value<double>()->default_value(0.01), "largest step");
+      ("ds_max", po::value<double>()->default_value(0.005), "largest step");
   keys.add(shooting);
   return keys;
 }
