@@ -20,8 +20,10 @@ struct CliRun {
   std::string err;
 };
 
+// ctest runs each test in its own process, concurrently: every test gets its own folder.
 fs::path scratch(const std::string& name) {
-  fs::path p = fs::path(BACKBONE_BINARY_DIR) / "tests" / "simulate_cli" / name;
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  fs::path p = fs::path(BACKBONE_BINARY_DIR) / "tests" / "simulate_cli" / info->name() / name;
   fs::remove_all(p);
   fs::create_directories(p.parent_path());
   return p;
