@@ -27,6 +27,12 @@ ShootingFormulation parse_formulation(const std::string& name) {
                                name));
 }
 
+void PeriodicOrbitProblem::initial_state_samples(const Vector& x, Vector& coordinates,
+                                                 Vector& values) const {
+  coordinates = state_coordinates();
+  values = x.head(state_size());
+}
+
 Vector PeriodicOrbitProblem::state_coordinates() const {
   const int s = state_size();
   return Vector::LinSpaced(s, 0.0, static_cast<double>(s - 1));

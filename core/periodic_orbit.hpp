@@ -51,6 +51,10 @@ class PeriodicOrbitProblem : public Problem {
   // Coordinates of the state samples, for orbits.csv (node positions of a field problem;
   // 0..S-1 for an ODE).
   virtual Vector state_coordinates() const;
+  // The initial state of the orbit at x as (coordinate, value) samples: the rows of
+  // orbits.csv. Default: state_coordinates() paired with the state entries. A problem whose
+  // state holds more than values at fixed coordinates (e.g. a free knot) overrides it.
+  virtual void initial_state_samples(const Vector& x, Vector& coordinates, Vector& values) const;
 
   // Default observables: period, frequency, energy (columns of branch.csv).
   Observables observables(const Vector& x) const override;

@@ -180,10 +180,12 @@ void write_figure(const std::filesystem::path& out, const core::Table& table,
 
 core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const cont::Branch& branch) {
   core::Table t({"point", "x", "u0"});
-  const core::Vector coordinates = problem.state_coordinates();
-  for (const auto& p : branch.points)
-    for (int i = 0; i < problem.state_size(); ++i)
-      t.add_row({static_cast<double>(p.index), coordinates[i], p.x[i]});
+  core::Vector coordinates, values;
+  for (const auto& p : branch.points) {
+    problem.initial_state_samples(p.x, coordinates, values);
+    for (Eigen::Index i = 0; i < values.size(); ++i)
+      t.add_row({static_cast<double>(p.index), coordinates[i], values[i]});
+  }
   return t;
 }
 

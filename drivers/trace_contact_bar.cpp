@@ -111,7 +111,6 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
     const exact_bar::ExactBarSolver oracle;
     core::Table check({"point", "energy", "frequency", "closed_form_frequency", "relative_error",
                        "return_error_u", "return_error_v", "node"});
-    core::Table orbits({"point", "x", "u0"});
     for (const auto& point : b.points) {
       const double energy = point.observable("energy");
       const double w = point.observable("frequency");
@@ -130,11 +129,8 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
         }
       check.add_row({static_cast<double>(point.index), energy, w, exact, std::abs(w / exact - 1),
                      re.displacement, re.velocity, node});
-      for (std::size_t i = 0; i < xs.size(); ++i)
-        orbits.add_row({static_cast<double>(point.index), xs[i], ys[i]});
     }
     check.write_csv(out / "closed_form_check.csv");
-    orbits.write_csv(out / "orbits_knots.csv");  // u0 at its actual knots (mapped grid)
   };
   s.problem = std::move(problem);
   return s;

@@ -100,6 +100,15 @@ Vector ContactBarOrbitProblem::state_coordinates() const {
   return y;
 }
 
+void ContactBarOrbitProblem::initial_state_samples(const Vector& x, Vector& coordinates,
+                                                   Vector& values) const {
+  const bar::PiecewiseLinear u0 = initial_displacement(x);
+  coordinates =
+      Eigen::Map<const Vector>(u0.knots().data(), static_cast<Eigen::Index>(u0.knots().size()));
+  values =
+      Eigen::Map<const Vector>(u0.values().data(), static_cast<Eigen::Index>(u0.values().size()));
+}
+
 bar::PiecewiseLinear ContactBarOrbitProblem::initial_displacement(const Vector& x) const {
   const int n = options_.elements;
   const Vector y = node_positions(x);

@@ -66,6 +66,10 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   core::Vector node_positions(const core::Vector& x) const;
   // Uniform positions y_i = i L / N, then the knot (reference) positions: for orbits.csv.
   core::Vector state_coordinates() const override;
+  // orbits.csv rows: u0 at its actual knots, x = 0 and the mapped nodes (a free knot moves
+  // them), so the written orbit is exactly the piecewise-linear u0 the residual simulated.
+  void initial_state_samples(const core::Vector& x, core::Vector& coordinates,
+                             core::Vector& values) const override;
   // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (free knot only).
   core::Observables observables(const core::Vector& x) const override;
   core::Vector typical_scale() const override;
