@@ -191,9 +191,14 @@ void spacetime_figure(const fs::path& out, const std::string& name, bar::BarSetu
   std::string marker;
   std::string title_extra;
   if (mark_node) {
-    std::size_t best = 1;
-    for (std::size_t i = 1; i < max_abs.size(); ++i)
-      if (max_abs[i] < max_abs[best]) best = i;
+    // The node: the interior local minimum of max_t |u(x, t)| with the smallest value (the
+    // fixed end x = 0 is excluded: near it |u| is small only because u(0) = 0).
+    std::size_t best = 0;
+    for (std::size_t i = 1; i + 1 < max_abs.size(); ++i)
+      if (max_abs[i] <= max_abs[i - 1] && max_abs[i] <= max_abs[i + 1] &&
+          (best == 0 || max_abs[i] < max_abs[best]))
+        best = i;
+    if (best == 0) best = max_abs.size() - 1;
     Table node({"t", "x", "u"});
     node.add_row({0.0, xs[best], 0.0});
     node.add_row({orbit.period, xs[best], 0.0});
