@@ -31,18 +31,10 @@ EigenNewton::EigenNewton(const NewtonOptions& options) : options_(options) {
 }
 
 NewtonSummary EigenNewton::solve(const Problem& problem, Vector& x) {
-  const auto start = std::chrono::steady_clock::now();
-  const long residuals_before = problem.counters().residuals;
-  const long jacobians_before = problem.counters().jacobians;
+  const SummaryRecorder recorder(problem);
   NewtonSummary summary;
   auto finish = [&](NewtonStatus status, std::string message) {
-    summary.status = status;
-    summary.message = std::move(message);
-    summary.residual_evaluations = problem.counters().residuals - residuals_before;
-    summary.jacobian_evaluations = problem.counters().jacobians - jacobians_before;
-    summary.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return summary;
+    return recorder.finish(summary, status, std::move(message));
   };
 
   if (x.size() != problem.num_unknowns())

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <cmath>
 
 #include "core/eigen_newton.hpp"
@@ -47,6 +48,28 @@ std::unique_ptr<Corrector> make_corrector(const std::string& name, const NewtonO
   if (name == "kinsol") return std::make_unique<KinsolNewton>(options);
   throw InputError("newton",
                    fmt::format("unknown corrector '{}' (expected eigen or kinsol)", name));
+}
+
+namespace {
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+}  // namespace
+
+SummaryRecorder::SummaryRecorder(const Problem& problem)
+    : problem_(problem),
+      residuals_before_(problem.counters().residuals),
+      jacobians_before_(problem.counters().jacobians),
+      start_seconds_(now_seconds()) {}
+
+NewtonSummary SummaryRecorder::finish(NewtonSummary& summary, NewtonStatus status,
+                                      std::string message) const {
+  summary.status = status;
+  summary.message = std::move(message);
+  summary.residual_evaluations = problem_.counters().residuals - residuals_before_;
+  summary.jacobian_evaluations = problem_.counters().jacobians - jacobians_before_;
+  summary.seconds = now_seconds() - start_seconds_;
+  return summary;
 }
 
 }  // namespace backbone::core

@@ -25,7 +25,7 @@ struct NewtonOptions {
   double residual_tolerance = 1e-10;  // stop when ||F||_inf <= this
   double step_tolerance = 1e-14;      // stalled when the scaled step falls below this
   int max_iterations = 25;
-  bool line_search = true;            // backtracking on ||F||_2 (KINSOL: KIN_LINESEARCH)
+  bool line_search = true;  // backtracking on ||F||_2 (KINSOL: KIN_LINESEARCH)
   // Relative singular-value cut-off of the minimum-norm step (eigen backend): singular
   // values below rank_cutoff * sigma_max are treated as zero.
   double rank_cutoff = 1e-12;
@@ -34,10 +34,10 @@ struct NewtonOptions {
 
 enum class NewtonStatus {
   converged,
-  stalled,               // step below step_tolerance before the residual was small
+  stalled,  // step below step_tolerance before the residual was small
   max_iterations,
-  diverged,              // residual grew beyond recovery / line search failed
-  evaluation_failed,     // residual or Jacobian returned non-ok (NaN, failed simulation)
+  diverged,           // residual grew beyond recovery / line search failed
+  evaluation_failed,  // residual or Jacobian returned non-ok (NaN, failed simulation)
   linear_solver_failed,
 };
 const char* to_string(NewtonStatus s);
@@ -62,6 +62,19 @@ class Corrector {
   virtual std::string name() const = 0;
   // Solves problem(x) = 0 starting from x; x holds the last iterate on return.
   virtual NewtonSummary solve(const Problem& problem, Vector& x) = 0;
+};
+
+// Bookkeeping shared by every corrector: from construction on, counts the problem's
+// evaluations and the wall time, and fills those fields of a summary when the solve ends.
+class SummaryRecorder {
+ public:
+  explicit SummaryRecorder(const Problem& problem);
+  NewtonSummary finish(NewtonSummary& summary, NewtonStatus status, std::string message) const;
+
+ private:
+  const Problem& problem_;
+  long residuals_before_, jacobians_before_;
+  double start_seconds_;
 };
 
 // name: "eigen" or "kinsol". Throws InputError("newton", ...) for anything else.
