@@ -151,25 +151,19 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
       }
     }
     core::Vector y;
-    core::NewtonStatus last_failure = core::NewtonStatus::converged;
-    std::string last_message;
-    bool accepted = false;
     double step = 0;
-    while (true) {
-      step = parameter.direction * ds;
-      y = x + step * rate;
-      system.set_value(lambda + step);
-      s = corrector.solve(system, y);
-      accepted = s.converged() && y.allFinite();
-      if (hooks.on_attempt) hooks.on_attempt({index, ds, accepted, s});
-      if (accepted) break;
-      last_failure = s.status;
-      last_message = s.message;
-      const double smaller = ds * options.shrink_factor;
-      if (smaller < options.ds_min) break;
-      ds = smaller;
-    }
-    if (!accepted) {
+    const CorrectedStep corrected = correct_with_shrinking(ds, index, options, hooks, y,
+                                                           [&](double ds_try, core::Vector& guess) {
+                                                             step = parameter.direction * ds_try;
+                                                             guess = x + step * rate;
+                                                             system.set_value(lambda + step);
+                                                             return corrector.solve(system, guess);
+                                                           });
+    ds = corrected.ds;
+    s = corrected.summary;
+    const core::NewtonStatus last_failure = corrected.last_failure;
+    const std::string& last_message = corrected.last_message;
+    if (!corrected.accepted) {
       branch.reason = last_failure == core::NewtonStatus::evaluation_failed
                           ? StopReason::evaluation_failed
                           : StopReason::step_floor;

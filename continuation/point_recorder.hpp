@@ -17,6 +17,7 @@
 #include <string>
 
 #include "continuation/branch.hpp"
+#include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
 #include "core/newton.hpp"
 #include "core/problem.hpp"
@@ -50,5 +51,35 @@ std::string describe_point(const core::Vector& x);
 // Throws InputError unless guess (and direction, when non-empty) have num_unknowns entries.
 void check_sizes(const core::Problem& problem, const core::Vector& guess,
                  const core::Vector& direction);
+
+// The predict-correct step both loops share: attempt(ds, y) predicts into y and corrects it
+// with step ds; on failure ds shrinks by options.shrink_factor until a correction converges or
+// ds would fall below options.ds_min. Every try is reported through hooks.on_attempt.
+struct CorrectedStep {
+  bool accepted = false;
+  double ds = 0;                // the step of the last try
+  core::NewtonSummary summary;  // of the last try
+  core::NewtonStatus last_failure = core::NewtonStatus::converged;
+  std::string last_message;
+};
+
+template <class Attempt>  // core::NewtonSummary attempt(double ds, core::Vector& y)
+CorrectedStep correct_with_shrinking(double ds, int index, const ContinuationOptions& options,
+                                     const ContinuationHooks& hooks, core::Vector& y,
+                                     Attempt&& attempt) {
+  CorrectedStep r;
+  r.ds = ds;
+  while (true) {
+    r.summary = attempt(r.ds, y);
+    r.accepted = r.summary.converged() && y.allFinite();
+    if (hooks.on_attempt) hooks.on_attempt({index, r.ds, r.accepted, r.summary});
+    if (r.accepted) return r;
+    r.last_failure = r.summary.status;
+    r.last_message = r.summary.message;
+    const double smaller = r.ds * options.shrink_factor;
+    if (smaller < options.ds_min) return r;
+    r.ds = smaller;
+  }
+}
 
 }  // namespace backbone::continuation

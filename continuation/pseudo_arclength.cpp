@@ -138,24 +138,17 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
       if (secant.norm() > 0) step_direction = secant.normalized();
     }
     core::Vector y;
-    core::NewtonSummary s;
-    core::NewtonStatus last_failure = core::NewtonStatus::converged;
-    std::string last_message;
-    bool accepted = false;
-    while (true) {
-      y = x + ds * step_direction;
-      ArclengthSystem system(problem, x, step_direction, ds);
-      s = corrector.solve(system, y);
-      accepted = s.converged() && y.allFinite();
-      if (hooks.on_attempt) hooks.on_attempt({index, ds, accepted, s});
-      if (accepted) break;
-      last_failure = s.status;
-      last_message = s.message;
-      const double smaller = ds * options.shrink_factor;
-      if (smaller < options.ds_min) break;
-      ds = smaller;
-    }
-    if (!accepted) {
+    const CorrectedStep corrected = correct_with_shrinking(
+        ds, index, options, hooks, y, [&](double ds_try, core::Vector& guess) {
+          guess = x + ds_try * step_direction;
+          const ArclengthSystem system(problem, x, step_direction, ds_try);
+          return corrector.solve(system, guess);
+        });
+    ds = corrected.ds;
+    const core::NewtonSummary& s = corrected.summary;
+    const core::NewtonStatus last_failure = corrected.last_failure;
+    const std::string& last_message = corrected.last_message;
+    if (!corrected.accepted) {
       branch.reason = failure_reason(last_failure);
       branch.message = fmt::format(
           "no point {} could be corrected with ds >= ds_min = {:.3g} from {} (last Newton "
