@@ -139,10 +139,10 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
     }
     core::Vector y;
     const CorrectedStep corrected = correct_with_shrinking(
-        ds, index, options, hooks, y, [&](double ds_try, core::Vector& guess) {
-          guess = x + ds_try * step_direction;
+        ds, index, options, hooks, y, [&](double ds_try, core::Vector& predicted) {
+          predicted = x + ds_try * step_direction;
           const ArclengthSystem system(problem, x, step_direction, ds_try);
-          return corrector.solve(system, guess);
+          return corrector.solve(system, predicted);
         });
     ds = corrected.ds;
     const core::NewtonSummary& s = corrected.summary;
