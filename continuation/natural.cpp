@@ -152,13 +152,13 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
     }
     core::Vector y;
     double step = 0;
-    const CorrectedStep corrected = correct_with_shrinking(ds, index, options, hooks, y,
-                                                           [&](double ds_try, core::Vector& guess) {
-                                                             step = parameter.direction * ds_try;
-                                                             guess = x + step * rate;
-                                                             system.set_value(lambda + step);
-                                                             return corrector.solve(system, guess);
-                                                           });
+    const CorrectedStep corrected = correct_with_shrinking(
+        ds, index, options, hooks, y, [&](double ds_try, core::Vector& predicted) {
+          step = parameter.direction * ds_try;
+          predicted = x + step * rate;
+          system.set_value(lambda + step);
+          return corrector.solve(system, predicted);
+        });
     ds = corrected.ds;
     s = corrected.summary;
     const core::NewtonStatus last_failure = corrected.last_failure;
