@@ -12,6 +12,7 @@
 //   if (const Bound* b = rec.violated_bound(p)) { ... }
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -51,6 +52,16 @@ std::string describe_point(const core::Vector& x);
 // Throws InputError unless guess (and direction, when non-empty) have num_unknowns entries.
 void check_sizes(const core::Problem& problem, const core::Vector& guess,
                  const core::Vector& direction);
+
+// Step-size rule of both loops: grow after a fast correction, shrink after a slow one, within
+// [ds_min, ds_max].
+inline double adapted_step(double ds, int newton_iterations, const ContinuationOptions& options) {
+  if (newton_iterations <= options.fast_iterations)
+    return std::min(ds * options.grow_factor, options.ds_max);
+  if (newton_iterations >= options.slow_iterations)
+    return std::max(ds * options.shrink_factor, options.ds_min);
+  return ds;
+}
 
 // The predict-correct step both loops share: attempt(ds, y) predicts into y and corrects it
 // with step ds; on failure ds shrinks by options.shrink_factor until a correction converges or

@@ -205,10 +205,7 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
     have_previous = true;
     x = y;
     tangent = next_tangent;
-    if (s.iterations <= options.fast_iterations)
-      ds = std::min(ds * options.grow_factor, options.ds_max);
-    else if (s.iterations >= options.slow_iterations)
-      ds = std::max(ds * options.shrink_factor, options.ds_min);
+    ds = adapted_step(ds, s.iterations, options);
   }
   branch.reason = StopReason::max_points;
   branch.message = fmt::format("{} points computed", branch.points.size());
