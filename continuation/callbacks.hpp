@@ -4,7 +4,11 @@
 // a reporter prints a line, appends to a file or plots. on_attempt is called after every
 // correction attempt, accepted or not, so a progress display can show rejected steps.
 // cancel_requested, when set, is polled before each step: returning true ends the branch with
-// StopReason::cancelled (e.g. a wall-clock budget).
+// StopReason::cancelled (e.g. a wall-clock budget). reject_point, when set, is an independent
+// check of every converged correction (x in the problem's own unknowns): a non-empty answer
+// (the reason) rejects it like a failed correction, so ds shrinks and the step is retried. A
+// shooting residual projected on few test functions can have spurious roots; an exact
+// re-simulation of the orbit catches them.
 //
 //   ContinuationHooks hooks;
 //   hooks.on_point = [](const BranchPoint& p) {
@@ -15,6 +19,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "continuation/branch.hpp"
 #include "core/newton.hpp"
@@ -26,12 +31,14 @@ struct StepAttempt {
   double ds = 0;  // step size tried
   bool accepted = false;
   core::NewtonSummary newton;  // of the augmented system
+  std::string rejection;       // why reject_point refused a converged correction, else empty
 };
 
 struct ContinuationHooks {
   std::function<void(const BranchPoint&)> on_point;
   std::function<void(const StepAttempt&)> on_attempt;
   std::function<bool()> cancel_requested;
+  std::function<std::string(const core::Vector& x)> reject_point;
 };
 
 }  // namespace backbone::continuation

@@ -40,6 +40,12 @@ ParameterConstraintSystem::ParameterConstraintSystem(const core::Problem& base,
                                                      NaturalParameter parameter, double value)
     : base_(base), parameter_(std::move(parameter)), value_(value) {}
 
+double ParameterConstraintSystem::row_scale() const {
+  if (parameter_.kind == NaturalParameter::Kind::unknown) return 1.0;
+  const double size = std::abs(value_);
+  return size > 0 && std::isfinite(size) ? size : 1.0;
+}
+
 core::EvalStatus ParameterConstraintSystem::compute_residual(const core::Vector& x,
                                                              core::Vector& r) const {
   core::Vector f;
@@ -48,7 +54,7 @@ core::EvalStatus ParameterConstraintSystem::compute_residual(const core::Vector&
   const int m = base_.num_equations();
   r.resize(m + 1);
   r.head(m) = f;
-  r[m] = parameter_value(base_, parameter_, x) - value_;
+  r[m] = (parameter_value(base_, parameter_, x) - value_) / row_scale();
   return std::isfinite(r[m]) ? core::EvalStatus::ok : core::EvalStatus::failed;
 }
 
@@ -74,7 +80,7 @@ core::EvalStatus ParameterConstraintSystem::compute_jacobian(const core::Vector&
     xp[j] += h;
     xm[j] -= h;
     J(m, j) = (parameter_value(base_, parameter_, xp) - parameter_value(base_, parameter_, xm)) /
-              (xp[j] - xm[j]);
+              ((xp[j] - xm[j]) * row_scale());
   }
   return J.row(m).allFinite() ? core::EvalStatus::ok : core::EvalStatus::non_finite;
 }
@@ -86,10 +92,10 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
   check_sizes(problem, guess, core::Vector());
   const int n = problem.num_unknowns();
   const int m = problem.num_equations();
-  if (n - m != 1)
-    throw core::InputError("method", fmt::format("natural continuation in one parameter needs one "
-                                                 "more unknown than equations ({} unknowns vs "
-                                                 "{} equations)",
+  if (m < n - 1)
+    throw core::InputError("method", fmt::format("natural continuation in one parameter needs at "
+                                                 "least n - 1 equations for n unknowns ({} "
+                                                 "unknowns vs {} equations)",
                                                  n, m));
   if (parameter.kind == NaturalParameter::Kind::unknown &&
       (parameter.index < 0 || parameter.index >= n))
@@ -111,7 +117,7 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
   recorder.begin();
   core::Vector x = guess;
   core::NewtonSummary s = corrector.solve(system, x);
-  if (hooks.on_attempt) hooks.on_attempt({0, 0.0, s.converged(), s});
+  if (hooks.on_attempt) hooks.on_attempt({0, 0.0, s.converged(), s, {}});
   if (!s.converged()) {
     branch.reason = s.status == core::NewtonStatus::evaluation_failed
                         ? StopReason::evaluation_failed
@@ -158,7 +164,8 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
           predicted = x + step * rate;
           system.set_value(lambda + step);
           return corrector.solve(system, predicted);
-        });
+        },
+        [](const core::Vector& v) { return v; });
     ds = corrected.ds;
     s = corrected.summary;
     const core::NewtonStatus last_failure = corrected.last_failure;

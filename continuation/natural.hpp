@@ -41,6 +41,9 @@ double parameter_value(const core::Problem& problem, const NaturalParameter& par
 
 // [F(x); p(x) - value]. The last Jacobian row is e_index for an unknown, central differences
 // of the observable otherwise (observables are cheap closed forms of x in every problem here).
+// An observable's row is divided by |value| (1 when value = 0): an energy of 1e-3 J must not
+// weigh 1e-4 against residual rows of order one when an overdetermined system is solved in the
+// least-squares sense (measured: Newton then crawls, 3.8e-5 -> 3.0e-5 in 25 iterations).
 class ParameterConstraintSystem : public core::Problem {
  public:
   ParameterConstraintSystem(const core::Problem& base, NaturalParameter parameter, double value);
@@ -52,6 +55,8 @@ class ParameterConstraintSystem : public core::Problem {
   }
   core::Vector typical_scale() const override { return base_.typical_scale(); }
   void set_value(double value) { value_ = value; }
+  // Divisor of the constraint row: 1 for an unknown, |value| (or 1 at 0) for an observable.
+  double row_scale() const;
 
  protected:
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;

@@ -5,8 +5,10 @@
 // shrink_factor when it needed at least slow_iterations; a failed correction shrinks ds and
 // retries from the same point, and the branch ends with StopReason::step_floor once ds would
 // fall below ds_min. Bounds end the branch when an observable leaves [min, max]; the last point
-// is then re-corrected onto the bound itself. Distances (ds, arclength) are Euclidean in the
-// problem's unknowns.
+// is then re-corrected onto the bound itself. Pseudo-arclength distances (ds, arclength) are
+// Euclidean in the unknowns divided by the problem's typical_scale() (scale_unknowns, the
+// default: dimensionless, so one ds fits every scene of a problem); natural continuation steps
+// the parameter itself, in its own units.
 //
 //   ContinuationOptions opt;
 //   opt.ds = 0.01; opt.ds_max = 0.5; opt.max_points = 200;
@@ -49,6 +51,8 @@ struct ContinuationOptions {
   double grow_factor = 1.5;    // > 1
   double shrink_factor = 0.5;  // in (0, 1); also used after a failed correction
   int max_points = 100;        // including the first (corrected guess)
+  // Pseudo-arclength in z = x ./ typical_scale() (see scaled_problem.hpp); false: raw unknowns.
+  bool scale_unknowns = true;
   std::vector<Bound> bounds;
   bool land_on_bounds = true;  // re-correct the crossing point onto the bound
   // Rank report of the problem's Jacobian at every k-th point (and always at the first and

@@ -9,8 +9,9 @@
 
 namespace backbone::continuation {
 
-PointRecorder::PointRecorder(const core::Problem& problem, const ContinuationOptions& options)
-    : problem_(problem), options_(options) {
+PointRecorder::PointRecorder(const core::Problem& problem, const ContinuationOptions& options,
+                             const core::Problem* counted)
+    : problem_(problem), counted_(counted ? *counted : problem), options_(options) {
   if (options.rank_check_every > 0 && options.verify) {
     core::NewtonOptions newton;
     newton.residual_tolerance =
@@ -22,8 +23,8 @@ PointRecorder::PointRecorder(const core::Problem& problem, const ContinuationOpt
 
 void PointRecorder::begin() {
   start_ = std::chrono::steady_clock::now();
-  residuals_at_start_ = problem_.counters().residuals;
-  jacobians_at_start_ = problem_.counters().jacobians;
+  residuals_at_start_ = counted_.counters().residuals;
+  jacobians_at_start_ = counted_.counters().jacobians;
 }
 
 double PointRecorder::elapsed_seconds() const {
@@ -58,8 +59,8 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   p.arclength = arclength;
   const bool due = options_.rank_check_every > 0 && index % options_.rank_check_every == 0;
   if (due || (force_rank && options_.rank_check_every > 0)) check_rank(p);
-  p.residual_evaluations = problem_.counters().residuals - residuals_at_start_;
-  p.jacobian_evaluations = problem_.counters().jacobians - jacobians_at_start_;
+  p.residual_evaluations = counted_.counters().residuals - residuals_at_start_;
+  p.jacobian_evaluations = counted_.counters().jacobians - jacobians_at_start_;
   p.seconds = elapsed_seconds();
   return p;
 }

@@ -27,7 +27,10 @@ namespace backbone::continuation {
 
 class PointRecorder {
  public:
-  PointRecorder(const core::Problem& problem, const ContinuationOptions& options);
+  // counted: the problem whose evaluation counters measure the cost (the base problem when
+  // `problem` is a view of it, e.g. ScaledProblem, whose FD Jacobian calls only the base).
+  PointRecorder(const core::Problem& problem, const ContinuationOptions& options,
+                const core::Problem* counted = nullptr);
   void begin();
   // Fills a BranchPoint; runs the rank report when index % rank_check_every == 0 or force_rank.
   BranchPoint finish(const core::Vector& x, int index, int newton_iterations, double ds,
@@ -40,6 +43,7 @@ class PointRecorder {
 
  private:
   const core::Problem& problem_;
+  const core::Problem& counted_;
   const ContinuationOptions& options_;
   std::unique_ptr<core::Corrector> verifier_;  // eigen: handles non-square constrained systems
   std::chrono::steady_clock::time_point start_;
@@ -64,29 +68,40 @@ inline double adapted_step(double ds, int newton_iterations, const ContinuationO
 }
 
 // The predict-correct step both loops share: attempt(ds, y) predicts into y and corrects it
-// with step ds; on failure ds shrinks by options.shrink_factor until a correction converges or
-// ds would fall below options.ds_min. Every try is reported through hooks.on_attempt.
+// with step ds; on failure ds shrinks by options.shrink_factor until a correction converges (and
+// hooks.reject_point, given the point as unknowns(y), accepts it) or ds would fall below
+// options.ds_min. Every try is reported through hooks.on_attempt.
 struct CorrectedStep {
   bool accepted = false;
   double ds = 0;                // the step of the last try
   core::NewtonSummary summary;  // of the last try
   core::NewtonStatus last_failure = core::NewtonStatus::converged;
   std::string last_message;
+  int rejections = 0;  // converged corrections refused by hooks.reject_point
 };
 
-template <class Attempt>  // core::NewtonSummary attempt(double ds, core::Vector& y)
+template <class Attempt, class ToUnknowns>  // NewtonSummary attempt(double ds, Vector& y);
+                                            // Vector unknowns(const Vector& y)
 CorrectedStep correct_with_shrinking(double ds, int index, const ContinuationOptions& options,
                                      const ContinuationHooks& hooks, core::Vector& y,
-                                     Attempt&& attempt) {
+                                     Attempt&& attempt, ToUnknowns&& unknowns) {
   CorrectedStep r;
   r.ds = ds;
   while (true) {
     r.summary = attempt(r.ds, y);
     r.accepted = r.summary.converged() && y.allFinite();
-    if (hooks.on_attempt) hooks.on_attempt({index, r.ds, r.accepted, r.summary});
+    std::string rejection;
+    if (r.accepted && hooks.reject_point) {
+      rejection = hooks.reject_point(unknowns(y));
+      if (!rejection.empty()) {
+        r.accepted = false;
+        ++r.rejections;
+      }
+    }
+    if (hooks.on_attempt) hooks.on_attempt({index, r.ds, r.accepted, r.summary, rejection});
     if (r.accepted) return r;
     r.last_failure = r.summary.status;
-    r.last_message = r.summary.message;
+    r.last_message = rejection.empty() ? r.summary.message : "point rejected: " + rejection;
     const double smaller = r.ds * options.shrink_factor;
     if (smaller < options.ds_min) return r;
     r.ds = smaller;

@@ -7,6 +7,7 @@
 
 #include "continuation/natural.hpp"
 #include "continuation/point_recorder.hpp"
+#include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
 
 namespace backbone::continuation {
@@ -70,27 +71,20 @@ StopReason failure_reason(core::NewtonStatus s) {
                                                     : StopReason::step_floor;
 }
 
-}  // namespace
-
-Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
-                        const core::Vector& direction, core::Corrector& corrector,
-                        const ContinuationOptions& options, const ContinuationHooks& hooks) {
-  options.validate();
-  check_sizes(problem, guess, direction);
-  const int n = problem.num_unknowns();
-  const int m = problem.num_equations();
-  if (n - m != 1)
-    throw core::InputError("method", fmt::format("pseudo-arclength follows curves: it needs one "
-                                                 "more unknown than equations ({} unknowns vs "
-                                                 "{} equations)",
-                                                 n, m));
-  core::Vector hint = direction.size() ? direction : core::Vector::Unit(n, n - 1);
-  if (!(hint.norm() > 0) || !hint.allFinite())
-    throw core::InputError("direction", "must be a finite non-zero vector");
-  hint.normalize();
+// The loop proper, in the scaled unknowns z of `problem` (a ScaledProblem view: the identity
+// when options.scale_unknowns is false). Points are stored in z; the caller converts them.
+Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
+                      const core::Vector& hint_in, core::Corrector& corrector,
+                      const ContinuationOptions& options, const ContinuationHooks& hooks) {
+  const core::Vector hint = hint_in.normalized();
+  const auto unknowns = [&](const core::Vector& z) { return problem.to_unknowns(z); };
+  const auto describe = [&](const core::Vector& z) { return describe_point(unknowns(z)); };
+  const auto rejection_of = [&](const core::Vector& z) {
+    return hooks.reject_point ? hooks.reject_point(unknowns(z)) : std::string();
+  };
 
   Branch branch;
-  PointRecorder recorder(problem, options);
+  PointRecorder recorder(problem, options, &problem.base());
   const double threshold = options.rank.relative_threshold;
 
   // First point: the guess corrected on the hyperplane through it orthogonal to the hint.
@@ -99,13 +93,22 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
   {
     ArclengthSystem first(problem, guess, hint, 0.0);
     core::NewtonSummary s = corrector.solve(first, x);
-    if (hooks.on_attempt) hooks.on_attempt({0, 0.0, s.converged(), s});
+    const std::string rejection = s.converged() ? rejection_of(x) : std::string();
+    if (hooks.on_attempt)
+      hooks.on_attempt({0, 0.0, s.converged() && rejection.empty(), s, rejection});
     if (!s.converged()) {
       branch.reason = s.status == core::NewtonStatus::evaluation_failed
                           ? StopReason::evaluation_failed
                           : StopReason::newton_failed;
       branch.message = fmt::format("the starting guess did not converge ({}; {}): {}",
-                                   core::to_string(s.status), describe_point(guess), s.message);
+                                   core::to_string(s.status), describe(guess), s.message);
+      return branch;
+    }
+    if (!rejection.empty()) {
+      branch.reason = StopReason::newton_failed;
+      branch.message = fmt::format("the starting guess converged to a point the check rejects "
+                                   "({}): {}",
+                                   describe(x), rejection);
       return branch;
     }
     branch.points.push_back(recorder.finish(x, 0, s.iterations, 0.0, 0.0, true));
@@ -115,7 +118,7 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
   if (curve_tangent(problem, x, hint, threshold, tangent) != core::EvalStatus::ok) {
     branch.reason = StopReason::evaluation_failed;
     branch.message =
-        fmt::format("the Jacobian could not be evaluated at point 0 ({})", describe_point(x));
+        fmt::format("the Jacobian could not be evaluated at point 0 ({})", describe(x));
     return branch;
   }
 
@@ -143,7 +146,8 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
           predicted = x + ds_try * step_direction;
           const ArclengthSystem system(problem, x, step_direction, ds_try);
           return corrector.solve(system, predicted);
-        });
+        },
+        unknowns);
     ds = corrected.ds;
     const core::NewtonSummary& s = corrected.summary;
     const core::NewtonStatus last_failure = corrected.last_failure;
@@ -153,7 +157,7 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
       branch.message = fmt::format(
           "no point {} could be corrected with ds >= ds_min = {:.3g} from {} (last Newton "
           "status {}: {})",
-          index, options.ds_min, describe_point(x), core::to_string(last_failure), last_message);
+          index, options.ds_min, describe(x), core::to_string(last_failure), last_message);
       return branch;
     }
     core::Vector next_tangent;
@@ -176,13 +180,13 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
         // From the crossing point first, then from the last point inside the bound.
         core::Vector z = y;
         core::NewtonSummary sb = corrector.solve(on_bound, z);
-        if (hooks.on_attempt) hooks.on_attempt({index, ds, sb.converged(), sb});
+        if (hooks.on_attempt) hooks.on_attempt({index, ds, sb.converged(), sb, {}});
         if (!sb.converged()) {
           z = x;
           sb = corrector.solve(on_bound, z);
-          if (hooks.on_attempt) hooks.on_attempt({index, ds, sb.converged(), sb});
+          if (hooks.on_attempt) hooks.on_attempt({index, ds, sb.converged(), sb, {}});
         }
-        if (sb.converged() && (z - x).dot(step_direction) > 0) {
+        if (sb.converged() && (z - x).dot(step_direction) > 0 && rejection_of(z).empty()) {
           arclength += (z - x).norm() - (y - x).norm();
           branch.points.push_back(
               recorder.finish(z, index, sb.iterations, (z - x).norm(), arclength, true));
@@ -198,7 +202,7 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
     if (tangent_status != core::EvalStatus::ok) {
       branch.reason = StopReason::evaluation_failed;
       branch.message = fmt::format("the Jacobian could not be evaluated at point {} ({}: {})",
-                                   index, core::to_string(tangent_status), describe_point(y));
+                                   index, core::to_string(tangent_status), describe(y));
       return branch;
     }
     previous = x;
@@ -209,6 +213,41 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
   }
   branch.reason = StopReason::max_points;
   branch.message = fmt::format("{} points computed", branch.points.size());
+  return branch;
+}
+
+}  // namespace
+
+Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
+                        const core::Vector& direction, core::Corrector& corrector,
+                        const ContinuationOptions& options, const ContinuationHooks& hooks) {
+  options.validate();
+  check_sizes(problem, guess, direction);
+  const int n = problem.num_unknowns();
+  const int m = problem.num_equations();
+  if (m < n - 1)
+    throw core::InputError("method", fmt::format("pseudo-arclength follows curves: it needs at "
+                                                 "least n - 1 equations for n unknowns ({} "
+                                                 "unknowns vs {} equations)",
+                                                 n, m));
+  const core::Vector hint = direction.size() ? direction : core::Vector::Unit(n, n - 1);
+  if (!(hint.norm() > 0) || !hint.allFinite())
+    throw core::InputError("direction", "must be a finite non-zero vector");
+
+  const ScaledProblem scaled = options.scale_unknowns
+                                   ? ScaledProblem(problem)
+                                   : ScaledProblem(problem, core::Vector::Ones(n));
+  ContinuationHooks inner = hooks;
+  if (hooks.on_point)
+    inner.on_point = [&](const BranchPoint& p) {
+      BranchPoint q = p;
+      q.x = scaled.to_unknowns(p.x);
+      hooks.on_point(q);
+    };
+  Branch branch =
+      arclength_loop(scaled, scaled.to_scaled(guess), scaled.to_scaled(hint), corrector, options,
+                     inner);
+  for (BranchPoint& p : branch.points) p.x = scaled.to_unknowns(p.x);
   return branch;
 }
 

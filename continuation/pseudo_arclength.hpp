@@ -1,4 +1,7 @@
-// Pseudo-arclength continuation (PALC) of a solution curve F(x) = 0, F: R^n -> R^(n-1).
+// Pseudo-arclength continuation (PALC) of a solution curve F(x) = 0, F: R^n -> R^(n-1), or
+// R^m with m >= n - 1 when the system is overdetermined but consistent (rank n - 1 along the
+// curve, e.g. a shooting residual sampled on more test functions than unknowns): the eigen
+// corrector then solves each step in the least-squares sense, KINSOL refuses (square only).
 //
 // From a point x_k with unit tangent t_k the predictor is x_k + ds t_k (or the secant
 // direction), and the corrector solves the augmented system
@@ -8,7 +11,10 @@
 // of [J; t_prev^T] t = [0; 1], normalised: it spans the null space of J and keeps the
 // orientation of the previous tangent, so the branch goes through folds without reversing.
 // The first point is the guess corrected on the hyperplane through it orthogonal to the
-// direction hint. The loop prints nothing (see callbacks.hpp); failures are a StopReason.
+// direction hint. The curve is followed in the scaled unknowns x ./ typical_scale() (options.
+// scale_unknowns, scaled_problem.hpp): ds is dimensionless, the branch's points are returned in
+// the problem's own unknowns. The loop prints nothing (see callbacks.hpp); failures are a
+// StopReason.
 //
 //   auto newton = core::make_corrector("kinsol", core::NewtonOptions{});
 //   ContinuationOptions opt; opt.ds = 0.01; opt.ds_max = 0.5; opt.max_points = 60;
@@ -58,7 +64,7 @@ core::EvalStatus curve_tangent(const core::Problem& problem, const core::Vector&
                                core::Vector& tangent);
 
 // Throws core::InputError for bad options, sizes (guess and direction must have n entries,
-// n - m must be 1) or a zero direction. Never throws on numerical failure.
+// m >= n - 1) or a zero direction. Never throws on numerical failure.
 Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
                         const core::Vector& direction, core::Corrector& corrector,
                         const ContinuationOptions& options, const ContinuationHooks& hooks = {});

@@ -170,3 +170,118 @@ TEST(PseudoArclength, SphereIsNotACurve) {
       continuation::pseudo_arclength(sphere, x, core::Vector::Unit(3, 1), *newton, quick(5)),
       core::InputError);
 }
+
+namespace {
+
+// The unit circle with its first unknown in millimetres (x0 = 1000 cos, x1 = sin): the same
+// curve in other units, reporting them through typical_scale. Observables "angle".
+class MillimetreCircle : public core::Problem {
+ public:
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 1; }
+  core::Vector typical_scale() const override { return vec(1000.0, 1.0); }
+  core::Observables observables(const core::Vector& x) const override {
+    return {{"angle", std::atan2(x[1], x[0] / 1000.0)}};
+  }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    r.resize(1);
+    r[0] = (x[0] / 1000.0) * (x[0] / 1000.0) + x[1] * x[1] - 1.0;
+    return core::EvalStatus::ok;
+  }
+};
+
+// x^2 + y^2 = 1 written twice, once scaled: 2 equations of rank 1 in 2 unknowns. A consistent
+// overdetermined system, like a shooting residual sampled on more test functions than unknowns.
+class DoubledCircle : public core::Problem {
+ public:
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 2; }
+  core::Observables observables(const core::Vector& x) const override {
+    return {{"angle", std::atan2(x[1], x[0])}};
+  }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    r.resize(2);
+    r[0] = x.squaredNorm() - 1.0;
+    r[1] = 3.0 * r[0];
+    return core::EvalStatus::ok;
+  }
+};
+
+}  // namespace
+
+// Scaled unknowns make the branch independent of the units: the millimetre circle traced with
+// the same dimensionless ds gives the same angles as the unit circle, step for step. Unscaled,
+// a ds of 0.05 would be 0.05 mm and the branch would crawl.
+TEST(PseudoArclength, ScaledUnknownsMakeTheBranchUnitFree) {
+  algebraic::Circle circle;
+  MillimetreCircle mm;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  const auto opt = quick(40);
+  const Branch a = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  const Branch b = continuation::pseudo_arclength(mm, vec(1000, 0), vec(0, 1), *newton, opt);
+  ASSERT_EQ(a.points.size(), b.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    // Same steps: Circle has an analytic Jacobian, the mm circle a forward-difference one
+    // (relative error ~1e-8), so tangents and hence points along the curve differ by about
+    // ds * 1e-8 per step (measured 2e-10 rad after 5 steps); 1e-6 over 40 steps leaves room
+    // while a unit-dependent step (angle steps 1000x smaller) would fail by far.
+    EXPECT_NEAR(a.points[i].observable("angle"), b.points[i].observable("angle"), 1e-6) << i;
+    EXPECT_NEAR(b.points[i].x[0], 1000 * a.points[i].x[0], 1e-3) << i;  // returned in mm
+  }
+  auto raw = opt;
+  raw.scale_unknowns = false;
+  const Branch c = continuation::pseudo_arclength(mm, vec(1000, 0), vec(0, 1), *newton, raw);
+  // Unscaled, 40 steps of at most ds_max = 0.2 "mm + 1" cannot go far round: the angle after
+  // the same number of points is smaller than the scaled run's (measured 1.5 vs 4.6 rad of
+  // arclength); the comparison only needs c to lag.
+  EXPECT_LT(c.points.back().arclength / 1000, a.points.back().arclength);
+}
+
+// A point the independent check rejects is retried with a smaller step and never recorded;
+// when no step passes, the branch ends at the step floor and says why.
+TEST(PseudoArclength, RejectedPointsAreRetriedAndNeverRecorded) {
+  algebraic::Circle circle;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  continuation::ContinuationHooks hooks;
+  int rejections = 0;
+  hooks.reject_point = [](const core::Vector& x) {
+    return x[1] > 0.5 ? std::string("y above 0.5") : std::string();
+  };
+  hooks.on_attempt = [&](const continuation::StepAttempt& a) {
+    if (!a.rejection.empty()) ++rejections;
+  };
+  const Branch b =
+      continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, quick(200), hooks);
+  EXPECT_EQ(b.reason, StopReason::step_floor) << b.message;
+  EXPECT_NE(b.message.find("point rejected: y above 0.5"), std::string::npos) << b.message;
+  EXPECT_GT(rejections, 0);
+  for (const auto& p : b.points) EXPECT_LE(p.x[1], 0.5);
+  // It got as close to the limit as ds_min allows: the last point is within a step of it.
+  EXPECT_GT(b.points.back().x[1], 0.5 - 1e-6);
+}
+
+// A consistent overdetermined system is traced by least-squares Newton (eigen) like a square
+// one; KINSOL, square-only, says so instead of iterating.
+TEST(PseudoArclength, ConsistentOverdeterminedSystemIsACurve) {
+  DoubledCircle doubled;
+  algebraic::Circle circle;
+  auto eigen = core::make_corrector("eigen", core::NewtonOptions{});
+  const Branch a = continuation::pseudo_arclength(doubled, vec(1, 0), vec(0, 1), *eigen, quick(30));
+  const Branch b = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *eigen, quick(30));
+  ASSERT_EQ(a.points.size(), 30u) << a.message;
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    EXPECT_NEAR(a.points[i].x.norm(), 1.0, 1e-10);
+    if (a.points[i].dimension >= 0) {
+      EXPECT_EQ(a.points[i].dimension, 1) << i;  // rank 1 of 2
+    }
+  }
+  EXPECT_NEAR(a.points.back().observable("angle"), b.points.back().observable("angle"), 1e-6);
+  auto kinsol = core::make_corrector("kinsol", core::NewtonOptions{});
+  const Branch k = continuation::pseudo_arclength(doubled, vec(1, 0), vec(0, 1), *kinsol, quick(5));
+  EXPECT_EQ(k.reason, StopReason::newton_failed);
+  EXPECT_NE(k.message.find("square"), std::string::npos) << k.message;
+}

@@ -1,0 +1,52 @@
+// A problem seen in scaled unknowns z = x ./ s, s = base.typical_scale(): G(z) = F(s .* z).
+//
+// Pseudo-arclength measures steps with a Euclidean norm, which is only meaningful when the
+// unknowns have comparable magnitudes. A contact bar with a 1e-5 m gap and a 1e-4 s period, or
+// a Duffing orbit whose period is 2 pi while its amplitude is 0.01, is not: unscaled, ds is in
+// metres plus seconds and every new scene needs hand-tuned steps. Continuing G instead makes
+// ds, ds_min, ds_max and the arclength dimensionless (in units of the typical scale), the
+// tangent a scaled direction and the rank report a report on the column-scaled Jacobian J S,
+// whose singular values no longer depend on the units. The residual itself is the base's.
+//
+//   ScaledProblem scaled(problem);                 // s = problem.typical_scale()
+//   core::Vector z = scaled.to_scaled(x);          // x ./ s
+//   scaled.residual(z, r);                         // = problem.residual(x, r)
+//   core::Vector back = scaled.to_unknowns(z);     // s .* z
+#pragma once
+
+#include <string>
+
+#include "core/problem.hpp"
+
+namespace backbone::continuation {
+
+class ScaledProblem : public core::Problem {
+ public:
+  // Throws core::InputError when the base's typical scale is not finite and positive.
+  explicit ScaledProblem(const core::Problem& base);
+  // Same with an explicit scale (ones: the identity view, for unscaled runs).
+  ScaledProblem(const core::Problem& base, core::Vector scale);
+  int num_unknowns() const override { return base_.num_unknowns(); }
+  int num_equations() const override { return base_.num_equations(); }
+  std::string name() const override { return base_.name(); }
+  core::Observables observables(const core::Vector& z) const override {
+    return base_.observables(to_unknowns(z));
+  }
+  core::Vector typical_scale() const override { return core::Vector::Ones(num_unknowns()); }
+
+  core::Vector to_scaled(const core::Vector& x) const { return x.cwiseQuotient(scale_); }
+  core::Vector to_unknowns(const core::Vector& z) const { return z.cwiseProduct(scale_); }
+  const core::Vector& scale() const { return scale_; }
+  const core::Problem& base() const { return base_; }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& z, core::Vector& r) const override;
+  // J_z = J_x diag(s): the base's Jacobian (analytic or FD with its own step rule).
+  core::EvalStatus compute_jacobian(const core::Vector& z, core::Matrix& J) const override;
+
+ private:
+  const core::Problem& base_;
+  core::Vector scale_;
+};
+
+}  // namespace backbone::continuation
