@@ -245,8 +245,15 @@ int run_trace(const std::vector<std::string>& args) {
   }
 
   const int n = problem.num_unknowns(), m = problem.num_equations();
+  if (m != n - 1 && corrector->name() == "kinsol")
+    throw core::InputError("newton", fmt::format("kinsol solves square systems only; this {} "
+                                                 "residual has {} equations for {} unknowns "
+                                                 "(use newton = eigen, least squares)",
+                                                 problem_name, m, n));
+  // A consistent overdetermined system (m > n - 1) still has curves of solutions.
+  const int expected_dimension = n - std::min(m, n - 1);
   fmt::print("{} / {}: {} equations in {} unknowns, expected manifold dimension {}\n", problem_name,
-             branch_name, m, n, n - m);
+             branch_name, m, n, expected_dimension);
   fmt::print("  {} continuation, {} predictor, newton {}, {}{}\n", cont::to_string(options.method),
              cont::to_string(options.predictor), corrector->name(),
              periodic ? fmt::format("formulation {}, ", core::to_string(formulation)) : "",
@@ -264,6 +271,14 @@ int run_trace(const std::vector<std::string>& args) {
     std::fflush(stdout);
   };
 
+  long rejected = 0;
+  hooks.reject_point = setup.reject_point;
+  hooks.on_attempt = [&](const cont::StepAttempt& a) {
+    if (a.rejection.empty()) return;
+    ++rejected;
+    fmt::print("  point {:4d}  rejected at ds {:.3g}: {}\n", a.point, a.ds, a.rejection);
+  };
+
   cont::Branch branch;
   if (options.method == cont::Method::arclength) {
     branch = cont::pseudo_arclength(problem, setup.guess, direction, *corrector, options, hooks);
@@ -279,9 +294,10 @@ int run_trace(const std::vector<std::string>& args) {
 
   std::string summary = fmt::format(
       "problem {}\nbranch {}\nequations {}\nunknowns {}\nexpected_dimension {}\nmethod {}\n"
-      "newton {}\nformulation {}\npoints {}\nstop_reason {}\nmessage {}\n",
-      problem_name, branch_name, m, n, n - m, cont::to_string(options.method), corrector->name(),
-      periodic ? core::to_string(formulation) : "-", branch.points.size(),
+      "newton {}\nformulation {}\npoints {}\nrejected_corrections {}\nstop_reason {}\n"
+      "message {}\n",
+      problem_name, branch_name, m, n, expected_dimension, cont::to_string(options.method), corrector->name(),
+      periodic ? core::to_string(formulation) : "-", branch.points.size(), rejected,
       cont::to_string(branch.reason), branch.message);
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
   if (branch.points.empty()) {

@@ -38,6 +38,10 @@ po::options_description orbit_scene_keys() {
        "intervals of the u0 grid (0: the scene's elements). 20 holds modes 1 and 2 exactly "
        "(mode 2 with its free knot); at 100 the projected half-period residual has spurious "
        "roots near the branch (measured) and costs 5x more")  //
+      ("test_elements", po::value<long>()->default_value(-1),
+       "elements of the grid the residual is sampled on (its equations): 0 = as many as "
+       "unknowns (square), -1 = auto (2x the unknowns: overdetermined, consistent, no "
+       "spurious roots; least-squares Newton, eigen only)")  //
       ("steps_per_period", po::value<long>()->default_value(40),
        "time steps per period, dt = T / steps_per_period (even; event contact is exact for "
        "piecewise-linear orbits at any dt <= L/c)")  //
@@ -54,16 +58,22 @@ po::options_description orbit_scene_keys() {
        "points on the branch, first included")  //
       ("rank_check_every", po::value<long>()->default_value(10),
        "verified rank report every k points (0: never)")  //
-      ("ds", po::value<double>()->default_value(0.005),
-       "first step (Euclidean, in unknowns [m] and [s])")  //
-      ("ds_max", po::value<double>()->default_value(0.005), "largest step");
+      ("ds", po::value<double>()->default_value(2.0),
+       "first step, dimensionless: Euclidean in u0 / gap, knot / L and T c / L")  //
+      ("ds_max", po::value<double>()->default_value(2.0), "largest step (dimensionless)")  //
+      ("newton_tolerance", po::value<double>()->default_value(1e-10),
+       "||F||_inf to converge; F is in units of the gap, so this is relative to g0")  //
+      ("return_tolerance", po::value<double>()->default_value(1e-6),
+       "reject a converged point whose orbit, re-simulated over T by the exact oracle, misses "
+       "u0 or v0 = 0 by more than this, relative to max|u0| (0: no check). Catches spurious "
+       "roots of the projected residual");
   keys.add(shooting);
   return keys;
 }
 
 drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::string& branch) {
   const int mode = branch == "mode2" ? 2 : 1;
-  bar::BarSetup setup = contact_bar::setup_from_scene(scene);
+  bar::BarSetup setup = contact_bar::bar_from_scene(scene);  // u0, v0: the orbit's own
 
   std::shared_ptr<const bar::BarSolver> solver;
   const std::string solver_name = scene.choice("shooting_solver", {"tdbem", "exact"});
@@ -80,6 +90,9 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
   options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
   const long knots = scene.integer("free_knots", -1);
   options.free_knots = knots < 0 ? (mode == 2 ? 1 : 0) : static_cast<int>(knots);
+  const long test_elements = scene.integer("test_elements", -1);
+  options.test_elements = static_cast<int>(
+      test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);
   if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
     throw core::InputError("right_end",
                            "the contact-bar modes need right_end = contact and gap > 0");
@@ -96,6 +109,20 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
                 problem->contact_family_guess(mode, ratio);
 
   const contact_bar::ContactBarOrbitProblem* p = problem.get();
+  const double return_tolerance = scene.non_negative("return_tolerance");
+  if (return_tolerance > 0) {
+    // Exact oracle on a grid 4x finer than the residual's test functions: a spurious root of
+    // the N projected equations is not a root of these.
+    const int check_elements = 4 * p->state_size();
+    s.reject_point = [p, return_tolerance, check_elements](const core::Vector& x) {
+      const exact_bar::ExactBarSolver oracle;
+      const contact_bar::ReturnError e = contact_bar::return_error(*p, x, oracle, check_elements);
+      if (e.worst() <= return_tolerance) return std::string();
+      return fmt::format("exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
+                         "return_tolerance {:g}",
+                         e.displacement, e.velocity, return_tolerance);
+    };
+  }
   const bar::Material material = setup.material;
   const double gap = setup.right.gap;
   s.describe_point = [p, material, gap, mode](const continuation::BranchPoint& point) {

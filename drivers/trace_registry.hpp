@@ -48,6 +48,9 @@ struct TraceSetup {
   // (core::Table::write_csv, core::render_png).
   std::function<void(const std::filesystem::path& out_dir, const continuation::Branch& branch)>
       write_extra_outputs;
+  // Optional: independent check of each converged point (x in the problem's unknowns); a
+  // non-empty answer rejects it and the step is retried smaller (ContinuationHooks).
+  std::function<std::string(const core::Vector& x)> reject_point;
   // Optional: words appended to each progress line (e.g. "contact 0.31 T").
   std::function<std::string(const continuation::BranchPoint& point)> describe_point;
 };

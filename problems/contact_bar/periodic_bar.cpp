@@ -34,6 +34,11 @@ void OrbitOptions::validate() const {
     throw InputError(
         "steps_per_period",
         fmt::format("must be even and >= 2 so that T/2 is a step (got {})", steps_per_period));
+  if (test_elements != 0 && test_elements < elements + free_knots)
+    throw InputError("test_elements",
+                     fmt::format("must be 0 (square system) or >= elements + free_knots = {} "
+                                 "(got {})",
+                                 elements + free_knots, test_elements));
   if (!std::isfinite(fixed_dt) || fixed_dt < 0)
     throw InputError("fixed_dt", fmt::format("must be >= 0 (0: dt = T / steps_per_period; "
                                              "got {})",
@@ -73,6 +78,10 @@ int ContactBarOrbitProblem::reference_knot_node() const {
 
 double ContactBarOrbitProblem::gap() const {
   return setup_.right.type == bar::EndType::contact ? setup_.right.gap : 0.0;
+}
+
+double ContactBarOrbitProblem::displacement_scale() const {
+  return gap() > 0 ? gap() : 1e-3 * setup_.material.length;
 }
 
 Vector ContactBarOrbitProblem::node_positions(const Vector& x) const {
@@ -159,8 +168,7 @@ Vector ContactBarOrbitProblem::typical_scale() const {
   // Displacements scale with the gap (homogeneity: only E/g0^2 matters), lengths with L,
   // the period with the travel time.
   const double length = setup_.material.length;
-  const double u_scale = gap() > 0 ? gap() : 1e-3 * length;
-  Vector s = Vector::Constant(num_unknowns(), u_scale);
+  Vector s = Vector::Constant(num_unknowns(), displacement_scale());
   if (options_.free_knots == 1) s[options_.elements] = length;
   s[period_index()] = setup_.material.travel_time();
   return s;
@@ -168,7 +176,7 @@ Vector ContactBarOrbitProblem::typical_scale() const {
 
 EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
   const int n = options_.elements;
-  const int m = state_size();  // equations = snapshot grid elements
+  const int m = num_equations();  // equations = snapshot grid elements
   const double length = setup_.material.length;
   const double period = x[period_index()];
   if (!std::isfinite(period) || !(period > 0)) return EvalStatus::failed;
@@ -203,14 +211,15 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
   if (!snap.ok) return EvalStatus::failed;
 
   r.resize(m);
+  const double u_scale = displacement_scale();
   if (paper) {
     if (static_cast<int>(snap.u.size()) != m + 1) return EvalStatus::failed;
-    for (int i = 1; i <= m; ++i) r[i - 1] = s.u0(snap.x[i]) - snap.u[i];
+    for (int i = 1; i <= m; ++i) r[i - 1] = (s.u0(snap.x[i]) - snap.u[i]) / u_scale;
   } else {
     if (static_cast<int>(snap.v_projected.size()) != m + 1) return EvalStatus::failed;
     // (L / c) * hat-weighted average of v: a displacement, comparable with the paper's f.
     const double dx = length / m;
-    const double scale = setup_.material.travel_time();
+    const double scale = setup_.material.travel_time() / u_scale;
     for (int i = 1; i <= m; ++i) {
       const double mass = i == m ? 0.5 * dx : dx;
       r[i - 1] = scale * snap.v_projected[i] / mass;
@@ -226,8 +235,7 @@ Vector ContactBarOrbitProblem::linear_mode_guess(int mode, double amplitude_rati
   const double length = setup_.material.length;
   const double k = (2 * mode - 1) * std::numbers::pi / (2 * length);
   const double sign_at_end = (mode % 2 == 1) ? 1.0 : -1.0;  // sin((2k-1) pi / 2)
-  const double u_scale = gap() > 0 ? gap() : 1e-3 * length;
-  const double amplitude = -amplitude_ratio * u_scale * sign_at_end;  // u0(L) < 0
+  const double amplitude = -amplitude_ratio * displacement_scale() * sign_at_end;  // u0(L) < 0
   Vector x(num_unknowns());
   const int n = options_.elements;
   if (options_.free_knots == 1) x[n] = length / (2 * mode - 1);  // first crest of the sine
@@ -244,7 +252,7 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
   if (!(amplitude_ratio > 0))
     throw InputError("amplitude_ratio", fmt::format("must be > 0 (got {})", amplitude_ratio));
   const double length = setup_.material.length;
-  const double g0 = gap() > 0 ? gap() : 1e-3 * length;
+  const double g0 = displacement_scale();
   const double tau = setup_.material.travel_time();
   const int n = options_.elements;
   Vector x(num_unknowns());

@@ -43,6 +43,12 @@ struct OrbitOptions {
   int free_knots = 0;           // 0: uniform grid; 1: node knot_node moves (its position is
                                 // an unknown)
   int knot_node = 0;            // 1..N-1; 0 picks round(N / 3) (the crest of mode 2)
+  int test_elements = 0;        // M: residual sampled on a uniform grid of M elements (M
+                                // equations); 0: M = elements + free_knots (square system).
+                                // M > that: overdetermined but consistent (true orbits zero
+                                // every test function), solved by least squares; the N
+                                // projections of a square system have spurious roots that
+                                // M >= 2N removes (measured, see trace_contact_bar.cpp)
   int steps_per_period = 2000;  // dt = T / steps_per_period; must be even
   double fixed_dt = 0;          // > 0: this dt instead (T/2 and T then fall between steps)
   void validate() const;        // throws core::InputError naming the field
@@ -59,6 +65,10 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
 
   std::string name() const override { return "contact_bar"; }
   int state_size() const override { return options_.elements + options_.free_knots; }
+  // M = test_elements (state_size() when 0).
+  int num_equations() const override {
+    return options_.test_elements > 0 ? options_.test_elements : state_size();
+  }
   // Potential energy of u0: 1/2 int EA u0_x^2 dx (v0 = 0), exact for piecewise-linear u0.
   double energy(const core::Vector& x) const override;
   // Node positions y_1..y_N of the representation grid at x (mapped when a knot is free),
@@ -72,7 +82,10 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
                              core::Vector& values) const override;
   // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (free knot only).
   core::Observables observables(const core::Vector& x) const override;
+  // u_s for the u0 entries, L for a free knot, L/c for the period.
   core::Vector typical_scale() const override;
+  // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
+  double displacement_scale() const;
 
   // The initial displacement at x, as the solver sees it (knots at the node positions).
   bar::PiecewiseLinear initial_displacement(const core::Vector& x) const;

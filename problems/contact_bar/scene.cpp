@@ -97,7 +97,7 @@ bar::PiecewiseLinear parse_knots(const std::string& key, const std::string& text
   }
 }
 
-bar::BarSetup setup_from_scene(const core::Scene& scene) {
+bar::BarSetup bar_from_scene(const core::Scene& scene) {
   bar::BarSetup s;
   s.material.length = scene.positive("length");
   s.material.youngs_modulus = scene.positive("youngs_modulus");
@@ -107,6 +107,14 @@ bar::BarSetup setup_from_scene(const core::Scene& scene) {
   s.left = {bar::parse_end_type("left_end", scene.text("left_end")), gap};
   s.right = {bar::parse_end_type("right_end", scene.text("right_end")), gap};
   s.body_force = scene.number("body_force");
+  s.u0 = bar::PiecewiseLinear::zero(s.material.length);
+  s.v0 = bar::PiecewiseLinear::zero(s.material.length);
+  s.validate();
+  return s;
+}
+
+bar::BarSetup setup_from_scene(const core::Scene& scene) {
+  bar::BarSetup s = bar_from_scene(scene);
   s.u0 = parse_knots("u0", scene.has("u0") ? scene.text("u0") : "", s.material.length);
   s.v0 = parse_knots("v0", scene.has("v0") ? scene.text("v0") : "", s.material.length);
   s.validate();

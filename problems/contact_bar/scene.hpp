@@ -29,6 +29,10 @@ namespace po = boost::program_options;
 po::options_description scene_keys();
 
 bar::BarSetup setup_from_scene(const core::Scene& scene);
+// The bar alone (material, ends, gap, body force), u0 = v0 = 0: for problems that choose their
+// own initial fields (the orbit problem of `trace`), so that the scene's u0/v0 knots, written
+// for its own length, do not have to be rewritten when --length changes.
+bar::BarSetup bar_from_scene(const core::Scene& scene);
 // t_end = periods * period; dt, elements, history_samples, probes from the scene.
 bar::SimulationOptions simulation_from_scene(const core::Scene& scene, double periods = 1);
 ContactMethod contact_method_from_scene(const core::Scene& scene);

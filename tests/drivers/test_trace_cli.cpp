@@ -1,0 +1,58 @@
+// `backbone trace` end to end on the contact bar: bad input names its key (exit 2, nothing
+// written); another scene than the paper's (other L, E, rho, g0 on the command line, nothing
+// else changed) traces mode 1 onto the closed form of DESIGN.md section 1, because the
+// continuation works in units of the scene (u0 / g0, T c / L) and checks each point.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+
+#include "core/table.hpp"
+#include "tests/drivers/cli_run.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string paper =
+    std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
+
+void expect_bad_input(const std::string& arguments, const std::string& key) {
+  cli::expect_bad_input("trace", arguments, key, "trace_cli");
+}
+
+TEST(TraceCli, BadInputExitsTwoAndWritesNothing) {
+  expect_bad_input(paper + " --branch mode3", "branch");
+  expect_bad_input(paper + " --ds 0", "ds");
+  expect_bad_input(paper + " --test_elements 5", "test_elements");
+  expect_bad_input(paper + " --steps_per_period 41", "steps_per_period");
+  expect_bad_input(paper + " --return_tolerance -1", "return_tolerance");
+  expect_bad_input(paper + " --right_end free", "right_end");
+  // KINSOL is square-only; the default residual is oversampled (test_elements = -1).
+  expect_bad_input(paper + " --newton kinsol", "newton");
+}
+
+// A short stiff aluminium bar with a 10 um gap: u0 ~ 1e-5 m, T ~ 2e-4 s. The scene's u0 knots
+// (written for L = 1) are not needed; the default dimensionless steps fit. Every point must
+// match the closed form at its own energy (acceptance 1e-5; measured 1e-13) and return under
+// the exact oracle (the per-point check of trace, 1e-6).
+TEST(TraceCli, OtherSceneModeOneMatchesTheClosedForm) {
+  const fs::path out = cli::scratch("trace_cli", "short_bar");
+  const cli::Run r = cli::run("trace",
+                              paper + " --branch mode1 --length 0.3 --youngs_modulus 7e4 "
+                                      "--density 2.7 --gap 1e-5 --energy_max 1e-3",
+                              out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto check = backbone::core::Table::read_csv(out / "closed_form_check.csv");
+  const auto errors = check.column("relative_error");
+  ASSERT_GE(errors.size(), 10u);
+  EXPECT_LE(*std::max_element(errors.begin(), errors.end()), 1e-8);
+  const auto energy = check.column("energy");
+  EXPECT_NEAR(energy.back(), 1e-3, 1e-9);  // landed on the bound
+  // Grazing energy EA g0^2 / (2L) = 7e4 * 1e-10 / 0.6; the start is 5 % above in amplitude.
+  EXPECT_NEAR(energy.front(), 1.05 * 1.05 * 7e4 * 1e-10 / 0.6, 1e-15);
+  fs::remove_all(out);
+}
+
+}  // namespace
