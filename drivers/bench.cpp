@@ -8,8 +8,15 @@
 //                      force, energy drift, CPU time; plus the history figure (paper Fig. 3).
 //   mode1_convergence  TD-BEM errors on the exact mode 1 (onset, release, force, return to u0)
 //                      vs dt, with observed orders, for each contact method (FEM for reference).
+//   formulations       the paper's shooting residual u0 - u(T) vs the regular half-period
+//                      velocity one (DESIGN.md section 3) on the same exact orbits of modes 1 and
+//                      2 (4 amplitudes each): Newton from one perturbed start per orbit, at fixed
+//                      energy (the natural parameter: [F; E - E*], so both aim at x* itself),
+//                      iterations, observed orders, error to x*, exact-oracle return error and
+//                      rank reports (forward/central differences, verified) at the final point.
+//                      Residuals are reported in metres whatever unit the problem uses.
 //
-//   backbone bench                          # all three cases (a few minutes on one core)
+//   backbone bench                          # all four cases (a few minutes on one core)
 //   backbone bench --case bouncing_bar --out /tmp/bench
 #include <fmt/format.h>
 
@@ -20,17 +27,25 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "continuation/natural.hpp"
 #include "core/errors.hpp"
+#include "core/finite_difference.hpp"
+#include "core/newton.hpp"
+#include "core/periodic_orbit.hpp"
 #include "core/plot.hpp"
+#include "core/rank_report.hpp"
 #include "core/table.hpp"
 #include "drivers/commands.hpp"
 #include "problems/bar/bar.hpp"
+#include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/bouncing_bar.hpp"
+#include "problems/exact_bar/exact_bar_solver.hpp"
 #include "problems/fem_bar/fem.hpp"
 
 namespace {
@@ -55,6 +70,9 @@ class TextTable {
     for (double v : values) row.push_back(fmt::format("{:.17g}", v));
     rows_.push_back(row);
   }
+  // Cells in column order, text or number(...).
+  void add_cells(std::vector<std::string> cells) { rows_.push_back(std::move(cells)); }
+  static std::string number(double v) { return fmt::format("{:.17g}", v); }
   std::string csv() const {
     std::string text = join(columns_) + "\n";
     for (const auto& r : rows_) text += join(r) + "\n";
@@ -537,10 +555,387 @@ int case_mode1_convergence(const fs::path& out) {
   return 0;
 }
 
+// ---------------------------------------------------------------------------------------------
+// formulations: the paper's shooting residual f = u0 - u(T) against the regular half-period
+// velocity residual (DESIGN.md section 3), on the same exact orbits of the contact family.
+
+// End amplitudes (ratio * g0) along each branch, from grazing to E ~ 1e-2 J, the top of the
+// traced range: mode 1 E = (ratio g0)^2 / 2 (5e-3 J at 100), mode 2 E = ((2 ratio + 1) g0)^2 / 2
+// (9.9e-3 J at 70).
+struct FormulationBranch {
+  int mode;
+  std::vector<double> ratios;
+};
+const std::vector<FormulationBranch> formulation_branches{{1, {1.05, 2, 10, 100}},
+                                                          {2, {1.05, 2, 10, 70}}};
+const std::vector<std::pair<std::string, core::ShootingFormulation>> formulation_names{
+    {"regular", core::ShootingFormulation::half_period_velocity},
+    {"paper", core::ShootingFormulation::displacement_periodicity}};
+// The start of both formulations: x* plus start_u0_perturbation g0 sin(3 i) on u0 entry i
+// (a fixed pattern, alternating from node to node) and start_period_perturbation relative on T;
+// the knot stays. 1e-3 g0, not 1e-2: the pattern's strain, 2 * 1e-2 g0 / dx = 0.4 g0 / L, is
+// 40% of the grazing strain g0 / L, and from there both formulations leave the family at
+// A = 1.05 g0 (measured: u0 2% to 7% off x*, the paper's onto a T = 4L/c orbit without contact).
+const double start_u0_perturbation = 1e-3, start_period_perturbation = 1e-3;
+const double formulation_tolerance_metres = 1e-13;  // Newton: ||F||_inf in metres
+const int formulation_max_iterations = 30;
+
+// Metres per unit of the problem's residual, measured rather than assumed (the problem may
+// scale its residual, e.g. by g0): the paper residual of the linear state u0 = -g0 x / (2L) at
+// T = 2L/c is exactly 2 u0 / unit, because every fixed-free linear motion satisfies
+// u(t + 2L/c) = -u(t) and an end amplitude g0/2 never reaches the wall.
+double residual_unit(contact_bar::ContactBarOrbitProblem& problem, const core::Vector& like) {
+  const core::ShootingFormulation kept = problem.formulation();
+  problem.set_formulation(core::ShootingFormulation::displacement_periodicity);
+  const bar::Material& material = problem.setup_template().material;
+  const double gap = problem.setup_template().right.gap;
+  core::Vector x = like;  // keeps the knot, if any
+  const core::Vector y = problem.node_positions(x);
+  const int n = problem.options().elements;
+  for (int i = 0; i < n; ++i) x[i] = -0.5 * gap * y[i] / material.length;
+  x[problem.period_index()] = 2 * material.travel_time();
+  core::Vector r;
+  const bool ok = problem.residual(x, r) == core::EvalStatus::ok;
+  problem.set_formulation(kept);
+  // The last residual entry samples x = L (u0(L) = x[n - 1]) whatever grid the residual uses.
+  return ok && r.size() > 0 ? 2 * x[n - 1] / r[r.size() - 1] : nan;
+}
+
+// Observed convergence of a sequence e_0, e_1, ... (residuals or errors): order = median over
+// k of log(e_{k+1} / e_k) / log(e_k / e_{k-1}) (2: quadratic, 1: linear); ratio = geometric
+// mean of e_{k+1} / e_k (the linear rate). Only the leading values above `floor` (round-off)
+// enter; NaN when too few do.
+struct ObservedRate {
+  double order = nan, ratio = nan;
+};
+ObservedRate observed_rate(const std::vector<double>& e, double floor) {
+  std::size_t used = 0;  // e_0 .. e_{used - 1} are above the floor
+  while (used < e.size() && e[used] > floor) ++used;
+  ObservedRate rate;
+  if (used >= 2) rate.ratio = std::pow(e[used - 1] / e[0], 1.0 / static_cast<double>(used - 1));
+  std::vector<double> orders;
+  for (std::size_t k = 1; k + 1 < used; ++k)
+    orders.push_back(std::log(e[k + 1] / e[k]) / std::log(e[k] / e[k - 1]));
+  if (!orders.empty()) {
+    std::sort(orders.begin(), orders.end());
+    const std::size_t h = orders.size() / 2;
+    rate.order = orders.size() % 2 ? orders[h] : 0.5 * (orders[h - 1] + orders[h]);
+  }
+  return rate;
+}
+
+// max |u0(x) - u0*(x)| / max |u0*| between the piecewise-linear u0 of two points (exact: the
+// difference is piecewise linear, so its maximum sits on a knot of either).
+double relative_u0_distance(const contact_bar::ContactBarOrbitProblem& problem,
+                            const core::Vector& x, const core::Vector& exact) {
+  const bar::PiecewiseLinear a = problem.initial_displacement(x);
+  const bar::PiecewiseLinear b = problem.initial_displacement(exact);
+  double distance = 0, size = 0;
+  for (const bar::PiecewiseLinear* f : {&a, &b})
+    for (double k : f->knots()) distance = std::max(distance, std::abs(a(k) - b(k)));
+  for (double v : b.values()) size = std::max(size, std::abs(v));
+  return distance / size;
+}
+
+// Newton on [F; E - E*] (energy fixed: both formulations aim at x* itself), one iteration per
+// solve() so that every iterate is measured. The eigen corrector keeps no state between calls
+// and applies the same tests after each iteration, so the iterates are those of one solve().
+struct NewtonTrace {
+  core::NewtonStatus status = core::NewtonStatus::max_iterations;
+  int iterations = 0;
+  std::vector<double> shooting_residual;  // ||F||_inf [m] at the start and after each iteration
+  std::vector<double> energy_error;       // |E - E*| [J]
+  std::vector<double> u0_error;           // relative_u0_distance to x*
+  double seconds = 0;
+};
+
+NewtonTrace trace_newton(const contact_bar::ContactBarOrbitProblem& problem,
+                         const core::Vector& exact, double unit, core::Vector& x) {
+  const double energy = problem.energy(exact);
+  const continuation::ParameterConstraintSystem system(
+      problem, continuation::NaturalParameter::of_observable("energy"), energy);
+  core::NewtonOptions options;
+  options.residual_tolerance = formulation_tolerance_metres / unit;  // problem's units
+  options.max_iterations = 1;
+  const auto newton = core::make_corrector("eigen", options);
+  NewtonTrace trace;
+  auto record = [&] {
+    core::Vector r;
+    trace.shooting_residual.push_back(
+        problem.residual(x, r) == core::EvalStatus::ok ? unit * r.lpNorm<Eigen::Infinity>() : nan);
+    trace.energy_error.push_back(std::abs(problem.energy(x) - energy));
+    trace.u0_error.push_back(relative_u0_distance(problem, x, exact));
+  };
+  record();
+  trace.seconds = seconds_of([&] {
+    while (trace.iterations < formulation_max_iterations) {
+      const core::NewtonSummary s = newton->solve(system, x);
+      if (s.iterations == 0) {  // already converged at the start
+        trace.status = s.status;
+        return;
+      }
+      ++trace.iterations;
+      record();
+      if (s.status != core::NewtonStatus::max_iterations) {
+        trace.status = s.status;
+        return;
+      }
+    }
+  });
+  return trace;
+}
+
+// Rank report of the shooting Jacobian (N equations, N + 1 unknowns) as the continuation makes
+// it (continuation/point_recorder.cpp: the problem's forward-difference Jacobian, relative
+// threshold 1e-8, candidate null directions verified by re-correction), and the same with an
+// absolute floor at the measured uncertainty of that Jacobian, ||J_forward - J_central||_2
+// (Weyl: singular values below it cannot be told from zero), and the central-difference
+// Jacobian at the relative threshold (DESIGN.md section 3 and the tests count on it). At the
+// paper's double root the period column is that uncertain: v(., T) jumps at T, so one-sided
+// differences give -v(T+), central ones its mean, zero (rank_report.hpp on absolute_threshold).
+struct RankColumns {
+  core::RankReport relative, absolute, central;  // central: relative threshold, J_central
+  double period_column_forward = nan, period_column_central = nan, uncertainty = nan;
+  double sigma_min(int k) const {  // k-th smallest singular value, 1-based
+    const Eigen::Index m = relative.singular_values.size();
+    return m >= k ? relative.singular_values[m - k] : nan;
+  }
+  double central_sigma_min_relative() const {
+    const Eigen::Index m = central.singular_values.size();
+    return m > 0 ? central.singular_values[m - 1] / central.singular_values[0] : nan;
+  }
+};
+
+RankColumns rank_columns(const core::PeriodicOrbitProblem& problem, const core::Vector& x) {
+  RankColumns c;
+  core::Matrix forward, central;
+  core::FiniteDifferenceOptions central_differences;
+  central_differences.scheme = core::FiniteDifferenceOptions::Scheme::central;
+  if (problem.jacobian(x, forward) != core::EvalStatus::ok ||
+      core::finite_difference_jacobian(problem, x, central, central_differences) !=
+          core::EvalStatus::ok)
+    return c;
+  const int period = problem.period_index();
+  c.period_column_forward = forward.col(period).lpNorm<Eigen::Infinity>();
+  c.period_column_central = central.col(period).lpNorm<Eigen::Infinity>();
+  c.uncertainty = Eigen::JacobiSVD<core::Matrix>(forward - central).singularValues()[0];
+  // The continuation's verifier (continuation/point_recorder.cpp).
+  core::NewtonOptions verifier_options;
+  verifier_options.residual_tolerance = 0.1 * core::VerifyOptions{}.residual_tolerance;
+  verifier_options.max_iterations = 60;
+  const auto verifier = core::make_corrector("eigen", verifier_options);
+  core::RankOptions absolute;
+  absolute.absolute_threshold = c.uncertainty;
+  c.relative = core::rank_report(forward, core::RankOptions{});
+  c.absolute = core::rank_report(forward, absolute);
+  c.central = core::rank_report(central, core::RankOptions{});
+  for (core::RankReport* report : {&c.relative, &c.absolute, &c.central})
+    core::verify_null_directions(problem, x, *verifier, core::VerifyOptions{}, *report);
+  return c;
+}
+
+int case_formulations(const fs::path& out) {
+  const double gap = 1e-3;
+  bar::BarSetup setup;  // paper scene: E = rho = L = A = 1 (c = 1)
+  setup.left = {bar::EndType::fixed, 0};
+  setup.right = {bar::EndType::contact, gap};
+  const contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
+  const exact_bar::ExactBarSolver oracle;
+  fmt::print(
+      "bench formulations: regular (half-period velocity) vs paper (u0 - u(T)) shooting from "
+      "the same perturbed exact orbits\n  TD-BEM event contact, 20 elements, 40 steps per "
+      "period; Newton (eigen) on [F; E - E*], ||F||_inf <= {:g} m, {} iterations\n",
+      formulation_tolerance_metres, formulation_max_iterations);
+
+  // Columns by group: the orbit and the start; the Newton run; where it ended; rank reports.
+  std::vector<std::string> columns;
+  for (const std::vector<std::string>& group :
+       {std::vector<std::string>{"formulation", "status", "mode", "amplitude_ratio", "energy",
+                                 "exact_residual", "exact_sigma_min_relative", "exact_nullity",
+                                 "start_residual", "start_u0_error"},
+        {"iterations", "final_residual", "energy_error", "residual_order", "residual_ratio"},
+        {"u0_error", "error_order", "error_ratio", "period_error", "knot_error", "return_error_u",
+         "return_error_v"},
+        {"period_column_forward", "period_column_central", "jacobian_uncertainty"},
+        {"sigma_min_1", "sigma_min_2", "sigma_min_3", "sigma_max", "threshold", "nullity",
+         "verified"},
+        {"threshold_absolute", "nullity_absolute", "verified_absolute"},
+        {"central_sigma_min_relative", "nullity_central", "verified_central"},
+        {"residual_unit", "seconds"}})
+    columns.insert(columns.end(), group.begin(), group.end());
+  TextTable table(columns);
+  TextTable history({"mode", "amplitude_ratio", "formulation", "iteration", "residual",
+                     "energy_error", "u0_error"});
+  TextTable screen({"mode", "A/g0", "form", "status", "it", "|F| [m]", "order_F", "order_err",
+                    "u0_err", "T_err", "return_err", "smin/smax", "null/ver", "abs", "central",
+                    "x*: smin/smax"});
+  const auto num = TextTable::number;
+  const auto counts = [](const core::RankReport& r) {
+    return fmt::format("{}/{}", r.nullity, r.verified_dimension);
+  };
+
+  for (const FormulationBranch& branch : formulation_branches) {
+    contact_bar::OrbitOptions options;
+    options.elements = 20;
+    options.steps_per_period = 40;
+    options.free_knots = branch.mode == 2 ? 1 : 0;  // mode 2: its crest is a free knot
+    contact_bar::ContactBarOrbitProblem problem(setup, tdbem, options);
+    const int period = problem.period_index();
+    for (double ratio : branch.ratios) {
+      const core::Vector exact = problem.contact_family_guess(branch.mode, ratio);
+      const double energy = problem.energy(exact);
+      const double unit = residual_unit(problem, exact);
+      core::Vector start = exact;
+      for (int i = 0; i < options.elements; ++i)
+        start[i] += start_u0_perturbation * gap * std::sin(3.0 * (i + 1));
+      start[period] *= 1 + start_period_perturbation;
+      double u_max = 0;
+      for (int i = 0; i < options.elements; ++i) u_max = std::max(u_max, std::abs(exact[i]));
+      // Round-off of a residual or error of size u_max after O(steps) operations.
+      const double eps = std::numeric_limits<double>::epsilon();
+      const double residual_floor = 100 * eps * u_max, error_floor = 100 * eps;
+
+      for (const auto& [label, formulation] : formulation_names) {
+        problem.set_formulation(formulation);
+        core::Vector r;
+        const double exact_residual = problem.residual(exact, r) == core::EvalStatus::ok
+                                          ? unit * r.lpNorm<Eigen::Infinity>()
+                                          : nan;
+        // The Jacobian at x* itself (no verification): is the orbit sought a regular root?
+        core::Matrix exact_jacobian;
+        core::RankReport at_exact;
+        if (problem.jacobian(exact, exact_jacobian) == core::EvalStatus::ok)
+          at_exact = core::rank_report(exact_jacobian, core::RankOptions{});
+        const Eigen::Index m = at_exact.singular_values.size();
+        const double exact_sigma_min =
+            m > 0 ? at_exact.singular_values[m - 1] / at_exact.singular_values[0] : nan;
+
+        core::Vector x = start;
+        const NewtonTrace trace = trace_newton(problem, exact, unit, x);
+        const ObservedRate residual_rate = observed_rate(trace.shooting_residual, residual_floor);
+        const ObservedRate error_rate = observed_rate(trace.u0_error, error_floor);
+        const double final_energy = problem.energy(x);
+        const double closed_form_frequency =
+            branch.mode == 1 ? contact_bar::mode1_frequency(setup.material, gap, final_energy)
+                             : contact_bar::mode2_frequency(setup.material, gap, final_energy);
+        const double period_error =
+            std::abs(x[period] * closed_form_frequency / (2 * std::numbers::pi) - 1);
+        const double knot_error =
+            options.free_knots == 1 ? std::abs(x[options.elements] - exact[options.elements]) : nan;
+        const contact_bar::ReturnError returned = contact_bar::return_error(problem, x, oracle);
+        const RankColumns rank = rank_columns(problem, x);
+        const double sigma_max =
+            rank.relative.singular_values.size() ? rank.relative.singular_values[0] : nan;
+        const std::string status = core::to_string(trace.status);
+        table.add_cells({label,
+                         status,
+                         num(branch.mode),
+                         num(ratio),
+                         num(energy),
+                         num(exact_residual),
+                         num(exact_sigma_min),
+                         num(at_exact.nullity),
+                         num(trace.shooting_residual.front()),
+                         num(trace.u0_error.front()),
+                         num(trace.iterations),
+                         num(trace.shooting_residual.back()),
+                         num(trace.energy_error.back()),
+                         num(residual_rate.order),
+                         num(residual_rate.ratio),
+                         num(trace.u0_error.back()),
+                         num(error_rate.order),
+                         num(error_rate.ratio),
+                         num(period_error),
+                         num(knot_error),
+                         num(returned.displacement),
+                         num(returned.velocity),
+                         num(rank.period_column_forward),
+                         num(rank.period_column_central),
+                         num(rank.uncertainty),
+                         num(rank.sigma_min(1)),
+                         num(rank.sigma_min(2)),
+                         num(rank.sigma_min(3)),
+                         num(sigma_max),
+                         num(rank.relative.threshold),
+                         num(rank.relative.nullity),
+                         num(rank.relative.verified_dimension),
+                         num(rank.absolute.threshold),
+                         num(rank.absolute.nullity),
+                         num(rank.absolute.verified_dimension),
+                         num(rank.central_sigma_min_relative()),
+                         num(rank.central.nullity),
+                         num(rank.central.verified_dimension),
+                         num(unit),
+                         num(trace.seconds)});
+        for (std::size_t k = 0; k < trace.shooting_residual.size(); ++k)
+          history.add_cells({num(branch.mode), num(ratio), label, num(static_cast<double>(k)),
+                             num(trace.shooting_residual[k]), num(trace.energy_error[k]),
+                             num(trace.u0_error[k])});
+        screen.add_cells({num(branch.mode), num(ratio), label, status, num(trace.iterations),
+                          num(trace.shooting_residual.back()), num(residual_rate.order),
+                          num(error_rate.order), num(trace.u0_error.back()), num(period_error),
+                          num(returned.worst()), num(rank.sigma_min(1) / sigma_max),
+                          counts(rank.relative), counts(rank.absolute), counts(rank.central),
+                          num(exact_sigma_min)});
+      }
+    }
+  }
+  const fs::path csv = out / "formulations.csv";
+  const fs::path hcsv = out / "formulations_history.csv";
+  table.write(csv);
+  history.write(hcsv);
+  screen.print();
+  fmt::print(
+      "  |F|: final ||F||_inf; order_F, order_err: median observed order of the residual and of "
+      "u0_err = max|u0 - u0*| / max|u0*| (2 quadratic, 1 linear);\n  T_err: |T / T_closed(E) - "
+      "1|; return_err: exact-oracle return error (relative); smin/smax: smallest singular value "
+      "of the forward-difference\n  shooting Jacobian at the final point; null/ver: nullity at "
+      "relative 1e-8 / verified dimension; abs: absolute floor ||J_fwd - J_cen||_2; central: "
+      "J_cen;\n  x*: smin/smax at the exact orbit\n");
+
+  // Residual and u0 error vs iteration: one column per mode, colour per amplitude, dash per
+  // formulation. The error is the comparable measure: the two residuals differ by definition.
+  const std::string q = core::gnuplot_quote(hcsv);
+  std::string panels;
+  for (const auto& [column, label] : {std::pair{5, "shooting residual ||F||_{/Symbol \\245}  [m]"},
+                                      std::pair{7, "u_0 error max|u_0 - u_0^*| / max|u_0^*|"}})
+    for (const FormulationBranch& branch : formulation_branches) {
+      panels += fmt::format("set title 'mode {}'\nset ylabel '{}'\nplot ", branch.mode, label);
+      for (std::size_t k = 0; k < branch.ratios.size(); ++k)
+        for (std::size_t f = 0; f < formulation_names.size(); ++f)
+          panels += fmt::format(
+              "{}{} using (($1 == {} && abs($2 - {:.17g}) < 1e-9 && strcol(3) eq '{}') ? $4 "
+              ": NaN):(${} > 0 ? ${} : NaN) with linespoints lc {} dt {} pt {} title '{}, A = "
+              "{:g} g_0'",
+              k + f ? ", " : "", q, branch.mode, branch.ratios[k], formulation_names[f].first,
+              column, column, k + 1, f + 1, f ? 6 : 7, formulation_names[f].first,
+              branch.ratios[k]);
+      if (column == 5)
+        panels += fmt::format(", {:g} title 'tolerance' dt 2 lw 2 lc rgb 'black'",
+                              formulation_tolerance_metres);
+      panels += "\n";
+    }
+  const fs::path png = out / "formulations.png";
+  report_plot(
+      core::render_png(png,
+                       fmt::format("set multiplot layout 2,2 title 'Newton from the same "
+                                   "perturbed exact orbit at fixed energy: regular "
+                                   "(solid) vs paper (dashed), g_0 = {:g} m'\nset "
+                                   "logscale y\nset grid\nset format y '10^{{%L}}'\n"
+                                   "set xlabel 'Newton iteration'\nset key outside right top "
+                                   "font ',8'\n",
+                                   gap) +
+                           panels + "unset multiplot\n",
+                       {1600, 1300}),
+      png);
+  return 0;
+}
+
 int run_bench(const std::vector<std::string>& args) {
   po::options_description keys("backbone bench");
-  keys.add_options()("case", po::value<std::string>(),
-                     "tdbem_scaling | bouncing_bar | mode1_convergence (default: all)")(
+  keys.add_options()(
+      "case", po::value<std::string>(),
+      "tdbem_scaling | bouncing_bar | mode1_convergence | formulations (default: all)")(
       "out", po::value<std::string>()->default_value("results/bench"), "output directory")(
       "help", "describe the command");
   po::variables_map vm;
@@ -559,12 +954,13 @@ int run_bench(const std::vector<std::string>& args) {
   const std::vector<std::pair<std::string, std::function<int(const fs::path&)>>> cases{
       {"tdbem_scaling", case_tdbem_scaling},
       {"bouncing_bar", case_bouncing_bar},
-      {"mode1_convergence", case_mode1_convergence}};
+      {"mode1_convergence", case_mode1_convergence},
+      {"formulations", case_formulations}};
   std::string selected = vm.count("case") ? vm["case"].as<std::string>() : "";
   if (!selected.empty() &&
       std::none_of(cases.begin(), cases.end(), [&](const auto& c) { return c.first == selected; }))
     throw core::InputError("case", fmt::format("must be one of tdbem_scaling, bouncing_bar, "
-                                               "mode1_convergence (got '{}')",
+                                               "mode1_convergence, formulations (got '{}')",
                                                selected));
   const fs::path out = vm["out"].as<std::string>();
   int status = 0;
@@ -579,5 +975,5 @@ int run_bench(const std::vector<std::string>& args) {
 }  // namespace
 
 static const bool registered = backbone::drivers::register_command(
-    {"bench", "[--case tdbem_scaling|bouncing_bar|mode1_convergence] [--out DIR]",
+    {"bench", "[--case tdbem_scaling|bouncing_bar|mode1_convergence|formulations] [--out DIR]",
      "benchmarks with known answers (CSV + PNG in results/bench)", run_bench});
