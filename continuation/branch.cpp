@@ -36,7 +36,7 @@ core::Table branch_table(const Branch& branch) {
     for (const auto& [key, value] : branch.points.front().observables) names.push_back(key);
   std::vector<std::string> columns{"point"};
   columns.insert(columns.end(), names.begin(), names.end());
-  for (const char* c : {"dimension", "nullity", "residual", "newton_iterations", "step_size",
+  for (const char* c : {"dimension", "nullity", "sigma_zero", "sigma_kept", "residual", "newton_iterations", "step_size",
                         "arclength", "seconds", "jacobian_evaluations", "residual_evaluations"})
     columns.push_back(c);
   core::Table table(columns);
@@ -45,6 +45,19 @@ core::Table branch_table(const Branch& branch) {
     for (const std::string& n : names) row.push_back(p.observable(n));
     row.push_back(p.dimension);
     row.push_back(p.rank ? p.rank->nullity : -1);
+    // sigma_zero: largest singular value counted as zero, sigma_kept: smallest one kept, both
+    // relative to the largest (NaN when there is none or the rank was not checked): how far
+    // the rank decision is from its threshold on either side.
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    double zero = nan, kept = nan;
+    if (p.rank && p.rank->singular_values.size() > 0 && p.rank->singular_values[0] > 0) {
+      const auto& sv = p.rank->singular_values;
+      const Eigen::Index rank = static_cast<Eigen::Index>(p.x.size()) - p.rank->nullity;
+      if (rank < sv.size()) zero = sv[rank] / sv[0];
+      if (rank >= 1 && rank - 1 < sv.size()) kept = sv[rank - 1] / sv[0];
+    }
+    row.push_back(zero);
+    row.push_back(kept);
     row.push_back(p.residual);
     row.push_back(p.newton_iterations);
     row.push_back(p.step_size);

@@ -69,6 +69,9 @@ po::options_description continuation_keys(const po::options_description& problem
       "NAME:MIN:MAX, stop when observable NAME leaves [MIN, MAX] (empty = unbounded; repeatable)");
   add("rank_check_every", po::value<long>()->default_value(1),
       "verified rank report every k points (0: never)");
+  add("rank_threshold", po::value<double>()->default_value(1e-8),
+      "rank report: singular values below this times the largest count as zero (candidates; "
+      "verify then keeps only the real directions)");
   add("verify", po::value<bool>()->default_value(true),
       "re-correct along candidate null directions (verified dimension)");
   add("newton_tolerance", po::value<double>()->default_value(1e-10), "||F||_inf to converge");
@@ -100,6 +103,10 @@ cont::ContinuationOptions read_options(const core::Scene& scene) {
   o.max_points = static_cast<int>(scene.integer("max_points", 1));
   o.rank_check_every = static_cast<int>(scene.integer("rank_check_every", 0));
   o.verify = scene.flag("verify");
+  o.rank.relative_threshold = scene.positive("rank_threshold");
+  if (!(o.rank.relative_threshold < 1))
+    throw core::InputError("rank_threshold",
+                           fmt::format("must be in (0, 1) (got {})", o.rank.relative_threshold));
   for (const char* name : {"energy", "period"}) {
     const double lo = scene.values()[std::string(name) + "_min"].as<double>();
     const double hi = scene.values()[std::string(name) + "_max"].as<double>();
