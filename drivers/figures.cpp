@@ -1,13 +1,18 @@
 // `backbone figures`: the paper's figures of the contact-bar modes, drawn from the outputs of
 // `backbone trace` (branch.csv, orbits.csv of mode1 and mode2):
 //   backbones.png        frequency-energy backbones, log energy axis, linear modes and the
-//                        mode-1 asymptote 2 pi c / (3L) as vertical lines, closed form of mode 1
+//                        asymptotes 2 pi c / (3L) (mode 1) and 8 pi c / (5L) (mode 2) as
+//                        vertical lines, closed forms of both modes
 //   mode1_contact.png    contacting-end displacement and contact force over one period of a
 //                        mode-1 orbit (TD-BEM and the exact oracle)
 //   mode1_spacetime.png, mode2_spacetime.png
 //                        u(x, t) over one period (TD-BEM), mode 2 marking the point of the
 //                        bar that stays closest to zero displacement
-// with the CSV behind each figure beside it.
+// with the CSV behind each figure beside it, and
+//   closed_form_summary.csv
+//                        one row per traced contact-bar branch found in OUT/*/ (its
+//                        closed_form_check.csv): points, energy range, worst closed-form
+//                        frequency error and exact-oracle return errors, point seconds
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -21,6 +26,7 @@
 #include "core/scene.hpp"
 #include "core/table.hpp"
 #include "drivers/commands.hpp"
+#include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
@@ -91,15 +97,19 @@ void backbones_figure(const fs::path& out, const bar::BarSetup& s, const fs::pat
     if (fs::exists(dir / "branch.csv"))
       for (double e : Table::read_csv(dir / "branch.csv").column("energy"))
         e_max = std::max(e_max, e);
-  // Closed form of mode 1 (DESIGN.md section 1), from grazing upwards.
-  Table closed({"energy", "frequency"});
-  const double e_graze = EA * g0 * g0 / (2 * L);
-  for (int i = 0; i <= 400; ++i) {
-    const double e = e_graze * std::pow(e_max / e_graze, i / 400.0);
-    closed.add_row({e, 2 * pi * c / (3 * L + g0 * std::sqrt(EA * L / (2 * e)))});
+  // Closed forms of modes 1 (DESIGN.md section 1) and 2 (periodic_bar.cpp), from grazing up.
+  for (int mode : {1, 2}) {
+    Table closed({"energy", "frequency"});
+    const double e_graze = EA * std::pow((2 * mode - 1) * g0, 2) / (2 * L);
+    for (int i = 0; i <= 400; ++i) {
+      const double e = e_graze * std::pow(e_max / e_graze, i / 400.0) * (1 + 1e-12);
+      closed.add_row({e, mode == 1 ? contact_bar::mode1_frequency(s.material, g0, e)
+                                   : contact_bar::mode2_frequency(s.material, g0, e)});
+    }
+    closed.write_csv(out / fmt::format("backbone_mode{}_closed_form.csv", mode));
   }
-  closed.write_csv(out / "backbone_mode1_closed_form.csv");
   const double w1 = pi * c / (2 * L), w2 = 3 * pi * c / (2 * L), w_inf = 2 * pi * c / (3 * L);
+  const double w2_inf = 8 * pi * c / (5 * L);  // mode 2: T -> 5L / (4c)
   std::string plot = fmt::format(
       "set title 'Backbones of the contact bar (g_0 = {} m, c = {} m/s, L = {} m)'\n"
       "set xlabel 'frequency {{/Symbol w}} [rad/s]'\nset ylabel 'energy E [J]'\n"
@@ -108,13 +118,18 @@ void backbones_figure(const fs::path& out, const bar::BarSetup& s, const fs::pat
       "set arrow from {},graph 0 to {},graph 1 nohead lc rgb 'gray40' dt 2\n"
       "set arrow from {},graph 0 to {},graph 1 nohead lc rgb 'gray40' dt 2\n"
       "set arrow from {},graph 0 to {},graph 1 nohead lc rgb 'dark-red' dt 3\n"
+      "set arrow from {},graph 0 to {},graph 1 nohead lc rgb 'dark-red' dt 3\n"
+      "set label '8{{/Symbol p}}c/(5L)' at {},graph 0.95 rotate by 90 right font ',9'\n"
       "set label 'linear mode 1' at {},graph 0.95 rotate by 90 right font ',9'\n"
       "set label 'linear mode 2' at {},graph 0.95 rotate by 90 right font ',9'\n"
       "set label '2{{/Symbol p}}c/(3L)' at {},graph 0.95 rotate by 90 right font ',9'\n"
       "plot {} using 'frequency':'energy' with lines lw 2 lc rgb 'black' title 'mode 1, closed "
-      "form'",
-      g0, c, L, 0.9 * w1, 1.1 * w2, w1, w1, w2, w2, w_inf, w_inf, w1 - 0.02 * w1, w2 - 0.02 * w1,
-      w_inf - 0.02 * w1, backbone::core::gnuplot_quote(out / "backbone_mode1_closed_form.csv"));
+      "form', {} using 'frequency':'energy' with lines lw 2 lc rgb 'gray50' title 'mode 2, "
+      "closed form'",
+      g0, c, L, 0.9 * w1, 1.1 * w2_inf, w1, w1, w2, w2, w_inf, w_inf, w2_inf, w2_inf,
+      w2_inf - 0.02 * w1, w1 - 0.02 * w1, w2 - 0.02 * w1, w_inf - 0.02 * w1,
+      backbone::core::gnuplot_quote(out / "backbone_mode1_closed_form.csv"),
+      backbone::core::gnuplot_quote(out / "backbone_mode2_closed_form.csv"));
   if (fs::exists(mode1 / "branch.csv"))
     plot += fmt::format(
         ", {} using 'frequency':'energy' with points pt 7 ps 0.6 lc rgb 'blue' "
@@ -221,6 +236,42 @@ void spacetime_figure(const fs::path& out, const std::string& name, bar::BarSetu
   report(backbone::core::render_png(png, plot, {1100, 800}), png);
 }
 
+// closed_form_summary.csv: the acceptance numbers of every branch in one table.
+void closed_form_summary(const fs::path& out) {
+  std::vector<fs::path> dirs;
+  for (const auto& entry : fs::directory_iterator(out))
+    if (entry.is_directory() && fs::exists(entry.path() / "closed_form_check.csv") &&
+        fs::exists(entry.path() / "branch.csv"))
+      dirs.push_back(entry.path());
+  std::sort(dirs.begin(), dirs.end());
+  // The first column is a name, so the CSV is written as text (same atomic rule as Table).
+  std::string csv =
+      "branch,points,energy_first,energy_last,worst_relative_error,worst_return_error_u,"
+      "worst_return_error_v,point_seconds\n";
+  for (const fs::path& dir : dirs) {
+    const Table check = Table::read_csv(dir / "closed_form_check.csv");
+    const Table branch = Table::read_csv(dir / "branch.csv");
+    const auto energy = check.column("energy");
+    if (energy.empty()) continue;
+    const auto worst = [&](const char* name) {
+      const auto v = check.column(name);
+      return *std::max_element(v.begin(), v.end());
+    };
+    double seconds = 0;
+    for (double t : branch.column("seconds")) seconds += t;
+    const std::string name = dir.filename().string();
+    csv += fmt::format("{},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n", name,
+                       energy.size(), energy.front(), energy.back(), worst("relative_error"),
+                       worst("return_error_u"), worst("return_error_v"), seconds);
+    fmt::print("[figures] {}: {} points, E {:.3g} .. {:.3g}, worst closed-form error {:.2e}, "
+               "return error {:.2e}, {:.2f} s\n",
+               name, energy.size(), energy.front(), energy.back(), worst("relative_error"),
+               worst("return_error_u"), seconds);
+  }
+  if (dirs.empty()) return;
+  backbone::core::write_text_atomically(out / "closed_form_summary.csv", csv);
+}
+
 int run_figures(const std::vector<std::string>& args) {
   po::options_description keys(
       "backbone figures [--out DIR] [--scene INI] [--mode1 DIR] [--mode2 DIR]");
@@ -274,8 +325,10 @@ int run_figures(const std::vector<std::string>& args) {
   }
   if (load_orbit(mode2, energy, setup.material.length, orbit))
     spacetime_figure(out, "mode2", setup, orbit, dt, elements, true);
+  closed_form_summary(out);
   return 0;
 }
+
 
 }  // namespace
 

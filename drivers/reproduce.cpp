@@ -38,6 +38,16 @@ std::vector<Step> plan(const std::string& out, bool quick) {
        {"problems/duffing/scenes/duffing.ini", "--branch", "backbone", "--out", out + "/duffing"}},
       {"mode1", "trace", {contact + "paper.ini", "--branch", "mode1", "--out", out + "/mode1"}},
       {"mode2", "trace", {contact + "paper.ini", "--branch", "mode2", "--out", out + "/mode2"}},
+      // Other scenes, nothing but the bar changed: the closed forms must hold there too.
+      {"mode1_short_bar",
+       "trace",
+       {contact + "paper.ini", "--branch", "mode1", "--length", "0.3", "--youngs_modulus", "7e4",
+        "--density", "2.7", "--gap", "1e-5", "--out", out + "/mode1_short_bar"}},
+      {"mode2_steel_bar",
+       "trace",
+       {contact + "paper.ini", "--branch", "mode2", "--length", "2.5", "--youngs_modulus",
+        "2.1e11", "--density", "7850", "--area", "3e-4", "--gap", "1e-4", "--energy_max", "1e3",
+        "--out", out + "/mode2_steel_bar"}},
       {"figures", "figures", {"--out", out}},
   };
   if (!quick) steps.push_back({"bench", "bench", {"--out", out + "/bench"}});
@@ -58,7 +68,8 @@ int run_reproduce(const std::vector<std::string>& args) {
     throw backbone::core::InputError("", e.what());
   }
   if (vm.count("help")) {
-    fmt::print("{}\nsteps: bouncing_bar mode1_orbit duffing mode1 mode2 figures bench\n",
+    fmt::print("{}\nsteps: bouncing_bar mode1_orbit duffing mode1 mode2 mode1_short_bar mode2_steel_bar "
+               "figures bench\n",
                fmt::streamed(keys));
     return 0;
   }
