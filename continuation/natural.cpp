@@ -89,14 +89,8 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
                const NaturalParameter& parameter, core::Corrector& corrector,
                const ContinuationOptions& options, const ContinuationHooks& hooks) {
   options.validate();
-  check_sizes(problem, guess, core::Vector());
+  check_sizes(problem, guess, core::Vector(), "natural continuation in one parameter");
   const int n = problem.num_unknowns();
-  const int m = problem.num_equations();
-  if (m < n - 1)
-    throw core::InputError("method", fmt::format("natural continuation in one parameter needs at "
-                                                 "least n - 1 equations for n unknowns ({} "
-                                                 "unknowns vs {} equations)",
-                                                 n, m));
   if (parameter.kind == NaturalParameter::Kind::unknown &&
       (parameter.index < 0 || parameter.index >= n))
     throw core::InputError("natural_parameter", fmt::format("unknown index {} out of range [0, {})",

@@ -90,8 +90,13 @@ std::string describe_point(const core::Vector& x) {
 }
 
 void check_sizes(const core::Problem& problem, const core::Vector& guess,
-                 const core::Vector& direction) {
+                 const core::Vector& direction, const char* what) {
   const int n = problem.num_unknowns();
+  const int m = problem.num_equations();
+  if (m < n - 1)
+    throw core::InputError("method", fmt::format("{}: it needs at least n - 1 equations for n "
+                                                 "unknowns ({} unknowns vs {} equations)",
+                                                 what, n, m));
   if (guess.size() != n)
     throw core::InputError("guess", fmt::format("dimensions of the guess and the unknowns do not "
                                                 "match ({} vs {})",

@@ -53,9 +53,11 @@ class PointRecorder {
 // "x = (0.5, 6.1)" for messages (at most 4 entries shown).
 std::string describe_point(const core::Vector& x);
 
-// Throws InputError unless guess (and direction, when non-empty) have num_unknowns entries.
+// Throws InputError unless guess (and direction, when non-empty) have num_unknowns entries
+// and the problem has at least n - 1 equations for its n unknowns (a curve; `what` names the
+// method in the message).
 void check_sizes(const core::Problem& problem, const core::Vector& guess,
-                 const core::Vector& direction);
+                 const core::Vector& direction, const char* what);
 
 // Step-size rule of both loops: grow after a fast correction, shrink after a slow one, within
 // [ds_min, ds_max].

@@ -222,14 +222,8 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
                         const core::Vector& direction, core::Corrector& corrector,
                         const ContinuationOptions& options, const ContinuationHooks& hooks) {
   options.validate();
-  check_sizes(problem, guess, direction);
+  check_sizes(problem, guess, direction, "pseudo-arclength follows curves");
   const int n = problem.num_unknowns();
-  const int m = problem.num_equations();
-  if (m < n - 1)
-    throw core::InputError("method", fmt::format("pseudo-arclength follows curves: it needs at "
-                                                 "least n - 1 equations for n unknowns ({} "
-                                                 "unknowns vs {} equations)",
-                                                 n, m));
   const core::Vector hint = direction.size() ? direction : core::Vector::Unit(n, n - 1);
   if (!(hint.norm() > 0) || !hint.allFinite())
     throw core::InputError("direction", "must be a finite non-zero vector");
