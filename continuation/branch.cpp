@@ -36,8 +36,9 @@ core::Table branch_table(const Branch& branch) {
     for (const auto& [key, value] : branch.points.front().observables) names.push_back(key);
   std::vector<std::string> columns{"point"};
   columns.insert(columns.end(), names.begin(), names.end());
-  for (const char* c : {"dimension", "nullity", "sigma_zero", "sigma_kept", "residual", "newton_iterations", "step_size",
-                        "arclength", "seconds", "jacobian_evaluations", "residual_evaluations"})
+  for (const char* c :
+       {"dimension", "nullity", "sigma_zero", "sigma_kept", "residual", "newton_iterations",
+        "step_size", "arclength", "seconds", "jacobian_evaluations", "residual_evaluations"})
     columns.push_back(c);
   core::Table table(columns);
   for (const BranchPoint& p : branch.points) {

@@ -67,8 +67,8 @@ struct Branch {
 
 // Columns: point, then every observable by name (in the order of the first point), then
 // dimension, nullity (candidate, -1 when unchecked), sigma_zero and sigma_kept (largest
-// singular value counted as zero and smallest kept, relative to the largest), residual, newton_iterations, step_size,
-// arclength, seconds, jacobian_evaluations, residual_evaluations.
+// singular value counted as zero and smallest kept, relative to the largest), residual,
+// newton_iterations, step_size, arclength, seconds, jacobian_evaluations, residual_evaluations.
 core::Table branch_table(const Branch& branch);
 
 }  // namespace backbone::continuation

@@ -153,7 +153,8 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
     core::Vector y;
     double step = 0;
     const CorrectedStep corrected = correct_with_shrinking(
-        ds, index, options, hooks, y, [&](double ds_try, core::Vector& predicted) {
+        ds, index, options, hooks, y,
+        [&](double ds_try, core::Vector& predicted) {
           step = parameter.direction * ds_try;
           predicted = x + step * rate;
           system.set_value(lambda + step);

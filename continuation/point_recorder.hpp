@@ -79,7 +79,6 @@ struct CorrectedStep {
   core::NewtonSummary summary;  // of the last try
   core::NewtonStatus last_failure = core::NewtonStatus::converged;
   std::string last_message;
-  int rejections = 0;  // converged corrections refused by hooks.reject_point
 };
 
 template <class Attempt, class ToUnknowns>  // NewtonSummary attempt(double ds, Vector& y);
@@ -95,10 +94,7 @@ CorrectedStep correct_with_shrinking(double ds, int index, const ContinuationOpt
     std::string rejection;
     if (r.accepted && hooks.reject_point) {
       rejection = hooks.reject_point(unknowns(y));
-      if (!rejection.empty()) {
-        r.accepted = false;
-        ++r.rejections;
-      }
+      r.accepted = rejection.empty();
     }
     if (hooks.on_attempt) hooks.on_attempt({index, r.ds, r.accepted, r.summary, rejection});
     if (r.accepted) return r;

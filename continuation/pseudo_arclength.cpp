@@ -106,9 +106,10 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
     }
     if (!rejection.empty()) {
       branch.reason = StopReason::newton_failed;
-      branch.message = fmt::format("the starting guess converged to a point the check rejects "
-                                   "({}): {}",
-                                   describe(x), rejection);
+      branch.message = fmt::format(
+          "the starting guess converged to a point the check rejects "
+          "({}): {}",
+          describe(x), rejection);
       return branch;
     }
     branch.points.push_back(recorder.finish(x, 0, s.iterations, 0.0, 0.0, true));
@@ -142,7 +143,8 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
     }
     core::Vector y;
     const CorrectedStep corrected = correct_with_shrinking(
-        ds, index, options, hooks, y, [&](double ds_try, core::Vector& predicted) {
+        ds, index, options, hooks, y,
+        [&](double ds_try, core::Vector& predicted) {
           predicted = x + ds_try * step_direction;
           const ArclengthSystem system(problem, x, step_direction, ds_try);
           return corrector.solve(system, predicted);
@@ -238,9 +240,8 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
       q.x = scaled.to_unknowns(p.x);
       hooks.on_point(q);
     };
-  Branch branch =
-      arclength_loop(scaled, scaled.to_scaled(guess), scaled.to_scaled(hint), corrector, options,
-                     inner);
+  Branch branch = arclength_loop(scaled, scaled.to_scaled(guess), scaled.to_scaled(hint), corrector,
+                                 options, inner);
   for (BranchPoint& p : branch.points) p.x = scaled.to_unknowns(p.x);
   return branch;
 }

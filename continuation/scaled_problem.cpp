@@ -14,9 +14,8 @@ ScaledProblem::ScaledProblem(const core::Problem& base)
 ScaledProblem::ScaledProblem(const core::Problem& base, core::Vector scale)
     : base_(base), scale_(std::move(scale)) {
   if (scale_.size() != base.num_unknowns())
-    throw core::InputError("typical_scale",
-                           fmt::format("has {} entries for {} unknowns", scale_.size(),
-                                       base.num_unknowns()));
+    throw core::InputError("typical_scale", fmt::format("has {} entries for {} unknowns",
+                                                        scale_.size(), base.num_unknowns()));
   for (Eigen::Index i = 0; i < scale_.size(); ++i)
     if (!std::isfinite(scale_[i]) || !(scale_[i] > 0))
       throw core::InputError("typical_scale",

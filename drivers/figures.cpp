@@ -263,10 +263,11 @@ void closed_form_summary(const fs::path& out) {
     csv += fmt::format("{},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n", name,
                        energy.size(), energy.front(), energy.back(), worst("relative_error"),
                        worst("return_error_u"), worst("return_error_v"), seconds);
-    fmt::print("[figures] {}: {} points, E {:.3g} .. {:.3g}, worst closed-form error {:.2e}, "
-               "return error {:.2e}, {:.2f} s\n",
-               name, energy.size(), energy.front(), energy.back(), worst("relative_error"),
-               worst("return_error_u"), seconds);
+    fmt::print(
+        "[figures] {}: {} points, E {:.3g} .. {:.3g}, worst closed-form error {:.2e}, "
+        "return error {:.2e}, {:.2f} s\n",
+        name, energy.size(), energy.front(), energy.back(), worst("relative_error"),
+        worst("return_error_u"), seconds);
   }
   if (dirs.empty()) return;
   backbone::core::write_text_atomically(out / "closed_form_summary.csv", csv);
@@ -328,7 +329,6 @@ int run_figures(const std::vector<std::string>& args) {
   closed_form_summary(out);
   return 0;
 }
-
 
 }  // namespace
 

@@ -45,9 +45,9 @@ std::vector<Step> plan(const std::string& out, bool quick) {
         "--density", "2.7", "--gap", "1e-5", "--out", out + "/mode1_short_bar"}},
       {"mode2_steel_bar",
        "trace",
-       {contact + "paper.ini", "--branch", "mode2", "--length", "2.5", "--youngs_modulus",
-        "2.1e11", "--density", "7850", "--area", "3e-4", "--gap", "1e-4", "--energy_max", "1e3",
-        "--out", out + "/mode2_steel_bar"}},
+       {contact + "paper.ini", "--branch", "mode2", "--length", "2.5", "--youngs_modulus", "2.1e11",
+        "--density", "7850", "--area", "3e-4", "--gap", "1e-4", "--energy_max", "1e3", "--out",
+        out + "/mode2_steel_bar"}},
       {"figures", "figures", {"--out", out}},
   };
   if (!quick) steps.push_back({"bench", "bench", {"--out", out + "/bench"}});
@@ -68,9 +68,10 @@ int run_reproduce(const std::vector<std::string>& args) {
     throw backbone::core::InputError("", e.what());
   }
   if (vm.count("help")) {
-    fmt::print("{}\nsteps: bouncing_bar mode1_orbit duffing mode1 mode2 mode1_short_bar mode2_steel_bar "
-               "figures bench\n",
-               fmt::streamed(keys));
+    fmt::print(
+        "{}\nsteps: bouncing_bar mode1_orbit duffing mode1 mode2 mode1_short_bar mode2_steel_bar "
+        "figures bench\n",
+        fmt::streamed(keys));
     return 0;
   }
   const std::string out = vm["out"].as<std::string>();

@@ -303,9 +303,9 @@ int run_trace(const std::vector<std::string>& args) {
       "problem {}\nbranch {}\nequations {}\nunknowns {}\nexpected_dimension {}\nmethod {}\n"
       "newton {}\nformulation {}\npoints {}\nrejected_corrections {}\nstop_reason {}\n"
       "message {}\n",
-      problem_name, branch_name, m, n, expected_dimension, cont::to_string(options.method), corrector->name(),
-      periodic ? core::to_string(formulation) : "-", branch.points.size(), rejected,
-      cont::to_string(branch.reason), branch.message);
+      problem_name, branch_name, m, n, expected_dimension, cont::to_string(options.method),
+      corrector->name(), periodic ? core::to_string(formulation) : "-", branch.points.size(),
+      rejected, cont::to_string(branch.reason), branch.message);
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
   if (branch.points.empty()) {
     core::write_text_atomically(out / "summary.txt", summary);

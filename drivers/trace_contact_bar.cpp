@@ -36,8 +36,9 @@ po::options_description orbit_scene_keys() {
   shooting.add_options()  //
       ("shooting_elements", po::value<long>()->default_value(20),
        "intervals of the u0 grid (0: the scene's elements). 20 holds modes 1 and 2 exactly "
-       "(mode 2 with its free knot); at 100 the projected half-period residual has spurious "
-       "roots near the branch (measured) and costs 5x more")  //
+       "(mode 2 with its free knot); at 100 mode 1 meets a continuum of other periodic orbits "
+       "at end amplitude 2 g0 and follows it (measured; no branch-point detection yet), at "
+       "~100x the cost per point")  //
       ("test_elements", po::value<long>()->default_value(-1),
        "elements of the grid the residual is sampled on (its equations): 0 = as many as "
        "unknowns (square), -1 = auto (2x the unknowns: overdetermined, consistent, no "
@@ -64,7 +65,7 @@ po::options_description orbit_scene_keys() {
        "sigma_kept): the forward-difference Jacobian's null value reaches 2.8e-6 (kinks of "
        "the contact map), the smallest kept one is 5.6e-5; verify decides")  //
       ("ds", po::value<double>()->default_value(2.0),
-       "first step, dimensionless: Euclidean in u0 / gap, knot / L and T c / L")  //
+       "first step, dimensionless: Euclidean in u0 / gap, knot / L and T c / L")           //
       ("ds_max", po::value<double>()->default_value(2.0), "largest step (dimensionless)")  //
       ("newton_tolerance", po::value<double>()->default_value(1e-10),
        "||F||_inf to converge; F is in units of the gap, so this is relative to g0")  //
@@ -116,16 +117,17 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
   const contact_bar::ContactBarOrbitProblem* p = problem.get();
   const double return_tolerance = scene.non_negative("return_tolerance");
   if (return_tolerance > 0) {
-    // Exact oracle on a grid 4x finer than the residual's test functions: a spurious root of
-    // the N projected equations is not a root of these.
+    // Exact oracle sampled on 4x as many intervals as unknowns (finer than the default test
+    // grid): a spurious root of the projected equations is not a root of these.
     const int check_elements = 4 * p->state_size();
     s.reject_point = [p, return_tolerance, check_elements](const core::Vector& x) {
       const exact_bar::ExactBarSolver oracle;
       const contact_bar::ReturnError e = contact_bar::return_error(*p, x, oracle, check_elements);
       if (e.worst() <= return_tolerance) return std::string();
-      return fmt::format("exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
-                         "return_tolerance {:g}",
-                         e.displacement, e.velocity, return_tolerance);
+      return fmt::format(
+          "exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
+          "return_tolerance {:g}",
+          e.displacement, e.velocity, return_tolerance);
     };
   }
   const bar::Material material = setup.material;

@@ -13,7 +13,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) { return cli::scratch("simulate_cli", name); }
+fs::path scratch(const std::string& name) {
+  return cli::scratch("simulate_cli", name);
+}
 
 cli::Run simulate(const std::string& arguments, const fs::path& out) {
   return cli::run("simulate", arguments, out);

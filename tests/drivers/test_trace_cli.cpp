@@ -40,8 +40,9 @@ TEST(TraceCli, BadInputExitsTwoAndWritesNothing) {
 TEST(TraceCli, OtherSceneModeOneMatchesTheClosedForm) {
   const fs::path out = cli::scratch("trace_cli", "short_bar");
   const cli::Run r = cli::run("trace",
-                              paper + " --branch mode1 --length 0.3 --youngs_modulus 7e4 "
-                                      "--density 2.7 --gap 1e-5 --energy_max 1e-3",
+                              paper +
+                                  " --branch mode1 --length 0.3 --youngs_modulus 7e4 "
+                                  "--density 2.7 --gap 1e-5 --energy_max 1e-3",
                               out);
   ASSERT_EQ(r.code, 0) << r.err;
   const auto check = backbone::core::Table::read_csv(out / "closed_form_check.csv");
