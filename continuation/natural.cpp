@@ -104,6 +104,15 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
         "natural_parameter",
         fmt::format("the problem reports no finite observable '{}' at the guess", parameter.name));
 
+  // ds is dimensionless like pseudo-arclength's when the parameter is an unknown and unknowns
+  // are scaled: a step of ds moves it by ds * typical_scale. An observable steps in its units.
+  const double unit = options.scale_unknowns && parameter.kind == NaturalParameter::Kind::unknown
+                          ? std::abs(problem.typical_scale()[parameter.index])
+                          : 1.0;
+  if (!(unit > 0) || !std::isfinite(unit))
+    throw core::InputError("typical_scale", fmt::format("entry {} must be finite and > 0 (got {})",
+                                                        parameter.index, unit));
+
   Branch branch;
   PointRecorder recorder(problem, options);
   ParameterConstraintSystem system(problem, parameter, lambda0);
@@ -144,8 +153,10 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
     } else if (options.predictor == Predictor::tangent) {
       core::Matrix J;
       if (system.jacobian(x, J) == core::EvalStatus::ok) {
-        core::Vector rhs = core::Vector::Zero(n);
-        rhs[n - 1] = 1.0;
+        // dF/dx . rate = 0, dp/dx . rate = 1: the last of J's rows (m + 1 >= n of them; least
+        // squares when the system is overdetermined).
+        core::Vector rhs = core::Vector::Zero(J.rows());
+        rhs[J.rows() - 1] = 1.0;
         core::Vector candidate = J.colPivHouseholderQr().solve(rhs);
         if (candidate.allFinite()) rate = candidate;
       }
@@ -155,7 +166,7 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
     const CorrectedStep corrected = correct_with_shrinking(
         ds, index, options, hooks, y,
         [&](double ds_try, core::Vector& predicted) {
-          step = parameter.direction * ds_try;
+          step = parameter.direction * ds_try * unit;
           predicted = x + step * rate;
           system.set_value(lambda + step);
           return corrector.solve(system, predicted);

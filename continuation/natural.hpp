@@ -5,7 +5,10 @@
 // system [F(x); p(x) - lambda] = 0 (ParameterConstraintSystem, itself a core::Problem) at
 // lambda_k = lambda_0 + direction * sum of steps, from a secant or tangent predictor. It cannot
 // pass a fold in p: there Newton fails, ds shrinks to ds_min and the branch ends with
-// StopReason::step_floor, keeping the points computed so far. The loop prints nothing.
+// StopReason::step_floor, keeping the points computed so far (switching.hpp then hands over to
+// pseudo-arclength). With options.scale_unknowns an unknown parameter steps by
+// ds * typical_scale (ds dimensionless, as in pseudo-arclength); an observable steps in its own
+// units. The loop prints nothing.
 //
 //   auto newton = core::make_corrector("eigen", core::NewtonOptions{});
 //   ContinuationOptions opt; opt.method = Method::natural; opt.ds = 0.05; opt.max_points = 20;

@@ -9,7 +9,15 @@
 namespace backbone::continuation {
 
 const char* to_string(Method m) {
-  return m == Method::natural ? "natural" : "arclength";
+  switch (m) {
+    case Method::natural:
+      return "natural";
+    case Method::arclength:
+      return "arclength";
+    case Method::natural_then_arclength:
+      return "natural_then_arclength";
+  }
+  return "?";
 }
 const char* to_string(Predictor p) {
   return p == Predictor::secant ? "secant" : "tangent";
@@ -18,7 +26,10 @@ const char* to_string(Predictor p) {
 Method parse_method(const std::string& name) {
   if (name == "natural") return Method::natural;
   if (name == "arclength" || name == "pseudo_arclength" || name == "palc") return Method::arclength;
-  throw core::InputError("method", fmt::format("must be natural or arclength (got '{}')", name));
+  if (name == "natural_then_arclength") return Method::natural_then_arclength;
+  throw core::InputError("method", fmt::format("must be natural, arclength or "
+                                               "natural_then_arclength (got '{}')",
+                                               name));
 }
 
 Predictor parse_predictor(const std::string& name) {

@@ -8,7 +8,7 @@
 // is then re-corrected onto the bound itself. Pseudo-arclength distances (ds, arclength) are
 // Euclidean in the unknowns divided by the problem's typical_scale() (scale_unknowns, the
 // default: dimensionless, so one ds fits every scene of a problem); natural continuation steps
-// the parameter itself, in its own units.
+// an unknown parameter by ds times its typical scale, an observable in its own units.
 //
 //   ContinuationOptions opt;
 //   opt.ds = 0.01; opt.ds_max = 0.5; opt.max_points = 200;
@@ -25,7 +25,8 @@
 
 namespace backbone::continuation {
 
-enum class Method { natural, arclength };
+// natural_then_arclength: natural until it stalls, then pseudo-arclength (switching.hpp).
+enum class Method { natural, arclength, natural_then_arclength };
 enum class Predictor { secant, tangent };
 const char* to_string(Method m);
 const char* to_string(Predictor p);
@@ -51,7 +52,8 @@ struct ContinuationOptions {
   double grow_factor = 1.5;    // > 1
   double shrink_factor = 0.5;  // in (0, 1); also used after a failed correction
   int max_points = 100;        // including the first (corrected guess)
-  // Pseudo-arclength in z = x ./ typical_scale() (see scaled_problem.hpp); false: raw unknowns.
+  // Pseudo-arclength in z = x ./ typical_scale() (see scaled_problem.hpp), natural steps of an
+  // unknown in units of its typical scale; false: raw unknowns.
   bool scale_unknowns = true;
   std::vector<Bound> bounds;
   bool land_on_bounds = true;  // re-correct the crossing point onto the bound

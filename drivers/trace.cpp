@@ -17,6 +17,7 @@
 
 #include "continuation/natural.hpp"
 #include "continuation/pseudo_arclength.hpp"
+#include "continuation/switching.hpp"
 #include "core/errors.hpp"
 #include "core/periodic_orbit.hpp"
 #include "core/plot.hpp"
@@ -52,7 +53,8 @@ po::options_description continuation_keys(const po::options_description& problem
   };
   const double inf = std::numeric_limits<double>::infinity();
   add("method", po::value<std::string>()->default_value("arclength"),
-      "arclength (pseudo-arclength, passes folds) or natural");
+      "arclength (pseudo-arclength, passes folds), natural, or natural_then_arclength "
+      "(natural until it stalls, then arclength: the paper's strategy)");
   add("predictor", po::value<std::string>()->default_value("tangent"), "tangent or secant");
   add("newton", po::value<std::string>()->default_value("eigen"), "corrector: eigen or kinsol");
   add("formulation", po::value<std::string>()->default_value("regular"),
@@ -287,6 +289,7 @@ int run_trace(const std::vector<std::string>& args) {
   };
 
   cont::Branch branch;
+  int switch_index = -1;
   if (options.method == cont::Method::arclength) {
     branch = cont::pseudo_arclength(problem, setup.guess, direction, *corrector, options, hooks);
   } else {
@@ -296,16 +299,23 @@ int run_trace(const std::vector<std::string>& args) {
             ? cont::NaturalParameter::of_unknown(periodic->period_index(), "period",
                                                  static_cast<double>(natural_direction))
             : cont::NaturalParameter::of_observable(name, static_cast<double>(natural_direction));
-    branch = cont::natural(problem, setup.guess, parameter, *corrector, options, hooks);
+    if (options.method == cont::Method::natural) {
+      branch = cont::natural(problem, setup.guess, parameter, *corrector, options, hooks);
+    } else {
+      cont::SwitchingBranch s =
+          cont::natural_then_arclength(problem, setup.guess, parameter, *corrector, options, hooks);
+      branch = std::move(s.branch);
+      switch_index = s.switch_index;
+    }
   }
 
   std::string summary = fmt::format(
       "problem {}\nbranch {}\nequations {}\nunknowns {}\nexpected_dimension {}\nmethod {}\n"
-      "newton {}\nformulation {}\npoints {}\nrejected_corrections {}\nstop_reason {}\n"
-      "message {}\n",
+      "newton {}\nformulation {}\npoints {}\nrejected_corrections {}\nswitch_index {}\n"
+      "stop_reason {}\nmessage {}\n",
       problem_name, branch_name, m, n, expected_dimension, cont::to_string(options.method),
       corrector->name(), periodic ? core::to_string(formulation) : "-", branch.points.size(),
-      rejected, cont::to_string(branch.reason), branch.message);
+      rejected, switch_index, cont::to_string(branch.reason), branch.message);
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
   if (branch.points.empty()) {
     core::write_text_atomically(out / "summary.txt", summary);

@@ -7,6 +7,7 @@
 
 #include "continuation/natural.hpp"
 #include "continuation/pseudo_arclength.hpp"
+#include "continuation/switching.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
 
@@ -284,4 +285,54 @@ TEST(PseudoArclength, ConsistentOverdeterminedSystemIsACurve) {
   const Branch k = continuation::pseudo_arclength(doubled, vec(1, 0), vec(0, 1), *kinsol, quick(5));
   EXPECT_EQ(k.reason, StopReason::newton_failed);
   EXPECT_NE(k.message.find("square"), std::string::npos) << k.message;
+}
+
+// The paper's strategy on x^2 + lambda = 1: natural in lambda stalls at the fold lambda = 1,
+// pseudo-arclength takes over from there and goes round it; one branch, numbering and
+// arclength continuous, every point on the curve, x increasing throughout (no turning back).
+TEST(NaturalThenArclength, PassesTheFoldWhereNaturalStalls) {
+  algebraic::FoldCurve fold;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(60);
+  opt.ds_min = 1e-4;
+  std::vector<int> reported;
+  continuation::ContinuationHooks hooks;
+  hooks.on_point = [&](const continuation::BranchPoint& p) { reported.push_back(p.index); };
+  const continuation::SwitchingBranch s = continuation::natural_then_arclength(
+      fold, vec(-1.5, -1.25), continuation::NaturalParameter::of_unknown(1, "lambda"), *newton, opt,
+      hooks);
+  const Branch& b = s.branch;
+  ASSERT_GT(s.switch_index, 5) << b.message;
+  EXPECT_EQ(b.reason, StopReason::max_points) << b.message;
+  ASSERT_EQ(b.points.size(), 60u);
+  ASSERT_EQ(reported.size(), 60u);  // the restart point is not reported twice
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    const auto& p = b.points[i];
+    EXPECT_EQ(p.index, static_cast<int>(i));
+    EXPECT_EQ(reported[i], static_cast<int>(i));
+    EXPECT_NEAR(p.x[0] * p.x[0] + p.x[1], 1.0, 1e-9) << i;  // Newton tolerance 1e-10
+    if (i > 0) {
+      EXPECT_GT(p.x[0], b.points[i - 1].x[0]) << i;
+      EXPECT_GT(p.arclength, b.points[i - 1].arclength) << i;
+    }
+  }
+  EXPECT_GT(b.points.back().x[0], 0.0);  // past the fold at x = 0
+  EXPECT_NE(b.message.find("pseudo-arclength from point"), std::string::npos) << b.message;
+}
+
+// Natural continuation of the consistent overdetermined circle (2 equations of rank 1): the
+// tangent predictor solves the bordered system of m + 1 = 3 rows by least squares (it once
+// assumed n rows and wrote past the right-hand side).
+TEST(Natural, ConsistentOverdeterminedSystem) {
+  DoubledCircle doubled;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(15);
+  opt.ds = opt.ds_max = 0.05;
+  const Branch b = continuation::natural(
+      doubled, vec(1, 0), continuation::NaturalParameter::of_unknown(1, "y"), *newton, opt);
+  ASSERT_EQ(b.points.size(), 15u) << b.message;
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    EXPECT_NEAR(b.points[i].x.norm(), 1.0, 1e-10) << i;
+    EXPECT_NEAR(b.points[i].x[1], 0.05 * static_cast<double>(i), 1e-12) << i;  // y = i ds
+  }
 }
