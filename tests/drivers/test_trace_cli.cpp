@@ -56,4 +56,24 @@ TEST(TraceCli, OtherSceneModeOneMatchesTheClosedForm) {
   fs::remove_all(out);
 }
 
+// Natural continuation in the period, the paper's parameter, on the oversampled residual (the
+// bordered predictor once overran its right-hand side there and aborted): T falls from 3.95
+// towards 3 L/c, each point on the closed form (acceptance 1e-5; measured 2e-13).
+TEST(TraceCli, NaturalInThePeriodFollowsModeOne) {
+  const fs::path out = cli::scratch("trace_cli", "natural");
+  const cli::Run r = cli::run("trace",
+                              paper + " --branch mode1 --method natural_then_arclength "
+                                      "--natural_direction -1 --ds 0.05 --ds_max 0.05 "
+                                      "--energy_max 1e-4",
+                              out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto check = backbone::core::Table::read_csv(out / "closed_form_check.csv");
+  const auto errors = check.column("relative_error");
+  ASSERT_GE(errors.size(), 10u);
+  EXPECT_LE(*std::max_element(errors.begin(), errors.end()), 1e-8);
+  const auto period = backbone::core::Table::read_csv(out / "branch.csv").column("period");
+  for (std::size_t i = 1; i < period.size(); ++i) EXPECT_LT(period[i], period[i - 1]) << i;
+  fs::remove_all(out);
+}
+
 }  // namespace
