@@ -42,7 +42,7 @@ SwitchingBranch natural_then_arclength(const core::Problem& problem, const core:
       hooks.on_attempt(b);
     };
   Branch tail = pseudo_arclength(problem, last.x, secant, corrector, rest, inner);
-  result.switch_index = count;
+  if (tail.points.size() > 1) result.switch_index = count;  // its point 0 is our last one
   for (BranchPoint& p : tail.points) {
     if (p.index == 0) continue;
     p.index += count - 1;

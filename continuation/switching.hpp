@@ -25,7 +25,7 @@ namespace backbone::continuation {
 
 struct SwitchingBranch {
   Branch branch;
-  int switch_index = -1;  // first point computed by pseudo-arclength; -1 when no switch
+  int switch_index = -1;  // first point computed by pseudo-arclength; -1 when none was
 };
 
 // Throws core::InputError like natural() and pseudo_arclength(). Never throws on numerical
