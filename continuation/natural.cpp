@@ -139,11 +139,7 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
   core::Vector previous = x;
   double previous_step = 0;
   while (static_cast<int>(branch.points.size()) < options.max_points) {
-    if (hooks.cancel_requested && hooks.cancel_requested()) {
-      branch.reason = StopReason::cancelled;
-      branch.message = fmt::format("cancelled after {} points", branch.points.size());
-      return branch;
-    }
+    if (cancelled(hooks, branch)) return branch;
     const int index = static_cast<int>(branch.points.size());
     recorder.begin();
     // dx/dlambda for the predictor: tangent of the curve scaled so that dp = 1, or the secant.
@@ -205,9 +201,7 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
     lambda += step;
     ds = adapted_step(ds, s.iterations, options);
   }
-  branch.reason = StopReason::max_points;
-  branch.message = fmt::format("{} points computed", branch.points.size());
-  return branch;
+  return reached_max_points(std::move(branch));
 }
 
 }  // namespace backbone::continuation

@@ -81,6 +81,19 @@ const Bound* PointRecorder::violated_bound(const BranchPoint& point, double& val
   return nullptr;
 }
 
+bool cancelled(const ContinuationHooks& hooks, Branch& branch) {
+  if (!hooks.cancel_requested || !hooks.cancel_requested()) return false;
+  branch.reason = StopReason::cancelled;
+  branch.message = fmt::format("cancelled after {} points", branch.points.size());
+  return true;
+}
+
+Branch reached_max_points(Branch branch) {
+  branch.reason = StopReason::max_points;
+  branch.message = fmt::format("{} points computed", branch.points.size());
+  return branch;
+}
+
 std::string describe_point(const core::Vector& x) {
   std::string s = "x = (";
   for (Eigen::Index i = 0; i < x.size() && i < 4; ++i)

@@ -59,6 +59,12 @@ std::string describe_point(const core::Vector& x);
 void check_sizes(const core::Problem& problem, const core::Vector& guess,
                  const core::Vector& direction, const char* what);
 
+// Polls hooks.cancel_requested; when it answers true, ends the branch as cancelled (reason and
+// message set) and returns true.
+bool cancelled(const ContinuationHooks& hooks, Branch& branch);
+// The branch ended because it has options.max_points points: sets reason and message.
+Branch reached_max_points(Branch branch);
+
 // Step-size rule of both loops: grow after a fast correction, shrink after a slow one, within
 // [ds_min, ds_max].
 inline double adapted_step(double ds, int newton_iterations, const ContinuationOptions& options) {

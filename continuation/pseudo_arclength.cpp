@@ -128,11 +128,7 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
   core::Vector previous = x;
   bool have_previous = false;
   while (static_cast<int>(branch.points.size()) < options.max_points) {
-    if (hooks.cancel_requested && hooks.cancel_requested()) {
-      branch.reason = StopReason::cancelled;
-      branch.message = fmt::format("cancelled after {} points", branch.points.size());
-      return branch;
-    }
+    if (cancelled(hooks, branch)) return branch;
     const int index = static_cast<int>(branch.points.size());
     recorder.begin();
     // Predictor direction: the secant through the last two points, or the tangent.
@@ -213,9 +209,7 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
     tangent = next_tangent;
     ds = adapted_step(ds, s.iterations, options);
   }
-  branch.reason = StopReason::max_points;
-  branch.message = fmt::format("{} points computed", branch.points.size());
-  return branch;
+  return reached_max_points(std::move(branch));
 }
 
 }  // namespace
