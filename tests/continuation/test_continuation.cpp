@@ -336,3 +336,25 @@ TEST(Natural, ConsistentOverdeterminedSystem) {
     EXPECT_NEAR(b.points[i].x[1], 0.05 * static_cast<double>(i), 1e-12) << i;  // y = i ds
   }
 }
+
+// A cancel request is polled before each step: both loops end with StopReason::cancelled and
+// keep the points made so far.
+TEST(Continuation, CancelRequestEndsBothLoopsKeepingThePoints) {
+  algebraic::Circle circle;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  int points = 0;
+  continuation::ContinuationHooks hooks;
+  hooks.on_point = [&](const continuation::BranchPoint&) { ++points; };
+  hooks.cancel_requested = [&] { return points >= 5; };
+  const Branch a =
+      continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, quick(50), hooks);
+  EXPECT_EQ(a.reason, StopReason::cancelled) << a.message;
+  EXPECT_EQ(a.points.size(), 5u);
+  points = 0;
+  const Branch b =
+      continuation::natural(circle, vec(1, 0), continuation::NaturalParameter::of_unknown(1, "y"),
+                            *newton, quick(50), hooks);
+  EXPECT_EQ(b.reason, StopReason::cancelled) << b.message;
+  EXPECT_EQ(b.points.size(), 5u);
+  EXPECT_NE(b.message.find("cancelled after 5 points"), std::string::npos) << b.message;
+}
