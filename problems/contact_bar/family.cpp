@@ -1,0 +1,68 @@
+#include "problems/contact_bar/family.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/errors.hpp"
+
+namespace backbone::contact_bar {
+
+ContactFamily::ContactFamily(const bar::Material& material, double gap, int mode)
+    : material_(material), gap_(gap), mode_(mode) {
+  if (mode != 1 && mode != 2)
+    throw core::InputError("mode", fmt::format("the contact family is known in closed form for "
+                                               "modes 1 and 2 (got {})",
+                                               mode));
+  if (!(gap > 0) || !std::isfinite(gap))
+    throw core::InputError("gap", fmt::format("the contact family needs a gap > 0 (got {})", gap));
+}
+
+double ContactFamily::slope(double energy) const {
+  return std::sqrt(2 * energy / (material_.axial_stiffness() * material_.length));
+}
+
+double ContactFamily::grazing_energy() const {
+  const double g = (2 * mode_ - 1) * gap_;  // mode 2 grazes when s L = 3 g0
+  return material_.axial_stiffness() * g * g / (2 * material_.length);
+}
+
+double ContactFamily::period(double energy) const {
+  const double length = material_.length, s = slope(energy);
+  if (!(s * length >= (2 * mode_ - 1) * gap_)) return std::nan("");
+  if (mode_ == 1) return (3 * length + gap_ / s) / material_.wave_speed();
+  return (5 * length + gap_ / s) / (4 * material_.wave_speed());
+}
+
+double ContactFamily::frequency(double energy) const {
+  return 2 * std::numbers::pi / period(energy);
+}
+
+double ContactFamily::linear_frequency() const {
+  return (2 * mode_ - 1) * std::numbers::pi * material_.wave_speed() / (2 * material_.length);
+}
+
+double ContactFamily::asymptotic_frequency() const {
+  const double c = material_.wave_speed(), length = material_.length;
+  return mode_ == 1 ? 2 * std::numbers::pi * c / (3 * length)
+                    : 8 * std::numbers::pi * c / (5 * length);
+}
+
+double ContactFamily::node(double energy) const {
+  const double s = slope(energy), length = material_.length;
+  if (mode_ == 1 || !(s * length >= 3 * gap_)) return std::nan("");
+  const double b = 0.25 * (1 + gap_ / (s * length));
+  return 2 * b * length;
+}
+
+double node_of(const bar::PiecewiseLinear& u0) {
+  const auto& xs = u0.knots();
+  const auto& ys = u0.values();
+  for (std::size_t i = 2; i < xs.size(); ++i)
+    if ((ys[i - 1] > 0 && ys[i] <= 0) || (ys[i - 1] < 0 && ys[i] >= 0))
+      return xs[i - 1] + (xs[i] - xs[i - 1]) * ys[i - 1] / (ys[i - 1] - ys[i]);
+  return std::nan("");
+}
+
+}  // namespace backbone::contact_bar

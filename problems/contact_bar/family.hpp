@@ -1,0 +1,57 @@
+// The contact family of the bar: closed forms of its nonlinear modes 1 and 2, in one place.
+//
+// Every report, figure and benchmark that compares a traced branch with the exact answer asks
+// this class (problems/contact_bar/README.md, sections "Exact mode 1" and "Exact mode 2"):
+//   mode 1: u0 = eps x, T = (3L + g0/|eps|)/c, grazing at E = EA g0^2 / (2L),
+//           omega -> 2 pi c / (3L) as E grows;
+//   mode 2: a tent of slopes +-s with its crest at bL, b = (1 + g0/(sL))/4,
+//           T = (5L + g0/s) / (4c), grazing at E = EA (3 g0)^2 / (2L), omega -> 8 pi c / (5L);
+//           u0 changes sign at x = 2bL, the mode's node (the quasi-node of the space-time
+//           figure: the point that moves least).
+// with s = |eps| = sqrt(2E / (EA L)). Frequencies are NaN below grazing.
+//
+//   ContactFamily mode1(setup.material, setup.right.gap, 1);
+//   double w = mode1.frequency(1e-3);                 // closed form at E = 1e-3 J
+//   double err = std::abs(point_frequency / w - 1);
+//   double e0 = mode1.grazing_energy();               // EA g0^2 / (2L)
+//   ContactFamily mode2(setup.material, gap, 2);
+//   double x_node = mode2.node(1e-3);                 // 2 b L
+//   double x_num = node_of(orbit_u0);                 // where a traced u0 changes sign
+#pragma once
+
+#include "problems/bar/bar.hpp"
+
+namespace backbone::contact_bar {
+
+class ContactFamily {
+ public:
+  // mode: 1 or 2 (InputError "mode" otherwise); gap > 0 (InputError "gap").
+  ContactFamily(const bar::Material& material, double gap, int mode);
+
+  int mode() const { return mode_; }
+  // Strain magnitude s = sqrt(2E / (EA L)) of the orbit of energy E.
+  double slope(double energy) const;
+  // Energy at which the family grazes the wall (contact duration -> 0).
+  double grazing_energy() const;
+  // Closed-form period and frequency 2 pi / T at energy E; NaN below grazing.
+  double period(double energy) const;
+  double frequency(double energy) const;
+  // Linear mode (2k - 1) pi c / (2L), where the family is born, and the limit as E -> inf.
+  double linear_frequency() const;
+  double asymptotic_frequency() const;
+  // Mode 2: position 2bL where u0 changes sign (NaN for mode 1, which has no interior node,
+  // and below grazing).
+  double node(double energy) const;
+
+ private:
+  bar::Material material_;
+  double gap_;
+  int mode_;
+};
+
+// Where a piecewise-linear u0 first changes sign from + to - (or - to +) inside (0, L),
+// linearly interpolated; NaN when it does not. The numerical counterpart of
+// ContactFamily::node.
+double node_of(const bar::PiecewiseLinear& u0);
+
+}  // namespace backbone::contact_bar
