@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -22,6 +23,23 @@ std::ifstream open_scene(const std::string& ini_path) {
   std::ifstream in(ini_path);
   if (!in) throw InputError("scene", fmt::format("cannot read scene file '{}'", ini_path));
   return in;
+}
+
+// "--gap -1" would read "-1" as an option: glue a negative number to its key.
+std::vector<std::string> glue_negative_values(const std::vector<std::string>& words) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    const std::string& w = words[i];
+    if (w.rfind("--", 0) == 0 && w.find('=') == std::string::npos && i + 1 < words.size() &&
+        words[i + 1].size() > 1 && words[i + 1][0] == '-' &&
+        (std::isdigit(static_cast<unsigned char>(words[i + 1][1])) || words[i + 1][1] == '.')) {
+      out.push_back(w + "=" + words[i + 1]);
+      ++i;
+    } else {
+      out.push_back(w);
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -78,7 +96,9 @@ std::string Scene::choice(const std::string& key,
   throw InputError(key, fmt::format("must be one of {} (got '{}')", list, v));
 }
 
-bool Scene::flag(const std::string& key) const { return has(key) && values_[key].as<bool>(); }
+bool Scene::flag(const std::string& key) const {
+  return has(key) && values_[key].as<bool>();
+}
 
 Scene read_scene(const po::options_description& scene_keys, const std::string& ini_path,
                  const std::vector<std::string>& arguments,
@@ -93,11 +113,13 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
   cli_keys.add(file_keys).add(driver_keys);
   try {
     // Command line first: po::store keeps the first value it sees, so the command line wins.
-    std::vector<std::string> words = arguments;
-    po::store(po::command_line_parser(words).options(cli_keys).style(
-                  po::command_line_style::unix_style ^ po::command_line_style::allow_guessing)
-                  .run(),
-              vm);
+    std::vector<std::string> words = glue_negative_values(arguments);
+    po::store(
+        po::command_line_parser(words)
+            .options(cli_keys)
+            .style(po::command_line_style::unix_style ^ po::command_line_style::allow_guessing)
+            .run(),
+        vm);
   } catch (const po::error& e) {
     rethrow_as_input_error(e, "command line");
   }
@@ -120,7 +142,7 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
 std::string scene_problem_name(const std::string& ini_path) {
   std::ifstream in = open_scene(ini_path);
   po::options_description keys;
-  keys.add_options()("problem", po::value<std::string>()->default_value("contact_bar"), "");
+  keys.add_options()("problem", po::value<std::string>()->default_value(""), "");
   po::variables_map vm;
   try {
     po::store(po::parse_config_file(in, keys, /*allow_unregistered=*/true), vm);

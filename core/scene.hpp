@@ -3,10 +3,11 @@
 // A problem declares its keys (with defaults and a one-line description giving the unit) in a
 // boost::program_options::options_description. read_scene parses the INI file against exactly
 // those keys and then the command-line overrides (`--key value`) against those keys plus the
-// driver's own options. Unknown keys, unreadable files, malformed or non-finite numbers are
-// InputErrors naming the key: the CLI turns them into one line on stderr and exit code 2.
-// Keys are flat (no INI sections) so that every key reads the same in the file and on the
-// command line. The key `problem` names the problem the scene is for (default contact_bar).
+// driver's own options (`--gap -1` reads -1 as the value). Unknown keys, unreadable files,
+// malformed or non-finite numbers are InputErrors naming the key: the CLI turns them into one line
+// on stderr and exit code 2. Keys are flat (no INI sections) so that every key reads the same in
+// the file and on the command line. The key `problem` names the problem the scene is for (no
+// default: core knows no problem; the CLI says which are known when it is missing).
 //
 //   namespace po = boost::program_options;
 //   po::options_description keys("contact bar");
@@ -32,9 +33,9 @@ class Scene {
 
   bool has(const std::string& key) const { return values_.count(key) > 0; }
   // Typed, validated accessors. Each throws InputError(key, constraint) on violation.
-  double number(const std::string& key) const;        // finite
-  double positive(const std::string& key) const;      // finite and > 0
-  double non_negative(const std::string& key) const;  // finite and >= 0
+  double number(const std::string& key) const;                 // finite
+  double positive(const std::string& key) const;               // finite and > 0
+  double non_negative(const std::string& key) const;           // finite and >= 0
   long integer(const std::string& key, long min_value) const;  // integral and >= min_value
   std::string text(const std::string& key) const;
   std::string choice(const std::string& key, std::initializer_list<const char*> allowed) const;
@@ -55,7 +56,7 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
                  const std::vector<std::string>& arguments,
                  const po::options_description& driver_keys);
 
-// The value of the `problem` key of an INI file ("contact_bar" when absent), read before the
+// The value of the `problem` key of an INI file (empty when absent), read before the
 // problem's keys are known. Throws InputError when the file cannot be read.
 std::string scene_problem_name(const std::string& ini_path);
 

@@ -8,7 +8,8 @@
 //   // drivers/simulate.cpp
 //   namespace { int run_simulate(const std::vector<std::string>& args) { ...; return 0; } }
 //   static const bool registered = backbone::drivers::register_command(
-//       {"simulate", "SCENE [--method tdbem|fem|exact] [--out DIR]", "time simulation", run_simulate});
+//       {"simulate", "SCENE [--method tdbem|fem|exact] [--out DIR]", "time simulation",
+//       run_simulate});
 #pragma once
 
 #include <functional>

@@ -27,7 +27,9 @@ bool register_command(Command command) {
   return registry().emplace(name, std::move(command)).second;
 }
 
-const std::map<std::string, Command>& commands() { return registry(); }
+const std::map<std::string, Command>& commands() {
+  return registry();
+}
 
 }  // namespace backbone::drivers
 

@@ -1,5 +1,6 @@
 // `backbone reproduce`: the main job. Runs every study whose figures and tables belong in
-// results/, by calling the other subcommands exactly as a user would, and writes a summary
+// results/ (each plugin's ProblemPlugin::reproduce steps, continuation/plugin.hpp), by calling
+// the other subcommands exactly as a user would, and writes a summary
 // of what ran, how long it took and whether it succeeded (results/reproduce.csv).
 #include <fmt/format.h>
 #include <fmt/ostream.h>
@@ -11,46 +12,27 @@
 #include "core/scene.hpp"
 #include "core/table.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/plugins.hpp"
 
 namespace {
 
 namespace po = boost::program_options;
 using backbone::drivers::commands;
 
-struct Step {
-  std::string name;
-  std::string command;
-  std::vector<std::string> args;
-};
+using backbone::continuation::ReproduceStep;
 
-std::vector<Step> plan(const std::string& out, bool quick) {
-  const std::string contact = "problems/contact_bar/scenes/";
-  std::vector<Step> steps{
-      {"bouncing_bar",
-       "simulate",
-       {contact + "bouncing_bar.ini", "--compare", "--periods", "2", "--out",
-        out + "/bouncing_bar"}},
-      {"mode1_orbit",
-       "simulate",
-       {contact + "paper.ini", "--compare", "--periods", "1", "--out", out + "/mode1_orbit"}},
-      {"duffing",
-       "trace",
-       {"problems/duffing/scenes/duffing.ini", "--branch", "backbone", "--out", out + "/duffing"}},
-      {"mode1", "trace", {contact + "paper.ini", "--branch", "mode1", "--out", out + "/mode1"}},
-      {"mode2", "trace", {contact + "paper.ini", "--branch", "mode2", "--out", out + "/mode2"}},
-      // Other scenes, nothing but the bar changed: the closed forms must hold there too.
-      {"mode1_short_bar",
-       "trace",
-       {contact + "paper.ini", "--branch", "mode1", "--length", "0.3", "--youngs_modulus", "7e4",
-        "--density", "2.7", "--gap", "1e-5", "--out", out + "/mode1_short_bar"}},
-      {"mode2_steel_bar",
-       "trace",
-       {contact + "paper.ini", "--branch", "mode2", "--length", "2.5", "--youngs_modulus", "2.1e11",
-        "--density", "7850", "--area", "3e-4", "--gap", "1e-4", "--energy_max", "1e3", "--out",
-        out + "/mode2_steel_bar"}},
-      {"figures", "figures", {"--out", out}},
-  };
-  if (!quick) steps.push_back({"bench", "bench", {"--out", out + "/bench"}});
+// Every plugin's steps, in registration order, with "{out}" replaced by the output folder.
+std::vector<ReproduceStep> plan(const std::string& out, bool quick) {
+  std::vector<ReproduceStep> steps;
+  for (const auto& plugin : backbone::drivers::plugins().all())
+    for (ReproduceStep step : plugin.reproduce) {
+      if (quick && step.command == "bench") continue;
+      for (std::string& word : step.arguments)
+        for (auto at = word.find("{out}"); at != std::string::npos;
+             at = word.find("{out}", at + out.size()))
+          word.replace(at, 5, out);
+      steps.push_back(std::move(step));
+    }
   return steps;
 }
 
@@ -68,17 +50,16 @@ int run_reproduce(const std::vector<std::string>& args) {
     throw backbone::core::InputError("", e.what());
   }
   if (vm.count("help")) {
-    fmt::print(
-        "{}\nsteps: bouncing_bar mode1_orbit duffing mode1 mode2 mode1_short_bar mode2_steel_bar "
-        "figures bench\n",
-        fmt::streamed(keys));
+    std::string names;
+    for (const ReproduceStep& s : plan("OUT", false)) names += " " + s.name;
+    fmt::print("{}\nsteps:{}\n", fmt::streamed(keys), names);
     return 0;
   }
   const std::string out = vm["out"].as<std::string>();
-  std::vector<Step> steps = plan(out, vm["quick"].as<bool>());
+  std::vector<ReproduceStep> steps = plan(out, vm["quick"].as<bool>());
   if (vm.count("only")) {
     const std::string only = vm["only"].as<std::string>();
-    std::erase_if(steps, [&](const Step& s) { return s.name != only; });
+    std::erase_if(steps, [&](const ReproduceStep& s) { return s.name != only; });
     if (steps.empty())
       throw backbone::core::InputError("only", fmt::format("no step named '{}'", only));
   }
@@ -86,9 +67,9 @@ int run_reproduce(const std::vector<std::string>& args) {
   backbone::core::Table summary({"step", "exit_code", "seconds"});
   std::vector<std::string> failed;
   for (std::size_t i = 0; i < steps.size(); ++i) {
-    const Step& s = steps[i];
+    const ReproduceStep& s = steps[i];
     fmt::print("[reproduce {}/{}] {}: backbone {} {}\n", i + 1, steps.size(), s.name, s.command,
-               fmt::join(s.args, " "));
+               fmt::join(s.arguments, " "));
     std::fflush(stdout);
     const auto start = std::chrono::steady_clock::now();
     int rc = 0;
@@ -99,7 +80,7 @@ int run_reproduce(const std::vector<std::string>& args) {
       rc = 1;
     } else {
       try {
-        rc = it->second.run(s.args);
+        rc = it->second.run(s.arguments);
       } catch (const std::exception& e) {
         fmt::print(stderr, "[reproduce] {}: {}\n", s.name, e.what());
         rc = dynamic_cast<const backbone::core::InputError*>(&e) ? 2 : 1;

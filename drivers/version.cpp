@@ -1,17 +1,17 @@
 // `backbone version`: prints the version and the libraries it was built with.
 #include <fmt/format.h>
+#include <sundials/sundials_config.h>
 
 #include <Eigen/Core>
 #include <boost/version.hpp>
-#include <sundials/sundials_config.h>
 
 #include "drivers/commands.hpp"
 
 namespace {
 int run_version(const std::vector<std::string>&) {
-  fmt::print("backbone 0.1.0 (Eigen {}.{}.{}, SUNDIALS {}, Boost {}, fmt {})\n", EIGEN_WORLD_VERSION,
-             EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, SUNDIALS_VERSION, BOOST_LIB_VERSION,
-             FMT_VERSION);
+  fmt::print("backbone 0.1.0 (Eigen {}.{}.{}, SUNDIALS {}, Boost {}, fmt {})\n",
+             EIGEN_WORLD_VERSION, EIGEN_MAJOR_VERSION, EIGEN_MINOR_VERSION, SUNDIALS_VERSION,
+             BOOST_LIB_VERSION, FMT_VERSION);
   return 0;
 }
 }  // namespace

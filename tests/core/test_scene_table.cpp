@@ -101,7 +101,7 @@ TEST_F(SceneTest, MissingFileIsAnInputError) {
 TEST_F(SceneTest, ProblemNameIsReadBeforeTheKeysAreKnown) {
   EXPECT_EQ(scene_problem_name(write("a.ini", "problem = duffing\nalpha = 1\n").string()),
             "duffing");
-  EXPECT_EQ(scene_problem_name(write("b.ini", "gap = 1\n").string()), "contact_bar");
+  EXPECT_EQ(scene_problem_name(write("b.ini", "gap = 1\n").string()), "");  // core knows no default
 }
 
 using TableTest = TempDir;

@@ -47,8 +47,17 @@ TEST(SimulateCli, BadInputExitsTwoAndWritesNothing) {
 
 TEST(SimulateCli, UnknownKeyInSceneFile) {
   const fs::path ini = scratch("unknown.ini");
-  std::ofstream(ini) << "length = 1\nlenght = 2\n";
+  std::ofstream(ini) << "problem = contact_bar\nlength = 1\nlenght = 2\n";
   expect_bad_input(ini.string(), "lenght");
+}
+
+TEST(SimulateCli, SceneWithoutProblemNamesTheKnownOnes) {
+  // core knows no default problem: a scene must say which one it is for.
+  const fs::path ini = scratch("no_problem.ini");
+  std::ofstream(ini) << "length = 1\n";
+  expect_bad_input(ini.string(), "problem");
+  const cli::Run r = cli::run("simulate", ini.string(), scratch("no_problem_out"));
+  EXPECT_NE(r.err.find("known: contact_bar"), std::string::npos) << r.err;
 }
 
 TEST(SimulateCli, PaperSceneWritesHistory) {

@@ -74,10 +74,10 @@ TEST(ContactFamily, GrazingAndLimits) {
   // Far above grazing the frequencies approach 2 pi c/(3L) and 8 pi c/(5L): exactly
   // omega_inf / omega = 1 + (g0/s)/(3L) (mode 1) and 1 + (g0/s)/(5L) (mode 2).
   for (double e : {1e2, 1e6}) {
-    EXPECT_NEAR(mode1.asymptotic_frequency() / mode1.frequency(e),
-                1 + gap / mode1.slope(e) / 3, 1e-14);
-    EXPECT_NEAR(mode2.asymptotic_frequency() / mode2.frequency(e),
-                1 + gap / mode2.slope(e) / 5, 1e-14);
+    EXPECT_NEAR(mode1.asymptotic_frequency() / mode1.frequency(e), 1 + gap / mode1.slope(e) / 3,
+                1e-14);
+    EXPECT_NEAR(mode2.asymptotic_frequency() / mode2.frequency(e), 1 + gap / mode2.slope(e) / 5,
+                1e-14);
   }
   EXPECT_TRUE(std::isnan(mode1.frequency(0.5 * mode1.grazing_energy())));
   EXPECT_THROW(ContactFamily(paper, gap, 3), core::InputError);

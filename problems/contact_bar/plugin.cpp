@@ -1,36 +1,40 @@
-// Registers the contact bar with `backbone trace`: branches mode1 and mode2, the nonlinear
-// modes born from the linear modes omega_k = (2k-1) pi c / (2L) at grazing.
+// The contact bar as a CLI plugin (continuation/plugin.hpp): `trace` branches mode1 and mode2
+// (the nonlinear modes born from the linear modes omega_k = (2k-1) pi c / (2L) at grazing),
+// `simulate` (simulate.hpp), its benchmarks and figures, and its steps of the main job.
 //
-// The scene gives the bar (problems/contact_bar/scene.hpp: length, youngs_modulus, density,
-// area, gap, contact, elements = the u0 grid); the keys below add the shooting setup. The
-// start is the grazing-side orbit of the contact family (end amplitude (1 + start_offset) g0),
-// not the sine of the linear mode: at grazing every initial condition is 4L/c-periodic and a
-// nodal Newton from the sine lands on such a non-contact orbit (measured: T = 4L/c exactly).
-// Mode 2 moves one knot with the physics (free_knots = 1, the crest of the tent) because its
-// kink travels with T and a uniform grid holds it only to O(dx).
+// The scene gives the bar (scene.hpp: length, youngs_modulus, density, area, gap, contact,
+// elements = the u0 grid); trace_keys add the shooting setup. The start is the grazing-side
+// orbit of the contact family (end amplitude (1 + start_offset) g0), not the sine of the
+// linear mode: at grazing every initial condition is 4L/c-periodic and a nodal Newton from the
+// sine lands on such a non-contact orbit (measured: T = 4L/c exactly). Mode 2 moves one knot
+// with the physics (free_knots = 1, the crest of the tent) because its kink travels with T and
+// a uniform grid holds it only to O(dx) (README.md, section "Shooting on the bar").
 //
 //   backbone trace problems/contact_bar/scenes/paper.ini --branch mode1 --out out/m1
-//   backbone trace problems/contact_bar/scenes/paper.ini --branch mode1 --elements 20
 //   backbone trace problems/contact_bar/scenes/paper.ini --branch mode2 --free_knots 0
+#include "continuation/plugin.hpp"
+
 #include <fmt/format.h>
 
-#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "core/errors.hpp"
 #include "core/table.hpp"
-#include "drivers/trace_registry.hpp"
+#include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/scene.hpp"
+#include "problems/contact_bar/simulate.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
 
+namespace backbone::contact_bar {
+
 namespace {
 
-using namespace backbone;
 namespace po = boost::program_options;
 
-po::options_description orbit_scene_keys() {
+po::options_description trace_keys() {
   po::options_description keys = contact_bar::scene_keys();
   po::options_description shooting("contact bar shooting");
   shooting.add_options()  //
@@ -77,19 +81,21 @@ po::options_description orbit_scene_keys() {
   return keys;
 }
 
-drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::string& branch) {
+continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
   const int mode = branch == "mode2" ? 2 : 1;
-  bar::BarSetup setup = contact_bar::bar_from_scene(scene);  // u0, v0: the orbit's own
+  bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
+  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
+    throw core::InputError("right_end",
+                           "the contact-bar modes need right_end = contact and gap > 0");
+  const ContactFamily family(setup.material, setup.right.gap, mode);
 
   std::shared_ptr<const bar::BarSolver> solver;
-  const std::string solver_name = scene.choice("shooting_solver", {"tdbem", "exact"});
-  if (solver_name == "exact")
+  if (scene.choice("shooting_solver", {"tdbem", "exact"}) == "exact")
     solver = std::make_shared<exact_bar::ExactBarSolver>();
   else
-    solver =
-        std::make_shared<contact_bar::TdbemSolver>(contact_bar::contact_method_from_scene(scene));
+    solver = std::make_shared<TdbemSolver>(contact_method_from_scene(scene));
 
-  contact_bar::OrbitOptions options;
+  OrbitOptions options;
   const long shooting_elements = scene.integer("shooting_elements", 0);
   options.elements =
       static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
@@ -99,22 +105,19 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements = static_cast<int>(
       test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);
-  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
-    throw core::InputError("right_end",
-                           "the contact-bar modes need right_end = contact and gap > 0");
 
-  auto problem = std::make_unique<contact_bar::ContactBarOrbitProblem>(setup, solver, options);
+  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, solver, options);
   const double ratio = 1 + scene.positive("start_offset");
   const std::string guess = scene.choice("start_guess", {"contact_family", "linear_mode"});
 
-  drivers::TraceSetup s;
+  continuation::TraceSetup s;
   s.guess = guess == "linear_mode" ? problem->linear_mode_guess(mode, ratio)
                                    : problem->contact_family_guess(mode, ratio);
   // Energy grows along the family: the direction of the contact family's own tangent.
   s.direction = problem->contact_family_guess(mode, ratio * 1.01) -
                 problem->contact_family_guess(mode, ratio);
 
-  const contact_bar::ContactBarOrbitProblem* p = problem.get();
+  const ContactBarOrbitProblem* p = problem.get();
   const double return_tolerance = scene.non_negative("return_tolerance");
   if (return_tolerance > 0) {
     // Exact oracle sampled on 4x as many intervals as unknowns (finer than the default test
@@ -122,7 +125,7 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
     const int check_elements = 4 * p->state_size();
     s.reject_point = [p, return_tolerance, check_elements](const core::Vector& x) {
       const exact_bar::ExactBarSolver oracle;
-      const contact_bar::ReturnError e = contact_bar::return_error(*p, x, oracle, check_elements);
+      const ReturnError e = return_error(*p, x, oracle, check_elements);
       if (e.worst() <= return_tolerance) return std::string();
       return fmt::format(
           "exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
@@ -130,39 +133,25 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
           e.displacement, e.velocity, return_tolerance);
     };
   }
-  const bar::Material material = setup.material;
-  const double gap = setup.right.gap;
-  s.describe_point = [p, material, gap, mode](const continuation::BranchPoint& point) {
-    const double energy = point.observable("energy");
-    const double exact = mode == 1 ? contact_bar::mode1_frequency(material, gap, energy)
-                                   : contact_bar::mode2_frequency(material, gap, energy);
+  s.describe_point = [family](const continuation::BranchPoint& point) {
+    const double exact = family.frequency(point.observable("energy"));
     return fmt::format("closed-form rel err {:.2e}",
                        std::abs(point.observable("frequency") / exact - 1));
   };
-  s.write_extra_outputs = [p, material, gap, mode](const std::filesystem::path& out,
-                                                   const continuation::Branch& b) {
-    // Per point: the closed form at the point's own energy and the exact-oracle return error.
+  s.write_extra_outputs = [p, family](const std::filesystem::path& out,
+                                      const continuation::Branch& b) {
+    // Per point: the closed form at the point's own energy, the exact-oracle return error and
+    // the node (where u0 changes sign; NaN for mode 1, which has none).
     const exact_bar::ExactBarSolver oracle;
     core::Table check({"point", "energy", "frequency", "closed_form_frequency", "relative_error",
                        "return_error_u", "return_error_v", "node"});
     for (const auto& point : b.points) {
       const double energy = point.observable("energy");
       const double w = point.observable("frequency");
-      const double exact = mode == 1 ? contact_bar::mode1_frequency(material, gap, energy)
-                                     : contact_bar::mode2_frequency(material, gap, energy);
-      const contact_bar::ReturnError re = contact_bar::return_error(*p, point.x, oracle);
-      // Node of the mode: where u0 changes sign inside (0, L) (NaN for mode 1: none).
-      const bar::PiecewiseLinear u0 = p->initial_displacement(point.x);
-      double node = std::nan("");
-      const auto& xs = u0.knots();
-      const auto& ys = u0.values();
-      for (std::size_t i = 2; i < xs.size(); ++i)
-        if (ys[i - 1] > 0 && ys[i] <= 0) {
-          node = xs[i - 1] + (xs[i] - xs[i - 1]) * ys[i - 1] / (ys[i - 1] - ys[i]);
-          break;
-        }
+      const double exact = family.frequency(energy);
+      const ReturnError re = return_error(*p, point.x, oracle);
       check.add_row({static_cast<double>(point.index), energy, w, exact, std::abs(w / exact - 1),
-                     re.displacement, re.velocity, node});
+                     re.displacement, re.velocity, node_of(p->initial_displacement(point.x))});
     }
     check.write_csv(out / "closed_form_check.csv");
   };
@@ -172,9 +161,39 @@ drivers::TraceSetup setup_contact_bar(const core::Scene& scene, const std::strin
 
 }  // namespace
 
-static const bool registered = drivers::register_trace_problem(
-    {"contact_bar",
-     "elastic bar fixed at x = 0, rigid wall at gap g0 beyond x = L (Signorini contact)",
-     &orbit_scene_keys,
-     {"mode1", "mode2"},
-     setup_contact_bar});
+void register_plugin(continuation::PluginRegistry& registry) {
+  continuation::ProblemPlugin p;
+  p.name = "contact_bar";
+  p.summary = "elastic bar fixed at x = 0, rigid wall at gap g0 beyond x = L (Signorini contact)";
+  p.scene_keys = &trace_keys;
+  p.branches = {"mode1", "mode2"};
+  p.setup = &setup_trace;
+  p.simulate_keys = &simulate_keys;
+  p.simulate = &simulate_scene;
+  const std::string scenes = "problems/contact_bar/scenes/";
+  p.reproduce = {
+      {"bouncing_bar",
+       "simulate",
+       {scenes + "bouncing_bar.ini", "--compare", "--periods", "2", "--out", "{out}/bouncing_bar"}},
+      {"mode1_orbit",
+       "simulate",
+       {scenes + "paper.ini", "--compare", "--periods", "1", "--out", "{out}/mode1_orbit"}},
+      {"mode1", "trace", {scenes + "paper.ini", "--branch", "mode1", "--out", "{out}/mode1"}},
+      {"mode2", "trace", {scenes + "paper.ini", "--branch", "mode2", "--out", "{out}/mode2"}},
+      // Other scenes, nothing but the bar changed: the closed forms must hold there too.
+      {"mode1_short_bar",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode1", "--length", "0.3", "--youngs_modulus", "7e4",
+        "--density", "2.7", "--gap", "1e-5", "--out", "{out}/mode1_short_bar"}},
+      {"mode2_steel_bar",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode2", "--length", "2.5", "--youngs_modulus", "2.1e11",
+        "--density", "7850", "--area", "3e-4", "--gap", "1e-4", "--energy_max", "1e3", "--out",
+        "{out}/mode2_steel_bar"}},
+      {"figures", "figures", {"--out", "{out}"}},
+      {"bench", "bench", {"--problem", "contact_bar", "--out", "{out}/bench"}},
+  };
+  registry.add(std::move(p));
+}
+
+}  // namespace backbone::contact_bar

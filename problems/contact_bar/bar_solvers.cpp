@@ -1,4 +1,4 @@
-#include "drivers/bar_solvers.hpp"
+#include "problems/contact_bar/bar_solvers.hpp"
 
 #include <fmt/format.h>
 
@@ -6,20 +6,19 @@
 #include "problems/exact_bar/exact_bar_solver.hpp"
 #include "problems/fem_bar/fem.hpp"
 
-namespace backbone::drivers {
+namespace backbone::contact_bar {
 
 const std::vector<std::string>& bar_solver_names() {
   static const std::vector<std::string> names{"tdbem", "fem", "exact"};
   return names;
 }
 
-std::unique_ptr<bar::BarSolver> make_bar_solver(const std::string& method,
-                                                contact_bar::ContactMethod contact) {
-  if (method == "tdbem") return std::make_unique<contact_bar::TdbemSolver>(contact);
+std::unique_ptr<bar::BarSolver> make_bar_solver(const std::string& method, ContactMethod contact) {
+  if (method == "tdbem") return std::make_unique<TdbemSolver>(contact);
   if (method == "fem") return std::make_unique<fem_bar::FemBarSolver>();
   if (method == "exact") return std::make_unique<exact_bar::ExactBarSolver>();
   throw core::InputError("method",
                          fmt::format("must be one of tdbem, fem, exact, all (got '{}')", method));
 }
 
-}  // namespace backbone::drivers
+}  // namespace backbone::contact_bar

@@ -1,0 +1,147 @@
+#include "continuation/scene_options.hpp"
+
+#include <fmt/format.h>
+
+#include <boost/make_shared.hpp>
+#include <cmath>
+#include <limits>
+
+#include "continuation/natural.hpp"
+#include "continuation/pseudo_arclength.hpp"
+#include "core/errors.hpp"
+
+namespace backbone::continuation {
+
+namespace po = boost::program_options;
+
+po::options_description continuation_keys(const po::options_description& problem_keys) {
+  po::options_description keys("continuation");
+  const auto add = [&](const char* name, const po::value_semantic* value, const char* help) {
+    if (problem_keys.find_nothrow(name, false)) {
+      delete value;
+      return;
+    }
+    keys.add(boost::make_shared<po::option_description>(name, value, help));
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  add("method", po::value<std::string>()->default_value("arclength"),
+      "arclength (pseudo-arclength, passes folds), natural, or natural_then_arclength "
+      "(natural until it stalls, then arclength: the paper's strategy)");
+  add("predictor", po::value<std::string>()->default_value("tangent"), "tangent or secant");
+  add("newton", po::value<std::string>()->default_value("eigen"), "corrector: eigen or kinsol");
+  add("formulation", po::value<std::string>()->default_value("regular"),
+      "shooting residual: regular (v(T/2) = 0) or paper (u0 - u(T) = 0)");
+  add("ds", po::value<double>()->default_value(0.01),
+      "first step, in unknowns divided by their typical scale (dimensionless)");
+  add("ds_min", po::value<double>()->default_value(1e-8), "smallest step before giving up");
+  add("ds_max", po::value<double>()->default_value(0.5), "largest step (dimensionless)");
+  add("max_points", po::value<long>()->default_value(200), "points on the branch, first included");
+  add("energy_min", po::value<double>()->default_value(-inf), "stop below this energy");
+  add("energy_max", po::value<double>()->default_value(inf), "stop above this energy");
+  add("period_min", po::value<double>()->default_value(-inf), "stop below this period");
+  add("period_max", po::value<double>()->default_value(inf), "stop above this period");
+  add("bound", po::value<std::vector<std::string>>()->composing(),
+      "NAME:MIN:MAX, stop when observable NAME leaves [MIN, MAX] (empty = unbounded; repeatable)");
+  add("rank_check_every", po::value<long>()->default_value(1),
+      "verified rank report every k points (0: never)");
+  add("rank_threshold", po::value<double>()->default_value(1e-8),
+      "rank report: singular values below this times the largest count as zero (candidates; "
+      "verify then keeps only the real directions)");
+  add("verify", po::value<bool>()->default_value(true),
+      "re-correct along candidate null directions (verified dimension)");
+  add("newton_tolerance", po::value<double>()->default_value(1e-10), "||F||_inf to converge");
+  add("newton_max_iterations", po::value<long>()->default_value(25), "Newton iterations per point");
+  add("natural_parameter", po::value<std::string>()->default_value("period"),
+      "natural method: the period unknown or an observable name");
+  add("natural_direction", po::value<long>()->default_value(1), "natural method: +1 or -1");
+  return keys;
+}
+
+namespace {
+
+double bound_value(const std::string& text, double fallback, const std::string& spec) {
+  if (text.empty()) return fallback;
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used == text.size() && !std::isnan(v)) return v;
+  } catch (const std::exception&) {
+  }
+  throw core::InputError("bound", fmt::format("'{}' is not NAME:MIN:MAX with numbers", spec));
+}
+
+void read_bounds(const core::Scene& scene, ContinuationOptions& o) {
+  for (const char* name : {"energy", "period"}) {
+    for (const char* side : {"_min", "_max"}) {
+      const std::string key = std::string(name) + side;
+      if (std::isnan(scene.values()[key].as<double>()))
+        throw core::InputError(key, "must be a number (got nan)");
+    }
+    const double lo = scene.values()[std::string(name) + "_min"].as<double>();
+    const double hi = scene.values()[std::string(name) + "_max"].as<double>();
+    if (std::isfinite(lo) || std::isfinite(hi)) o.bounds.push_back({name, lo, hi});
+  }
+  if (!scene.has("bound")) return;
+  for (const std::string& spec : scene.values()["bound"].as<std::vector<std::string>>()) {
+    const auto first = spec.find(':');
+    const auto second = first == std::string::npos ? first : spec.find(':', first + 1);
+    if (second == std::string::npos)
+      throw core::InputError("bound", fmt::format("'{}' is not NAME:MIN:MAX", spec));
+    Bound b;
+    b.observable = spec.substr(0, first);
+    b.min = bound_value(spec.substr(first + 1, second - first - 1),
+                        -std::numeric_limits<double>::infinity(), spec);
+    b.max = bound_value(spec.substr(second + 1), std::numeric_limits<double>::infinity(), spec);
+    o.bounds.push_back(b);
+  }
+}
+
+}  // namespace
+
+RunSettings read_run_settings(const core::Scene& scene) {
+  RunSettings run;
+  ContinuationOptions& o = run.options;
+  o.method = parse_method(scene.text("method"));
+  o.predictor = parse_predictor(scene.text("predictor"));
+  o.ds = scene.positive("ds");
+  o.ds_min = scene.positive("ds_min");
+  o.ds_max = scene.positive("ds_max");
+  o.max_points = static_cast<int>(scene.integer("max_points", 1));
+  o.rank_check_every = static_cast<int>(scene.integer("rank_check_every", 0));
+  o.verify = scene.flag("verify");
+  o.rank.relative_threshold = scene.positive("rank_threshold");
+  if (!(o.rank.relative_threshold < 1))
+    throw core::InputError("rank_threshold",
+                           fmt::format("must be in (0, 1) (got {})", o.rank.relative_threshold));
+  read_bounds(scene, o);
+  o.validate();
+  run.newton = scene.choice("newton", {"eigen", "kinsol"});
+  run.newton_options.residual_tolerance = scene.positive("newton_tolerance");
+  run.newton_options.max_iterations = static_cast<int>(scene.integer("newton_max_iterations", 1));
+  run.formulation = core::parse_formulation(scene.text("formulation"));
+  run.natural_parameter = scene.text("natural_parameter");
+  const long direction = scene.integer("natural_direction", -1);
+  if (direction != 1 && direction != -1)
+    throw core::InputError("natural_direction", fmt::format("must be 1 or -1 (got {})", direction));
+  run.natural_direction = static_cast<double>(direction);
+  return run;
+}
+
+SwitchingBranch run_continuation(const core::Problem& problem, const core::Vector& guess,
+                                 const core::Vector& direction, const RunSettings& settings,
+                                 core::Corrector& corrector, const ContinuationHooks& hooks) {
+  const ContinuationOptions& options = settings.options;
+  if (options.method == Method::arclength)
+    return {pseudo_arclength(problem, guess, direction, corrector, options, hooks), -1};
+  const auto* periodic = dynamic_cast<const core::PeriodicOrbitProblem*>(&problem);
+  const NaturalParameter parameter =
+      (periodic && settings.natural_parameter == "period")
+          ? NaturalParameter::of_unknown(periodic->period_index(), "period",
+                                         settings.natural_direction)
+          : NaturalParameter::of_observable(settings.natural_parameter, settings.natural_direction);
+  if (options.method == Method::natural)
+    return {natural(problem, guess, parameter, corrector, options, hooks), -1};
+  return natural_then_arclength(problem, guess, parameter, corrector, options, hooks);
+}
+
+}  // namespace backbone::continuation
