@@ -7,7 +7,7 @@
 // The orbits sought start at rest (v0 = 0), so the state samples are initial *displacements*
 // (for a field problem: nodal values of u0; for an ODE: the positions).
 //
-// Two shooting formulations (DESIGN.md section 3):
+// Two shooting formulations (core/README.md, section 'Shooting formulations'):
 //  - displacement_periodicity: the paper's f = u0 - u(u0, T). A double root on the family: the
 //    period column vanishes and Newton converges linearly; kept to compare against.
 //  - half_period_velocity: reversibility, an orbit with v0 = 0 is T-periodic iff

@@ -3,7 +3,7 @@
 // The numerical rank of J (m x n) at a converged point comes from its singular values with a
 // relative threshold (tau * sigma_max, tau documented in RankOptions). nullity = n - rank is
 // the *candidate* dimension of the solution manifold. Because a rank count on a degenerate
-// residual says nothing (DESIGN.md section 3: the paper's shooting residual is a double root),
+// residual says nothing (a double root, core/README.md, section 'Shooting formulations'),
 // verify_null_directions steps along each candidate null direction, re-corrects with a Newton
 // corrector constrained to the hyperplane orthogonal to that direction, and counts the
 // directions along which nearby solutions really exist.

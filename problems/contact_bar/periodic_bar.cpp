@@ -257,7 +257,7 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
   const int n = options_.elements;
   Vector x(num_unknowns());
   if (mode == 1) {
-    // u0 = eps x, end at -amplitude_ratio g0; T = (3L + g0/|eps|)/c (DESIGN.md section 1).
+    // u0 = eps x, end at -amplitude_ratio g0; T = (3L + g0/|eps|)/c (README.md, 'Mode 1').
     const double slope = amplitude_ratio * g0 / length;
     if (options_.free_knots == 1) x[n] = length * reference_knot_node() / n;
     const Vector y = node_positions(x);

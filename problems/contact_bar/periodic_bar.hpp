@@ -8,7 +8,7 @@
 // u0 at the nodes y_1..y_N of the representation grid (y_0 = 0 is the fixed end, u0 = 0 there),
 // then K = free_knots movable knot positions (0 by default: y_i = i L / N, uniform), then the
 // period. With one free knot the grid is mapped piecewise-linearly so that node knot_node sits
-// at k_1: a u0 with one kink anywhere (mode 2, DESIGN.md section 3, representability) is then
+// at k_1: a u0 with one kink anywhere (mode 2; README.md, section 'Representability') is then
 // held exactly, which a uniform grid only does to O(dx). Residual (N + K equations, sampled on
 // the uniform snapshot grid of N + K elements, nodes 1..N+K):
 //  - displacement_periodicity (paper): f_i = u0(x_i) - u(x_i, T)
@@ -98,8 +98,8 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   // linear_mode_guess: the sine of linear mode k, u0 = -A sin((2k-1) pi x / 2L) sign-adjusted
   // so that the end starts away from the wall, at the linear period 4L / ((2k-1) c).
   core::Vector linear_mode_guess(int mode, double amplitude_ratio) const;
-  // contact_family_guess: the exact piecewise-linear orbit of the contact family (DESIGN.md
-  // section 1 for mode 1: u0 = eps x, T = (3L + g0/|eps|)/c; mode 2: a tent with its crest
+  // contact_family_guess: the exact piecewise-linear orbit of the contact family (README.md
+  // 'Mode 1': u0 = eps x, T = (3L + g0/|eps|)/c; 'Mode 2': a tent with its crest
   // at b L, b = (1 + g0/(s L))/4, slope +-s, T = (1 + b) L / c), sampled on the grid.
   core::Vector contact_family_guess(int mode, double amplitude_ratio) const;
 
@@ -133,7 +133,7 @@ ReturnError return_error(const ContactBarOrbitProblem& problem, const core::Vect
                          const bar::BarSolver& oracle, int elements = 1000);
 
 // Closed forms of the contact family (c = sqrt(E/rho), EA, g0 from the setup), for tests and
-// reports. Mode 1: DESIGN.md section 1, T = (3L + g0 sqrt(EA L / (2E))) / c above grazing
+// reports. Mode 1 (README.md 'Mode 1'): T = (3L + g0 sqrt(EA L / (2E))) / c above grazing
 // E = EA g0^2 / (2L). Mode 2 (derived the same way from d'Alembert, see the .cpp): a tent
 // u0 of slopes +-s with its crest at bL, T = (5L + g0 sqrt(EA L / (2E))) / (4c) above grazing
 // E = EA (3 g0)^2 / (2L). Both return 2 pi / T, NaN below grazing.

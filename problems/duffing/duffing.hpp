@@ -1,7 +1,7 @@
 // The conservative Duffing oscillator x'' + x + x^3 = 0 as a periodic-orbit problem.
 //
 // Unknowns [x0 | T] (core::PeriodicOrbitProblem layout, state size 1, no parameters): the orbit
-// starts at rest at amplitude x0 (v0 = 0). Residuals (DESIGN.md section 3):
+// starts at rest at amplitude x0 (v0 = 0). Residuals (README.md, 'Residuals and Jacobians'):
 //   displacement_periodicity ("paper"):  (x0 - x(T)) / |x0|       (double root on the backbone)
 //   half_period_velocity ("regular"):    v(T/2) / v_max(x0)       (simple root, J ~ [2, 1])
 // Both are made dimensionless by the orbit's own scale (v_max = sqrt(2 V(x0)), the largest

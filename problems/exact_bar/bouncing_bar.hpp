@@ -1,4 +1,4 @@
-// The bouncing bar (Doyen, Ern & Piperno, SIAM J. Sci. Comput. 2011; DESIGN.md section 4) and
+// The bouncing bar (Doyen, Ern & Piperno 2011; README.md, section 'Bouncing bar') and
 // its closed-form solution, derived by hand from the characteristics.
 //
 // L = 10, E = 900, rho = 1, A = 1 (c = 30, tau = L/c = 1/3), gravity g = 10 towards the

@@ -61,7 +61,7 @@ class Sphere : public Problem {
 
 // F(x, y) = (y - x^2)^2: the solution set is the parabola y = x^2 (a curve), but F touches
 // zero quadratically, so the 1 x 2 Jacobian vanishes identically on it -- the algebraic twin
-// of the paper's shooting residual on the Duffing backbone (DESIGN.md section 3).
+// of the paper's shooting residual on Duffing (core/README.md, section 'Shooting formulations').
 class DoubleRootParabola : public Problem {
  public:
   int num_unknowns() const override { return 2; }

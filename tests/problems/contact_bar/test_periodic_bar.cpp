@@ -1,5 +1,5 @@
 // Known-solution tests of the contact-bar shooting problem (problems/contact_bar/periodic_bar):
-// the exact mode-1 orbit u0 = eps x, T = (3L + g0/|eps|)/c (DESIGN.md section 1) and the
+// the exact mode-1 orbit u0 = eps x, T = (3L + g0/|eps|)/c (its README.md, 'Mode 1') and the
 // mode-2 tent (closed form derived in periodic_bar.cpp) are roots of both formulations; the
 // regular Jacobian is regular (nullity 1), the paper's T column vanishes; Newton returns to
 // the family; short branches match the closed forms.

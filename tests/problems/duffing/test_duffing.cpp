@@ -1,5 +1,5 @@
 // The Duffing backbone against its exact period, across Newton backends and shooting
-// formulations (DESIGN.md section 3).
+// formulations (problems/duffing/README.md, section 'Residuals and Jacobians').
 #include <gtest/gtest.h>
 
 #include <cmath>
