@@ -1,6 +1,6 @@
 // `backbone trace` end to end on the contact bar: bad input names its key (exit 2, nothing
 // written); another scene than the paper's (other L, E, rho, g0 on the command line, nothing
-// else changed) traces mode 1 onto the closed form of DESIGN.md section 1, because the
+// else changed) traces mode 1 onto the closed form of problems/contact_bar/README.md, 'Mode 1', because the
 // continuation works in units of the scene (u0 / g0, T c / L) and checks each point.
 #include <gtest/gtest.h>
 
