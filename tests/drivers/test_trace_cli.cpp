@@ -1,7 +1,7 @@
 // `backbone trace` end to end on the contact bar: bad input names its key (exit 2, nothing
 // written); another scene than the paper's (other L, E, rho, g0 on the command line, nothing
-// else changed) traces mode 1 onto the closed form of problems/contact_bar/README.md, 'Mode 1', because the
-// continuation works in units of the scene (u0 / g0, T c / L) and checks each point.
+// else changed) traces mode 1 onto the closed form of problems/contact_bar/README.md, 'Mode 1',
+// because the continuation works in units of the scene (u0 / g0, T c / L) and checks each point.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -80,6 +80,25 @@ TEST(TraceCli, NaturalInThePeriodFollowsModeOne) {
   const auto period = backbone::core::Table::read_csv(out / "branch.csv").column("period");
   for (std::size_t i = 1; i < period.size(); ++i) EXPECT_LT(period[i], period[i - 1]) << i;
   fs::remove_all(out);
+}
+
+// Every scene shipped under problems/*/scenes names a problem the CLI has registered: a problem
+// folder with scenes but no register_plugin would fail here (the build registers every folder
+// that defines one, drivers/CMakeLists.txt). `trace SCENE --help` resolves the scene's problem
+// first and exits 2 naming `problem` when it is unknown.
+TEST(TraceCli, EveryShippedSceneNamesARegisteredProblem) {
+  int scenes = 0;
+  for (const auto& dir : fs::directory_iterator(fs::path(BACKBONE_SOURCE_DIR) / "problems")) {
+    if (!fs::is_directory(dir.path() / "scenes")) continue;
+    for (const auto& scene : fs::directory_iterator(dir.path() / "scenes")) {
+      if (scene.path().extension() != ".ini") continue;
+      ++scenes;
+      const cli::Run r =
+          cli::run("trace", scene.path().string() + " --help", cli::scratch("trace_cli", "help"));
+      EXPECT_EQ(r.code, 0) << scene.path() << "\n" << r.err;
+    }
+  }
+  EXPECT_GE(scenes, 3);  // paper, bouncing_bar, duffing at least
 }
 
 }  // namespace
