@@ -1,5 +1,20 @@
 #include "continuation/outputs.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include "continuation/point_recorder.hpp"
+#include "core/errors.hpp"
+
 namespace backbone::continuation {
 
 core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch& branch) {
@@ -11,6 +26,190 @@ core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch&
       t.add_row({static_cast<double>(p.index), coordinates[i], values[i]});
   }
   return t;
+}
+
+struct BranchWriter::File {
+  std::filesystem::path path;
+  std::FILE* handle = nullptr;
+  File(std::filesystem::path p, bool append) : path(std::move(p)) {
+    handle = std::fopen(path.c_str(), append ? "a" : "w");
+    if (!handle)
+      throw std::runtime_error(
+          fmt::format("cannot write '{}': {}", path.string(), std::strerror(errno)));
+  }
+  ~File() {
+    if (handle) std::fclose(handle);
+  }
+  // One fwrite per call, then flushed to the kernel: a killed process loses nothing written.
+  void write(const std::string& text) {
+    if (std::fwrite(text.data(), 1, text.size(), handle) != text.size() || std::fflush(handle) != 0)
+      throw std::runtime_error(fmt::format("cannot write '{}'", path.string()));
+  }
+};
+
+namespace {
+
+std::string csv_rows(const core::Table& table, bool header) {
+  std::string text;
+  if (header) {
+    for (std::size_t j = 0; j < table.columns().size(); ++j)
+      text += (j ? "," : "") + table.columns()[j];
+    text += '\n';
+  }
+  for (std::size_t i = 0; i < table.rows(); ++i) {
+    const auto& row = table.row(i);
+    for (std::size_t j = 0; j < row.size(); ++j)
+      text += fmt::format("{}{:.17g}", j ? "," : "", row[j]);
+    text += '\n';
+  }
+  return text;
+}
+
+}  // namespace
+
+BranchWriter::BranchWriter(std::filesystem::path out, const core::PeriodicOrbitProblem* periodic,
+                           bool append)
+    : out_(std::move(out)), periodic_(periodic), points_(append ? 1 : 0) {
+  std::filesystem::create_directories(out_);
+  branch_ = std::make_unique<File>(out_ / "branch.csv", append);
+  unknowns_ = std::make_unique<File>(out_ / "unknowns.csv", append);
+  if (periodic_) orbits_ = std::make_unique<File>(out_ / "orbits.csv", append);
+}
+
+BranchWriter::~BranchWriter() = default;
+
+void BranchWriter::append(const BranchPoint& point) {
+  Branch one;
+  one.points.push_back(point);
+  const bool first = points_ == 0;
+  branch_->write(csv_rows(branch_table(one), first));
+  core::Table unknowns({"point", "index", "value"});
+  for (Eigen::Index i = 0; i < point.x.size(); ++i)
+    unknowns.add_row({static_cast<double>(point.index), static_cast<double>(i), point.x[i]});
+  unknowns_->write(csv_rows(unknowns, first));
+  if (periodic_) orbits_->write(csv_rows(orbit_table(*periodic_, one), first));
+  ++points_;
+}
+
+namespace {
+
+// The header and the complete lines of a CSV file (a last line without its newline is cut).
+std::vector<std::string> complete_lines(const std::filesystem::path& path, const std::string& key) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw core::InputError(key, fmt::format("cannot read '{}'", path.string()));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::vector<std::string> lines;
+  std::string all = text.str(), line;
+  std::size_t start = 0;
+  for (std::size_t end = all.find('\n'); end != std::string::npos; end = all.find('\n', start)) {
+    lines.push_back(all.substr(start, end - start));
+    start = end + 1;
+  }
+  if (lines.empty()) throw core::InputError(key, fmt::format("'{}' has no header", path.string()));
+  return lines;
+}
+
+double first_cell(const std::string& line) {
+  return std::strtod(line.c_str(), nullptr);
+}
+
+}  // namespace
+
+int repair_branch_files(const std::filesystem::path& out, const std::string& key) {
+  std::vector<std::filesystem::path> files{out / "branch.csv", out / "unknowns.csv"};
+  if (std::filesystem::exists(out / "orbits.csv")) files.push_back(out / "orbits.csv");
+  std::vector<std::vector<std::string>> contents;
+  // The writer writes a point to branch.csv, then unknowns.csv, then orbits.csv: the last
+  // complete point is the smallest last point over the files, one less when a file holding
+  // several rows per point has only part of that point's rows.
+  double last = std::numeric_limits<double>::infinity();
+  for (const auto& f : files) {
+    contents.push_back(complete_lines(f, key));
+    const auto& lines = contents.back();
+    last = std::min(last, lines.size() > 1 ? first_cell(lines.back()) : -1.0);
+  }
+  const auto rows_of = [](const std::vector<std::string>& lines, double point) {
+    return std::count_if(lines.begin() + 1, lines.end(),
+                         [&](const std::string& l) { return first_cell(l) == point; });
+  };
+  if (last >= 0 && contents.size() > 1) {
+    // Every point has as many rows as the first one (same unknowns, same samples).
+    const auto& u = contents[1];
+    const double first_point = first_cell(u[1]);
+    if (rows_of(u, last) != rows_of(u, first_point)) last -= 1;
+    if (contents.size() > 2) {
+      const auto& o = contents[2];
+      if (o.size() > 1 && rows_of(o, last) != rows_of(o, first_cell(o[1]))) last -= 1;
+    }
+  }
+  if (!(last >= 0))
+    throw core::InputError(key, fmt::format("'{}' holds no complete point", out.string()));
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    std::string text = contents[i][0] + "\n";
+    for (std::size_t j = 1; j < contents[i].size(); ++j)
+      if (first_cell(contents[i][j]) <= last) text += contents[i][j] + "\n";
+    core::write_text_atomically(files[i], text);
+  }
+  return static_cast<int>(last);
+}
+
+core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key) {
+  std::vector<double> points, index, value;
+  try {
+    const core::Table table = core::Table::read_csv(path);
+    points = table.column("point");
+    index = table.column("index");
+    value = table.column("value");
+  } catch (const core::InputError& e) {
+    throw core::InputError(key, e.what());
+  }
+  if (points.empty())
+    throw core::InputError(key, fmt::format("'{}' holds no point", path.string()));
+  const double wanted = point < 0 ? points.back() : point;
+  std::map<int, double> entries;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (points[i] == wanted) entries[static_cast<int>(index[i])] = value[i];
+  if (entries.empty())
+    throw core::InputError(key, fmt::format("'{}' has no point {}", path.string(), point));
+  core::Vector x(static_cast<Eigen::Index>(entries.size()));
+  int expected = 0;
+  for (const auto& [i, v] : entries) {
+    if (i != expected++)
+      throw core::InputError(key, fmt::format("'{}': point {} misses unknown {}", path.string(),
+                                              static_cast<int>(wanted), expected - 1));
+    x[i] = v;
+  }
+  return x;
+}
+
+RestartPoint restart_point(const std::filesystem::path& dir, int point,
+                           const ContinuationOptions& options, const std::string& key) {
+  RestartPoint r;
+  r.x = read_unknowns(dir / "unknowns.csv", point, key);
+  std::vector<double> index, step, iterations, arclength;
+  try {
+    const core::Table branch = core::Table::read_csv(dir / "branch.csv");
+    index = branch.column("point");
+    step = branch.column("step_size");
+    iterations = branch.column("newton_iterations");
+    arclength = branch.column("arclength");
+  } catch (const core::InputError& e) {
+    throw core::InputError(key, e.what());
+  }
+  const double wanted = point < 0 ? index.back() : point;
+  const auto row = std::find(index.begin(), index.end(), wanted);
+  if (row == index.end())
+    throw core::InputError(key, fmt::format("'{}' has no point {}", (dir / "branch.csv").string(),
+                                            static_cast<int>(wanted)));
+  const std::size_t i = static_cast<std::size_t>(row - index.begin());
+  r.index = static_cast<int>(wanted);
+  r.arclength = arclength[i];
+  if (r.index > 0) {
+    r.secant = r.x - read_unknowns(dir / "unknowns.csv", r.index - 1, key);
+    r.next_step = adapted_step(step[i], static_cast<int>(iterations[i]), options);
+  }
+  return r;
 }
 
 }  // namespace backbone::continuation

@@ -1,18 +1,82 @@
-// The files a traced branch is written to, beside branch.csv (branch_table, branch.hpp).
+// The files a traced branch is written to, point by point, so that an interrupted run keeps
+// every completed point.
 //
-// orbits.csv holds, for every point of a branch of a core::PeriodicOrbitProblem, the initial
-// state of its orbit as (coordinate, value) rows: `point,x,u0`. It is also the restart format
-// (a point of it is a whole orbit).
+// BranchWriter appends each accepted point, as soon as it is accepted, to
+//   branch.csv    the columns of branch_table (branch.hpp): observables, dimension, cost
+//   orbits.csv    `point,x,u0`: the initial state of the orbit as (coordinate, value) samples
+//                 (core::PeriodicOrbitProblem::initial_state_samples), for figures
+//   unknowns.csv  `point,index,value`: the point's unknowns x in the problem's own layout, the
+//                 restart format (read_unknowns): `trace --resume DIR` and `--start DIR:K`
+// and flushes them, so even SIGKILL leaves readable files holding every completed point. A
+// row is written with one call, so at worst the last line is cut (read_csv refuses a short
+// row; remove it or resume, which rewrites the files).
 //
-//   continuation::orbit_table(problem, branch).write_csv(out / "orbits.csv");
+//   BranchWriter writer(out, periodic_or_null);
+//   hooks.on_point = [&](const BranchPoint& p) { writer.append(p); };
+//   ... continuation ...
+//   core::Vector x = read_unknowns(out / "unknowns.csv", /*point=*/-1);  // the last point
 #pragma once
 
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
 #include "continuation/branch.hpp"
+#include "continuation/options.hpp"
 #include "core/periodic_orbit.hpp"
 #include "core/table.hpp"
 
 namespace backbone::continuation {
 
 core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch& branch);
+
+class BranchWriter {
+ public:
+  // Creates `out` (and its parents). periodic: the problem when it is a periodic-orbit problem
+  // (orbits.csv is written only then), else nullptr. append = false truncates existing files;
+  // true appends to them (after repair_branch_files).
+  BranchWriter(std::filesystem::path out, const core::PeriodicOrbitProblem* periodic,
+               bool append = false);
+  ~BranchWriter();
+  BranchWriter(const BranchWriter&) = delete;
+  BranchWriter& operator=(const BranchWriter&) = delete;
+  // Appends the point to every file and flushes them. Throws std::runtime_error when a file
+  // cannot be written.
+  void append(const BranchPoint& point);
+  int points() const { return points_; }
+
+ private:
+  struct File;
+  std::filesystem::path out_;
+  const core::PeriodicOrbitProblem* periodic_;
+  std::unique_ptr<File> branch_, orbits_, unknowns_;
+  int points_ = 0;
+};
+
+// Makes the files of an interrupted run consistent: drops a line cut by the interruption and
+// every row of a point that is not complete in all of branch.csv, unknowns.csv (and orbits.csv
+// when present). Returns the last complete point; InputError naming `key` when there is none.
+int repair_branch_files(const std::filesystem::path& out, const std::string& key);
+
+// The unknowns of point `point` (-1: the last one) of an unknowns.csv. InputError naming `key`
+// when the file cannot be read or has no such point.
+core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key);
+
+// Where a restarted run takes up a saved branch (`trace --resume DIR`, `--start DIR:K`): the
+// saved point's unknowns, the secant from its predecessor (the direction the branch was going;
+// empty at point 0), the step the uninterrupted run would take next (step control of
+// adapted_step applied to the point's own step and Newton iterations; 0 at point 0: use ds),
+// and its index and arclength, so the restarted points continue the numbering.
+struct RestartPoint {
+  int index = 0;
+  core::Vector x;
+  core::Vector secant;
+  double next_step = 0;
+  double arclength = 0;
+};
+// InputError naming `key` when the folder lacks the files or the point.
+RestartPoint restart_point(const std::filesystem::path& dir, int point,
+                           const ContinuationOptions& options, const std::string& key);
 
 }  // namespace backbone::continuation

@@ -10,7 +10,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "continuation/outputs.hpp"
@@ -19,6 +21,7 @@
 #include "core/periodic_orbit.hpp"
 #include "core/plot.hpp"
 #include "core/scene.hpp"
+#include "core/scene_ini.hpp"
 #include "core/table.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/plugins.hpp"
@@ -34,6 +37,10 @@ po::options_description driver_keys() {
   keys.add_options()                                                                             //
       ("branch", po::value<std::string>(), "branch to follow (the problem lists its branches)")  //
       ("out", po::value<std::string>(), "output directory (default out/PROBLEM_BRANCH)")         //
+      ("start", po::value<std::string>(),
+       "DIR:K (or DIR/orbits.csv:K): start from point K of a traced branch (its unknowns.csv)")  //
+      ("direction", po::value<long>()->default_value(1),
+       "with --start: +1 continues the saved branch's way, -1 goes back")  //
       ("help", "describe the command, the problem's keys and the continuation keys");
   return keys;
 }
@@ -45,7 +52,9 @@ std::string joined(const std::vector<std::string>& words) {
 }
 
 void print_help(const cont::ProblemPlugin* problem) {
-  fmt::print("usage: backbone trace SCENE [--branch NAME] [--out DIR] [--key value ...]\n\n");
+  fmt::print(
+      "usage: backbone trace SCENE [--branch NAME] [--out DIR] [--start DIR:K] [--key value ...]\n"
+      "       backbone trace --resume DIR [--key value ...]   (continue an interrupted run)\n\n");
   fmt::print("problems (scene key `problem`):\n");
   for (const auto& p : plugins().all())
     if (p.can_trace())
@@ -90,11 +99,50 @@ void write_figure(const std::filesystem::path& out, const core::Table& table,
   if (!r.ok) fmt::print(stderr, "figure skipped: {}\n", r.message);
 }
 
-int run_trace(const std::vector<std::string>& args) {
+// SIGINT / SIGTERM ask the continuation to stop before its next step (ContinuationHooks::
+// cancel_requested): the current point is finished and written, then the summary.
+volatile std::sig_atomic_t stop_signal = 0;
+extern "C" void request_stop(int signal) {
+  stop_signal = signal;
+}
+
+// "DIR:K" or "DIR/orbits.csv:K" -> (DIR, K).
+std::pair<std::filesystem::path, int> parse_start(const std::string& text) {
+  const auto colon = text.rfind(':');
+  int point = -1;
+  try {
+    std::size_t used = 0;
+    if (colon != std::string::npos) point = std::stoi(text.substr(colon + 1), &used);
+    if (colon == std::string::npos || used != text.size() - colon - 1 || point < 0) point = -1;
+  } catch (const std::exception&) {
+    point = -1;
+  }
+  if (point < 0)
+    throw core::InputError("start", fmt::format("'{}' is not DIR:K with K >= 0", text));
+  std::filesystem::path dir = text.substr(0, colon);
+  if (dir.extension() == ".csv") dir = dir.parent_path();
+  return {dir, point};
+}
+
+int run_trace(const std::vector<std::string>& args_in) {
+  std::vector<std::string> args = args_in;
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
     print_help(nullptr);
     if (args.empty()) throw core::InputError("SCENE", "a scene file is required");
     return core::exit_ok;
+  }
+  // --resume DIR: the run's own resolved scene, its branch and folder.
+  std::filesystem::path resume;
+  if (args[0] == "--resume") {
+    if (args.size() < 2) throw core::InputError("resume", "needs the folder of a traced branch");
+    resume = args[1];
+    if (!std::filesystem::exists(resume / "scene.ini"))
+      throw core::InputError(
+          "resume", fmt::format("'{}' holds no scene.ini of a traced branch", resume.string()));
+    const std::string branch = core::read_text_value(resume / "summary.txt", "branch");
+    args.erase(args.begin(), args.begin() + 2);
+    args.insert(args.begin(),
+                {(resume / "scene.ini").string(), "--branch", branch, "--out", resume.string()});
   }
   const std::string scene_path = args[0];
   const cont::ProblemPlugin& entry = plugin_for_scene(scene_path, "trace");
@@ -114,9 +162,12 @@ int run_trace(const std::vector<std::string>& args) {
                                                  branch_name, entry.name, joined(entry.branches)));
   const std::filesystem::path out =
       scene.has("out") ? scene.text("out") : fmt::format("out/{}_{}", entry.name, branch_name);
-  const cont::RunSettings run = cont::read_run_settings(scene);
-  const cont::ContinuationOptions& options = run.options;
+  cont::RunSettings run = cont::read_run_settings(scene);
+  cont::ContinuationOptions& options = run.options;
   auto corrector = core::make_corrector(run.newton, run.newton_options);
+  const long start_direction = scene.integer("direction", -1);
+  if (start_direction != 1 && start_direction != -1)
+    throw core::InputError("direction", fmt::format("must be 1 or -1 (got {})", start_direction));
 
   cont::TraceSetup setup = entry.setup(scene, branch_name);
   if (!setup.problem) throw core::InputError("problem", "setup returned no problem");
@@ -128,6 +179,33 @@ int run_trace(const std::vector<std::string>& args) {
     direction = core::Vector::Unit(
         problem.num_unknowns(), periodic ? periodic->period_index() : problem.num_unknowns() - 1);
 
+  // A restart takes up a saved point: its unknowns, the way the branch went, the next step.
+  std::optional<cont::RestartPoint> restart;
+  if (!resume.empty()) {
+    cont::repair_branch_files(resume, "resume");
+    restart = cont::restart_point(resume, -1, options, "resume");
+  } else if (scene.has("start")) {
+    const auto [dir, point] = parse_start(scene.text("start"));
+    restart = cont::restart_point(dir, point, options, "start");
+    if (restart->secant.size() == 0) restart->secant = direction;
+    restart->secant *= static_cast<double>(start_direction);
+  }
+  if (restart) {
+    if (restart->x.size() != problem.num_unknowns())
+      throw core::InputError(resume.empty() ? "start" : "resume",
+                             fmt::format("the saved point has {} unknowns, this scene's problem "
+                                         "{} (same grid keys?)",
+                                         restart->x.size(), problem.num_unknowns()));
+    setup.guess = restart->x;
+    direction = restart->secant;
+    if (restart->next_step > 0)
+      options.ds = std::clamp(restart->next_step, options.ds_min, options.ds_max);
+    options.max_points -= restart->index;  // the saved point is the restart's first
+    if (options.max_points < 2)
+      throw core::InputError(
+          "max_points", fmt::format("the saved branch has {} points already", restart->index + 1));
+  }
+
   const int n = problem.num_unknowns(), m = problem.num_equations();
   if (m != n - 1 && corrector->name() == "kinsol")
     throw core::InputError("newton", fmt::format("kinsol solves square systems only; this {} "
@@ -138,14 +216,44 @@ int run_trace(const std::vector<std::string>& args) {
   const int expected_dimension = n - std::min(m, n - 1);
   fmt::print("{} / {}: {} equations in {} unknowns, expected manifold dimension {}\n", entry.name,
              branch_name, m, n, expected_dimension);
-  fmt::print("  {} continuation, {} predictor, newton {}, {}{}\n", cont::to_string(options.method),
-             cont::to_string(options.predictor), corrector->name(),
+  fmt::print("  {} continuation, {} predictor, newton {}, {}{}{}\n",
+             cont::to_string(options.method), cont::to_string(options.predictor), corrector->name(),
              periodic ? fmt::format("formulation {}, ", core::to_string(run.formulation)) : "",
              fmt::format("ds {:g} in [{:g}, {:g}], at most {} points", options.ds, options.ds_min,
-                         options.ds_max, options.max_points));
+                         options.ds_max, options.max_points),
+             restart ? fmt::format(", restarting from point {}", restart->index) : "");
 
+  // Output: the resolved scene first (it reproduces the run), then every point as it comes.
+  const auto summary = [&](const std::string& status, const cont::Branch* branch, long rejected,
+                           int switch_index) {
+    return fmt::format(
+        "problem {}\nbranch {}\nstatus {}\nequations {}\nunknowns {}\nexpected_dimension {}\n"
+        "method {}\nnewton {}\nformulation {}\npoints {}\nrejected_corrections {}\n"
+        "switch_index {}\nstop_reason {}\nmessage {}\n",
+        entry.name, branch_name, status, m, n, expected_dimension, cont::to_string(options.method),
+        corrector->name(), periodic ? core::to_string(run.formulation) : "-",
+        branch ? branch->points.size() : 0, rejected, switch_index,
+        branch ? cont::to_string(branch->reason) : "-", branch ? branch->message : "-");
+  };
+  cont::BranchWriter writer(out, periodic, restart.has_value() && !resume.empty());
+  if (resume.empty())
+    core::write_scene_ini(scene, out / "scene.ini",
+                          {"out", "help", "branch", "start", "direction"});
+  core::write_text_atomically(out / "summary.txt", summary("running", nullptr, 0, -1));
+
+  stop_signal = 0;
+  std::signal(SIGINT, request_stop);
+  std::signal(SIGTERM, request_stop);
+  const int offset = restart ? restart->index : 0;
+  const double arclength_offset = restart ? restart->arclength : 0;
   cont::ContinuationHooks hooks;
-  hooks.on_point = [&](const cont::BranchPoint& p) {
+  hooks.cancel_requested = [] { return stop_signal != 0; };
+  hooks.on_point = [&](const cont::BranchPoint& p_in) {
+    if (restart && !resume.empty() && p_in.index == 0) return;  // already in the files
+    cont::BranchPoint p = p_in;
+    p.index += offset;
+    p.arclength += arclength_offset;
+    writer.append(p);
     std::string observables;
     for (const auto& [key, value] : p.observables)
       observables += fmt::format(" {} {:.10g}", key, value);
@@ -159,33 +267,39 @@ int run_trace(const std::vector<std::string>& args) {
   hooks.on_attempt = [&](const cont::StepAttempt& a) {
     if (a.rejection.empty()) return;
     ++rejected;
-    fmt::print("  point {:4d}  rejected at ds {:.3g}: {}\n", a.point, a.ds, a.rejection);
+    fmt::print("  point {:4d}  rejected at ds {:.3g}: {}\n", a.point + offset, a.ds, a.rejection);
   };
 
-  const cont::SwitchingBranch result =
+  cont::SwitchingBranch result =
       cont::run_continuation(problem, setup.guess, direction, run, *corrector, hooks);
-  const cont::Branch& branch = result.branch;
-
-  const std::string summary = fmt::format(
-      "problem {}\nbranch {}\nequations {}\nunknowns {}\nexpected_dimension {}\nmethod {}\n"
-      "newton {}\nformulation {}\npoints {}\nrejected_corrections {}\nswitch_index {}\n"
-      "stop_reason {}\nmessage {}\n",
-      entry.name, branch_name, m, n, expected_dimension, cont::to_string(options.method),
-      corrector->name(), periodic ? core::to_string(run.formulation) : "-", branch.points.size(),
-      rejected, result.switch_index, cont::to_string(branch.reason), branch.message);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  cont::Branch& branch = result.branch;
+  for (cont::BranchPoint& p : branch.points) p.index += offset;
+  const bool complete = !branch.points.empty() && !branch.ended_early();
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
-  if (branch.points.empty()) {
-    core::write_text_atomically(out / "summary.txt", summary);
+  if (!branch.points.empty()) {
+    // The figure and the extra outputs show the whole branch, saved points included.
+    const core::Table table = core::Table::read_csv(out / "branch.csv");
+    write_figure(out, table,
+                 fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()));
+    if (setup.write_extra_outputs) setup.write_extra_outputs(out, branch);
+  }
+  core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",
+                                                           &branch, rejected, result.switch_index));
+  fmt::print("wrote {}\n", out.string());
+  if (stop_signal != 0) {
+    fmt::print(stderr,
+               "backbone trace: interrupted by signal {} after {} points; continue with "
+               "backbone trace --resume {}\n",
+               static_cast<int>(stop_signal), writer.points(), out.string());
+    return 128 + static_cast<int>(stop_signal);
+  }
+  if (!complete) {
+    fmt::print(stderr, "backbone trace: the branch ended before its bound or point budget: {}\n",
+               branch.message);
     return core::exit_numerical_failure;
   }
-  const core::Table table = cont::branch_table(branch);
-  table.write_csv(out / "branch.csv");
-  if (periodic) cont::orbit_table(*periodic, branch).write_csv(out / "orbits.csv");
-  write_figure(out, table,
-               fmt::format("{} / {} ({} points)", entry.name, branch_name, branch.points.size()));
-  if (setup.write_extra_outputs) setup.write_extra_outputs(out, branch);
-  core::write_text_atomically(out / "summary.txt", summary);
-  fmt::print("wrote {}\n", out.string());
   return core::exit_ok;
 }
 
