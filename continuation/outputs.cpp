@@ -183,6 +183,23 @@ core::Vector read_unknowns(const std::filesystem::path& path, int point, const s
   return x;
 }
 
+std::pair<std::filesystem::path, int> parse_saved_point(const std::string& text,
+                                                        const std::string& key) {
+  const auto colon = text.rfind(':');
+  int point = -1;
+  try {
+    std::size_t used = 0;
+    if (colon != std::string::npos) point = std::stoi(text.substr(colon + 1), &used);
+    if (colon == std::string::npos || used != text.size() - colon - 1) point = -1;
+  } catch (const std::exception&) {
+    point = -1;
+  }
+  if (point < 0) throw core::InputError(key, fmt::format("'{}' is not DIR:K with K >= 0", text));
+  std::filesystem::path dir = text.substr(0, colon);
+  if (dir.has_extension()) dir = dir.parent_path();
+  return {dir, point};
+}
+
 RestartPoint restart_point(const std::filesystem::path& dir, int point,
                            const ContinuationOptions& options, const std::string& key) {
   RestartPoint r;

@@ -76,6 +76,9 @@ struct RestartPoint {
   double arclength = 0;
 };
 // InputError naming `key` when the folder lacks the files or the point.
+// "DIR:K" or "DIR/orbits.csv:K" (any file of DIR) -> (DIR, K); InputError naming `key`.
+std::pair<std::filesystem::path, int> parse_saved_point(const std::string& text,
+                                                        const std::string& key);
 RestartPoint restart_point(const std::filesystem::path& dir, int point,
                            const ContinuationOptions& options, const std::string& key);
 

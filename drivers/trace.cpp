@@ -106,24 +106,6 @@ extern "C" void request_stop(int signal) {
   stop_signal = signal;
 }
 
-// "DIR:K" or "DIR/orbits.csv:K" -> (DIR, K).
-std::pair<std::filesystem::path, int> parse_start(const std::string& text) {
-  const auto colon = text.rfind(':');
-  int point = -1;
-  try {
-    std::size_t used = 0;
-    if (colon != std::string::npos) point = std::stoi(text.substr(colon + 1), &used);
-    if (colon == std::string::npos || used != text.size() - colon - 1 || point < 0) point = -1;
-  } catch (const std::exception&) {
-    point = -1;
-  }
-  if (point < 0)
-    throw core::InputError("start", fmt::format("'{}' is not DIR:K with K >= 0", text));
-  std::filesystem::path dir = text.substr(0, colon);
-  if (dir.extension() == ".csv") dir = dir.parent_path();
-  return {dir, point};
-}
-
 int run_trace(const std::vector<std::string>& args_in) {
   std::vector<std::string> args = args_in;
   if (args.empty() || args[0] == "--help" || args[0] == "-h") {
@@ -185,7 +167,7 @@ int run_trace(const std::vector<std::string>& args_in) {
     cont::repair_branch_files(resume, "resume");
     restart = cont::restart_point(resume, -1, options, "resume");
   } else if (scene.has("start")) {
-    const auto [dir, point] = parse_start(scene.text("start"));
+    const auto [dir, point] = cont::parse_saved_point(scene.text("start"), "start");
     restart = cont::restart_point(dir, point, options, "start");
     if (restart->secant.size() == 0) restart->secant = direction;
     restart->secant *= static_cast<double>(start_direction);
