@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <limits>
 
 #include "continuation/loop_steps.hpp"
 #include "continuation/scaled_problem.hpp"

@@ -1,8 +1,7 @@
 #include "continuation/point_recorder.hpp"
 
-#include <fmt/format.h>
-
 #include <cmath>
+#include <limits>
 
 #include "core/rank_report.hpp"
 
