@@ -33,8 +33,10 @@ struct BranchPoint {
   double residual = 0;            // ||F(x)||_inf of the problem (not of the augmented system)
   int newton_iterations = 0;
   double step_size = 0;  // ds used to reach this point (0 for the first point)
-  double arclength = 0;  // accumulated Euclidean distance along the branch
-  double seconds = 0;    // wall time spent on this point (prediction, correction, rank check)
+  // Sum of the chords between consecutive points, Euclidean in the scaled unknowns
+  // x ./ typical_scale() (options.scale_unknowns), the same units for every method.
+  double arclength = 0;
+  double seconds = 0;  // wall time spent on this point (prediction, correction, rank check)
   long jacobian_evaluations = 0;
   long residual_evaluations = 0;
   std::optional<core::RankReport> rank;  // when the rank was checked at this point

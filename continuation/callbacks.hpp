@@ -5,8 +5,9 @@
 // correction attempt, accepted or not, so a progress display can show rejected steps.
 // cancel_requested, when set, is polled before each step: returning true ends the branch with
 // StopReason::cancelled (e.g. a wall-clock budget). reject_point, when set, is an independent
-// check of every converged correction (x in the problem's own unknowns): a non-empty answer
-// (the reason) rejects it like a failed correction, so ds shrinks and the step is retried. A
+// check of every converged correction, the first point and a point landed on a bound included
+// (x in the problem's own unknowns): a non-empty answer (the reason) rejects it like a failed
+// correction, so ds shrinks and the step is retried (a rejected first point ends the branch). A
 // shooting residual projected on few test functions can have spurious roots; an exact
 // re-simulation of the orbit catches them.
 //

@@ -6,7 +6,9 @@
 // metres plus seconds and every new scene needs hand-tuned steps. Continuing G instead makes
 // ds, ds_min, ds_max and the arclength dimensionless (in units of the typical scale), the
 // tangent a scaled direction and the rank report a report on the column-scaled Jacobian J S,
-// whose singular values no longer depend on the units. The residual itself is the base's.
+// whose singular values no longer depend on the units. The residual itself is the base's. Both
+// continuation loops run on this view (loop_steps.hpp: in_scaled_unknowns), so natural and
+// pseudo-arclength branches report step sizes and arclength in the same units.
 //
 //   ScaledProblem scaled(problem);                 // s = problem.typical_scale()
 //   core::Vector z = scaled.to_scaled(x);          // x ./ s

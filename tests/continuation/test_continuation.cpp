@@ -1,9 +1,16 @@
 // Pseudo-arclength and natural continuation on algebraic curves with known shape: folds,
-// closed curves, failures that must end the branch cleanly.
+// closed curves, failures that must end the branch cleanly, and what both loops share (scaled
+// units of the arclength column, landing on bounds, reject_point at the first point, the
+// verifier's settings).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <iostream>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "continuation/natural.hpp"
 #include "continuation/pseudo_arclength.hpp"
@@ -357,4 +364,158 @@ TEST(Continuation, CancelRequestEndsBothLoopsKeepingThePoints) {
   EXPECT_EQ(b.reason, StopReason::cancelled) << b.message;
   EXPECT_EQ(b.points.size(), 5u);
   EXPECT_NE(b.message.find("cancelled after 5 points"), std::string::npos) << b.message;
+}
+
+namespace {
+
+// Checks a branch on a curve that is the unit circle in scaled unknowns (Circle, or the
+// millimetre circle once scaled): every arclength increment must be the chord 2 sin(dtheta / 2)
+// between consecutive points, in the scaled, dimensionless units. Points are on the circle to
+// Newton's tolerance (|z|^2 - 1 <= 1e-10, a radial error <= 5e-11), so a chord is exact to
+// ~1e-10: 1e-9 leaves room. An arclength in raw unknowns (millimetres) would be off by ~1000x.
+// Returns the largest angle step, for the chord-vs-arc bound.
+double expect_chords_of_the_unit_circle(const Branch& b) {
+  double largest = 0;
+  for (std::size_t i = 1; i < b.points.size(); ++i) {
+    const double dtheta = b.points[i].observable("angle") - b.points[i - 1].observable("angle");
+    largest = std::max(largest, std::abs(dtheta));
+    EXPECT_NEAR(b.points[i].arclength - b.points[i - 1].arclength, 2 * std::sin(dtheta / 2), 1e-9)
+        << "point " << i;
+  }
+  return largest;
+}
+
+// Arc length from angle 0 to 3 by chords of at most `largest` radians: each chord of an arc s
+// is short by s^3 / 24 + O(s^5), so the sum falls short of 3 by at most largest^2 / 24 * 3.
+void expect_arc_to_three(const Branch& b, double largest) {
+  ASSERT_FALSE(b.points.empty());
+  EXPECT_LE(b.points.back().arclength, 3.0 + 1e-9);
+  EXPECT_GE(b.points.back().arclength, 3.0 - largest * largest / 24 * 3 - 1e-9);
+}
+
+continuation::ContinuationOptions to_angle_three() {
+  auto opt = quick(200);
+  opt.ds_max = 0.1;
+  opt.bounds.push_back({"angle", -std::numbers::pi + 1e-9, 3.0});
+  return opt;
+}
+
+}  // namespace
+
+// One arclength for both loops: on the millimetre circle (unit circle in scaled unknowns, so
+// the arc from angle 0 to 3 has length exactly 3), pseudo-arclength and natural continuation in
+// the angle both report chords in scaled units, both land on the bound angle = 3 (Newton
+// tolerance 1e-10 on the bound row (angle - 3) / 3: 1e-9), and both totals are within the
+// chord-vs-arc bound of 3 (measured 2.9987903 and 2.9987931: chords of ~0.1 rad, 1.2e-3 short).
+TEST(Continuation, BothLoopsMeasureTheSameArcInScaledUnits) {
+  MillimetreCircle mm;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  const auto opt = to_angle_three();
+  const Branch arc = continuation::pseudo_arclength(mm, vec(1000, 0), vec(0, 1), *newton, opt);
+  const Branch nat = continuation::natural(
+      mm, vec(1000, 0), continuation::NaturalParameter::of_observable("angle"), *newton, opt);
+  for (const Branch* b : {&arc, &nat}) {
+    EXPECT_EQ(b->reason, StopReason::bound_reached) << b->message;
+    ASSERT_GT(b->points.size(), 20u) << b->message;
+    EXPECT_NEAR(b->points.back().observable("angle"), 3.0, 1e-9) << b->message;
+    expect_arc_to_three(*b, expect_chords_of_the_unit_circle(*b));
+  }
+  std::cout << std::setprecision(10) << "[ measured ] arclength pseudo-arclength "
+            << arc.points.back().arclength << ", natural " << nat.points.back().arclength << "\n";
+}
+
+// Natural continuation lands on a bound of another observable like pseudo-arclength does:
+// x^2 + lambda = 1 stepped in lambda from x = -1.5 (x rises) with x <= -0.5 ends on x = -0.5,
+// lambda = 0.75 (Newton tolerance 1e-10 on the rows F and (x + 0.5) / 0.5: 1e-9). Without
+// land_on_bounds it stops at its last point inside.
+TEST(Natural, LandsOnTheBound) {
+  algebraic::FoldCurve fold;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(100);
+  opt.bounds.push_back({"x", -10.0, -0.5});
+  const auto lambda = continuation::NaturalParameter::of_unknown(1, "lambda");
+  const Branch b = continuation::natural(fold, vec(-1.5, -1.25), lambda, *newton, opt);
+  EXPECT_EQ(b.reason, StopReason::bound_reached) << b.message;
+  ASSERT_GT(b.points.size(), 3u);
+  EXPECT_NEAR(b.points.back().x[0], -0.5, 1e-9);
+  EXPECT_NEAR(b.points.back().x[1], 0.75, 1e-9);
+  EXPECT_NE(b.message.find("lies on it"), std::string::npos) << b.message;
+  for (std::size_t i = 1; i < b.points.size(); ++i)
+    EXPECT_GT(b.points[i].x[0], b.points[i - 1].x[0]) << i;
+  opt.land_on_bounds = false;
+  const Branch short_of = continuation::natural(fold, vec(-1.5, -1.25), lambda, *newton, opt);
+  EXPECT_EQ(short_of.reason, StopReason::bound_reached);
+  EXPECT_LT(short_of.points.back().x[0], -0.5);
+  EXPECT_EQ(short_of.points.size() + 1, b.points.size());
+}
+
+// The first point goes through reject_point in both loops, in the problem's own unknowns
+// (millimetres here): a check that refuses the start ends the branch before any point.
+TEST(Continuation, FirstPointGoesThroughRejectPointInBothLoops) {
+  MillimetreCircle mm;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  std::vector<core::Vector> asked;
+  int rejected_attempts = 0;
+  continuation::ContinuationHooks hooks;
+  hooks.reject_point = [&](const core::Vector& x) {
+    asked.push_back(x);
+    return x[1] < 0.01 ? std::string("too close to angle 0") : std::string();
+  };
+  hooks.on_attempt = [&](const continuation::StepAttempt& a) {
+    if (a.point == 0 && !a.rejection.empty() && !a.accepted) ++rejected_attempts;
+  };
+  const auto opt = quick(20);
+  const Branch arc =
+      continuation::pseudo_arclength(mm, vec(1000, 0), vec(0, 1), *newton, opt, hooks);
+  const Branch nat = continuation::natural(mm, vec(1000, 0),
+                                           continuation::NaturalParameter::of_observable("angle"),
+                                           *newton, opt, hooks);
+  for (const Branch* b : {&arc, &nat}) {
+    EXPECT_EQ(b->reason, StopReason::newton_failed) << b->message;
+    EXPECT_TRUE(b->points.empty());
+    EXPECT_NE(b->message.find("too close to angle 0"), std::string::npos) << b->message;
+  }
+  ASSERT_EQ(asked.size(), 2u);
+  for (const core::Vector& x : asked) EXPECT_NEAR(x[0], 1000.0, 1e-6);  // millimetres
+  EXPECT_EQ(rejected_attempts, 2);
+}
+
+// natural_then_arclength adds consistent numbers: on the millimetre circle, natural in y stalls
+// at the fold y = 1 (angle pi / 2), pseudo-arclength goes on to the bound angle = 3; every
+// increment, across the switch too, is the chord in scaled units, and the total is the arc 3 to
+// the chord-vs-arc bound.
+TEST(NaturalThenArclength, AddsArclengthInTheSameUnits) {
+  MillimetreCircle mm;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = to_angle_three();
+  opt.ds_min = 1e-4;
+  const continuation::SwitchingBranch s = continuation::natural_then_arclength(
+      mm, vec(1000, 0), continuation::NaturalParameter::of_unknown(1, "y"), *newton, opt);
+  const Branch& b = s.branch;
+  ASSERT_GT(s.switch_index, 3) << b.message;
+  EXPECT_EQ(b.reason, StopReason::bound_reached) << b.message;
+  EXPECT_LT(b.points[s.switch_index - 1].observable("angle"), std::numbers::pi / 2 + 1e-6);
+  EXPECT_NEAR(b.points.back().observable("angle"), 3.0, 1e-9);
+  expect_arc_to_three(b, expect_chords_of_the_unit_circle(b));
+}
+
+// The rank verification runs with the corrector options.verification describes: probes 0.05
+// along the circle's tangent start 1.25e-3 off the circle, and one Newton iteration (quadratic:
+// to ~1e-6) cannot reach the verifier's 1e-10, while the default 60 can (3 iterations).
+TEST(Continuation, VerificationUsesTheVerifyOptionsCorrector) {
+  algebraic::Circle circle;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(6);
+  opt.rank_check_every = 1;
+  opt.verification.step = 0.05;
+  const Branch verified =
+      continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  opt.verification.max_iterations = 1;
+  const Branch capped = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  ASSERT_EQ(verified.points.size(), 6u);
+  ASSERT_EQ(capped.points.size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(verified.points[i].dimension, 1) << i;
+    EXPECT_EQ(capped.points[i].dimension, 0) << i;
+  }
 }

@@ -1,6 +1,7 @@
 // Rank reports on known matrices and verification of candidate null directions: a regular
 // circle and sphere (candidate = verified) and the double-root parabola, whose Jacobian is
-// identically zero on the solution curve (candidate nullity 2, verified dimension 1).
+// identically zero on the solution curve (candidate nullity 2, verified dimension 1), and the
+// verifier's corrector settings carried by VerifyOptions.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -92,6 +93,32 @@ TEST(RankReport, OptionsValidationNamesTheField) {
   v = {};
   v.step = -1e-3;
   EXPECT_THROW(v.validate(), InputError);
+  v = {};
+  v.max_iterations = 0;
+  try {
+    v.validate();
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "verify.max_iterations");
+  }
+  v = {};
+  v.corrector_tolerance_ratio = 0;
+  EXPECT_THROW(make_verifier(v), InputError);
+}
+
+// The verifier's corrector follows VerifyOptions: its tolerance is ratio * residual_tolerance
+// (defaults 0.1 * 1e-9 = 1e-10, what the continuation and the bench used by hand) and its
+// iteration cap is max_iterations (default 60).
+TEST(VerifyNullDirections, VerifierSettingsComeFromVerifyOptions) {
+  VerifyOptions v;
+  EXPECT_DOUBLE_EQ(v.corrector_options().residual_tolerance, 1e-10);
+  EXPECT_EQ(v.corrector_options().max_iterations, 60);
+  v.residual_tolerance = 1e-6;
+  v.corrector_tolerance_ratio = 0.5;
+  v.max_iterations = 7;
+  EXPECT_DOUBLE_EQ(v.corrector_options().residual_tolerance, 5e-7);
+  EXPECT_EQ(v.corrector_options().max_iterations, 7);
+  EXPECT_EQ(make_verifier(v)->name(), "eigen");
 }
 
 // Rank report + verification at a solution point x of `problem`.
@@ -169,6 +196,24 @@ TEST(VerifyNullDirections, DoubleRootWithMisalignedBasisIsACurve) {
       // Secants from h = 1e-3 probes: the tangent is recovered to O(h).
       EXPECT_NEAR(std::abs(r.null_directions.col(j).dot(tangent)), 1.0, 1e-2);
     }
+  }
+}
+
+// At (1, 1) on the double root, a probe starts with |y - x^2| ~ 2e-3 and Newton halves it per
+// iteration (F = g^2): reaching ||F|| <= 1e-10 (|g| <= 1e-5) takes about 8 iterations. The
+// default verifier (60) verifies the curve; one capped at 3 iterations cannot, so the cap is
+// the one VerifyOptions sets.
+TEST(VerifyNullDirections, DoubleRootNeedsTheVerifiersIterationBudget) {
+  DoubleRootParabola p;
+  const Vector x = Vector::Ones(2);
+  Matrix J;
+  ASSERT_EQ(p.jacobian(x, J), EvalStatus::ok);
+  for (const int cap : {60, 3}) {
+    VerifyOptions v;
+    v.max_iterations = cap;
+    RankReport r = rank_report(J, RankOptions{});
+    verify_null_directions(p, x, *make_verifier(v), v, r);
+    EXPECT_EQ(r.verified_dimension, cap == 60 ? 1 : 0) << cap << ": " << r.summary();
   }
 }
 
