@@ -49,7 +49,7 @@ bool has_branch(const fs::path& dir) {
 }
 
 // u(x, t) over one period of the orbit by TD-BEM snapshots (the field at one instant each):
-// the gnuplot grid text (t,x,u blocks) and, per node of the snapshot grid, max_t |u|.
+// the gnuplot grid text (one t,x,u block per instant) and the snapshots themselves.
 struct SpaceTime {
   std::string text = "t,x,u\n";
   std::vector<bar::FieldSnapshot> snapshots;
