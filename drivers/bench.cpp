@@ -1,13 +1,13 @@
-// `backbone bench [--case NAME] [--out DIR]`: runs the contact bar's benchmark cases
-// (problems/contact_bar/bench.hpp), all of them or the one named, into --out (default
-// results/bench), and reports the time each took.
+// `backbone bench [--case NAME] [--out DIR]`: the contact bar's benchmark cases
+// (problems/contact_bar/bench.hpp), all or the one named, and the time each took.
 #include "problems/contact_bar/bench.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ostream.h>
 
+#include <algorithm>
 #include <boost/program_options.hpp>
 #include <chrono>
-#include <sstream>
 
 #include "core/errors.hpp"
 #include "drivers/commands.hpp"
@@ -15,11 +15,11 @@
 namespace {
 
 namespace po = boost::program_options;
-using namespace backbone;
+namespace core = backbone::core;
 
 int run_bench(const std::vector<std::string>& args) {
-  const std::vector<continuation::ProblemJob> cases = contact_bar::bench_cases();
-  std::string names;
+  const auto cases = backbone::contact_bar::bench_cases();
+  std::string names;  // "tdbem_scaling, bouncing_bar, ...": for --help and errors
   for (const auto& c : cases) names += (names.empty() ? "" : ", ") + c.name;
   po::options_description keys("backbone bench");
   keys.add_options()("case", po::value<std::string>(),
@@ -34,9 +34,7 @@ int run_bench(const std::vector<std::string>& args) {
     throw core::InputError("", e.what());
   }
   if (vm.count("help")) {
-    std::ostringstream text;
-    text << keys;
-    fmt::print("usage: backbone bench [--case NAME] [--out DIR]\n{}", text.str());
+    fmt::print("usage: backbone bench [--case NAME] [--out DIR]\n{}", fmt::streamed(keys));
     return 0;
   }
   const std::string selected = vm.count("case") ? vm["case"].as<std::string>() : "";
@@ -57,5 +55,5 @@ int run_bench(const std::vector<std::string>& args) {
 }  // namespace
 
 static const bool registered = backbone::drivers::register_command(
-    {"bench", "[--case tdbem_scaling|bouncing_bar|mode1_convergence|formulations] [--out DIR]",
-     "benchmarks with known answers (CSV + PNG in results/bench)", run_bench});
+    {"bench", "[--case NAME] [--out DIR]", "benchmarks with known answers (results/bench)",
+     run_bench});

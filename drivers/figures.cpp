@@ -3,10 +3,10 @@
 #include "problems/contact_bar/figures.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ostream.h>
 
 #include <algorithm>
 #include <boost/program_options.hpp>
-#include <sstream>
 
 #include "core/errors.hpp"
 #include "drivers/commands.hpp"
@@ -28,9 +28,7 @@ int run_figures(const std::vector<std::string>& args) {
     throw core::InputError("", e.what());
   }
   if (vm.count("help")) {
-    std::ostringstream text;
-    text << keys;
-    fmt::print("{}", text.str());
+    fmt::print("{}", fmt::streamed(keys));
     return 0;
   }
   int status = 0;
