@@ -2,13 +2,16 @@
 //
 // The scalar is either one unknown (e.g. the period, as the paper does: fix T, solve for u0)
 // or a named observable of the problem (energy, amplitude...). Each point solves the square
-// system [F(x); p(x) - lambda] = 0 (ParameterConstraintSystem, itself a core::Problem) at
-// lambda_k = lambda_0 + direction * sum of steps, from a secant or tangent predictor. It cannot
-// pass a fold in p: there Newton fails, ds shrinks to ds_min and the branch ends with
-// StopReason::step_floor, keeping the points computed so far (switching.hpp then hands over to
-// pseudo-arclength). With options.scale_unknowns an unknown parameter steps by
-// ds * typical_scale (ds dimensionless, as in pseudo-arclength); an observable steps in its own
-// units. The loop prints nothing.
+// system [F(x); p(x) - lambda] = 0 (F bordered by one parameter row, core/bordered_system.hpp;
+// ParameterConstraintSystem below) at lambda_k = lambda_0 + direction * sum of steps, from a
+// secant or tangent predictor. It cannot pass a fold in p: there Newton fails, ds shrinks to
+// ds_min and the branch ends with StopReason::step_floor, keeping the points computed so far
+// (switching.hpp then hands over to pseudo-arclength). The loop shares with pseudo-arclength
+// (loop_steps.hpp, continuation/README.md) the scaled unknowns (options.scale_unknowns: an
+// unknown parameter steps by ds * typical_scale, an observable in its own units), the arclength
+// column (sum of chords in the scaled unknowns, the same units as pseudo-arclength's), the
+// first-point and step checks of hooks.reject_point and landing on bounds (the last point lies on
+// the bound). The loop prints nothing.
 //
 //   auto newton = core::make_corrector("eigen", core::NewtonOptions{});
 //   ContinuationOptions opt; opt.method = Method::natural; opt.ds = 0.05; opt.max_points = 20;
@@ -22,6 +25,7 @@
 #include "continuation/branch.hpp"
 #include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
+#include "core/bordered_system.hpp"
 #include "core/newton.hpp"
 #include "core/problem.hpp"
 
@@ -42,33 +46,23 @@ struct NaturalParameter {
 double parameter_value(const core::Problem& problem, const NaturalParameter& parameter,
                        const core::Vector& x);
 
-// [F(x); p(x) - value]. The last Jacobian row is e_index for an unknown, central differences
-// of the observable otherwise (observables are cheap closed forms of x in every problem here).
-// An observable's row is divided by |value| (1 when value = 0): an energy of 1e-3 J must not
-// weigh 1e-4 against residual rows of order one when an overdetermined system is solved in the
-// least-squares sense (measured: Newton then crawls, 3.8e-5 -> 3.0e-5 in 25 iterations).
-class ParameterConstraintSystem : public core::Problem {
+// The row p(x) - value of a core::BorderedSystem over `problem`: a fixed unknown (e_index .
+// x - value) or an observable row (divided by |value|, 1 when value = 0: an energy of 1e-3 J
+// must not weigh 1e-3 against residual rows of order one when an overdetermined system is
+// solved in the least-squares sense; measured: Newton then crawls, 3.8e-5 -> 3.0e-5 in 25
+// iterations). Throws core::InputError for an unknown index out of range.
+core::BorderRow parameter_row(const core::Problem& problem, const NaturalParameter& parameter,
+                              double value);
+
+// [F(x); p(x) - value]: the bordered system with the one row parameter_row(...), under the name
+// callers know it by. set_value moves the prescribed value.
+class ParameterConstraintSystem : public core::BorderedSystem {
  public:
-  ParameterConstraintSystem(const core::Problem& base, NaturalParameter parameter, double value);
-  int num_unknowns() const override { return base_.num_unknowns(); }
-  int num_equations() const override { return base_.num_equations() + 1; }
-  std::string name() const override { return base_.name() + " + " + parameter_.name + " fixed"; }
-  core::Observables observables(const core::Vector& x) const override {
-    return base_.observables(x);
-  }
-  core::Vector typical_scale() const override { return base_.typical_scale(); }
-  void set_value(double value) { value_ = value; }
-  // Divisor of the constraint row: 1 for an unknown, |value| (or 1 at 0) for an observable.
-  double row_scale() const;
-
- protected:
-  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
-  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
-
- private:
-  const core::Problem& base_;
-  NaturalParameter parameter_;
-  double value_;
+  ParameterConstraintSystem(const core::Problem& base, const NaturalParameter& parameter,
+                            double value)
+      : BorderedSystem(base, {parameter_row(base, parameter, value)}) {}
+  using BorderedSystem::set_value;
+  void set_value(double value) { set_value(0, value); }
 };
 
 // Throws core::InputError for bad options, sizes, an unknown index out of range or an

@@ -5,10 +5,12 @@
 // shrink_factor when it needed at least slow_iterations; a failed correction shrinks ds and
 // retries from the same point, and the branch ends with StopReason::step_floor once ds would
 // fall below ds_min. Bounds end the branch when an observable leaves [min, max]; the last point
-// is then re-corrected onto the bound itself. Pseudo-arclength distances (ds, arclength) are
+// is then re-corrected onto the bound itself (land_on_bounds, both methods). Distances are
 // Euclidean in the unknowns divided by the problem's typical_scale() (scale_unknowns, the
-// default: dimensionless, so one ds fits every scene of a problem); natural continuation steps
-// an unknown parameter by ds times its typical scale, an observable in its own units.
+// default: dimensionless, so one ds fits every scene of a problem): pseudo-arclength's ds, and
+// the arclength column of both methods (sum of chords between consecutive points); natural
+// continuation steps an unknown parameter by ds times its typical scale, an observable in its
+// own units. `verification` also sets the verifier's corrector (core::VerifyOptions).
 //
 //   ContinuationOptions opt;
 //   opt.ds = 0.01; opt.ds_max = 0.5; opt.max_points = 200;
@@ -52,8 +54,9 @@ struct ContinuationOptions {
   double grow_factor = 1.5;    // > 1
   double shrink_factor = 0.5;  // in (0, 1); also used after a failed correction
   int max_points = 100;        // including the first (corrected guess)
-  // Pseudo-arclength in z = x ./ typical_scale() (see scaled_problem.hpp), natural steps of an
-  // unknown in units of its typical scale; false: raw unknowns.
+  // Both loops in z = x ./ typical_scale() (see scaled_problem.hpp): pseudo-arclength's ds and
+  // both arclength columns in those units, natural steps of an unknown in units of its typical
+  // scale; false: raw unknowns.
   bool scale_unknowns = true;
   std::vector<Bound> bounds;
   bool land_on_bounds = true;  // re-correct the crossing point onto the bound

@@ -4,7 +4,6 @@
 
 #include <cmath>
 
-#include "core/errors.hpp"
 #include "core/rank_report.hpp"
 
 namespace backbone::continuation {
@@ -12,13 +11,8 @@ namespace backbone::continuation {
 PointRecorder::PointRecorder(const core::Problem& problem, const ContinuationOptions& options,
                              const core::Problem* counted)
     : problem_(problem), counted_(counted ? *counted : problem), options_(options) {
-  if (options.rank_check_every > 0 && options.verify) {
-    core::NewtonOptions newton;
-    newton.residual_tolerance =
-        std::min(newton.residual_tolerance, 0.1 * options.verification.residual_tolerance);
-    newton.max_iterations = 60;  // degenerate residuals converge linearly
-    verifier_ = core::make_corrector("eigen", newton);
-  }
+  if (options.rank_check_every > 0 && options.verify)
+    verifier_ = core::make_verifier(options.verification);
 }
 
 void PointRecorder::begin() {
@@ -79,47 +73,6 @@ const Bound* PointRecorder::violated_bound(const BranchPoint& point, double& val
     }
   }
   return nullptr;
-}
-
-bool cancelled(const ContinuationHooks& hooks, Branch& branch) {
-  if (!hooks.cancel_requested || !hooks.cancel_requested()) return false;
-  branch.reason = StopReason::cancelled;
-  branch.message = fmt::format("cancelled after {} points", branch.points.size());
-  return true;
-}
-
-Branch reached_max_points(Branch branch) {
-  branch.reason = StopReason::max_points;
-  branch.message = fmt::format("{} points computed", branch.points.size());
-  return branch;
-}
-
-std::string describe_point(const core::Vector& x) {
-  std::string s = "x = (";
-  for (Eigen::Index i = 0; i < x.size() && i < 4; ++i)
-    s += fmt::format("{}{:.10g}", i ? ", " : "", x[i]);
-  if (x.size() > 4) s += fmt::format(", ... {} entries", x.size());
-  return s + ")";
-}
-
-void check_sizes(const core::Problem& problem, const core::Vector& guess,
-                 const core::Vector& direction, const char* what) {
-  const int n = problem.num_unknowns();
-  const int m = problem.num_equations();
-  if (m < n - 1)
-    throw core::InputError("method", fmt::format("{}: it needs at least n - 1 equations for n "
-                                                 "unknowns ({} unknowns vs {} equations)",
-                                                 what, n, m));
-  if (guess.size() != n)
-    throw core::InputError("guess", fmt::format("dimensions of the guess and the unknowns do not "
-                                                "match ({} vs {})",
-                                                guess.size(), n));
-  if (direction.size() != 0 && direction.size() != n)
-    throw core::InputError("direction",
-                           fmt::format("dimensions of the direction and the unknowns do not match "
-                                       "({} vs {})",
-                                       direction.size(), n));
-  if (!guess.allFinite()) throw core::InputError("guess", "contains NaN or Inf");
 }
 
 }  // namespace backbone::continuation

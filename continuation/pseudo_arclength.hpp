@@ -4,16 +4,17 @@
 // corrector then solves each step in the least-squares sense, KINSOL refuses (square only).
 //
 // From a point x_k with unit tangent t_k the predictor is x_k + ds t_k (or the secant
-// direction), and the corrector solves the augmented system
+// direction), and the corrector solves F bordered by the arclength row,
 //     F(x) = 0,    t_k . (x - x_k) - ds = 0,
-// which is itself a core::Problem (ArclengthSystem, the LOCA habit): any corrector solves it,
-// KINSOL included, since it is square when m = n - 1. The tangent at a point is the solution
-// of [J; t_prev^T] t = [0; 1], normalised: it spans the null space of J and keeps the
-// orientation of the previous tangent, so the branch goes through folds without reversing.
+// a core::BorderedSystem with one linear row (core/bordered_system.hpp, the LOCA habit): any
+// corrector solves it, KINSOL included, since it is square when m = n - 1. The tangent at a point
+// is the solution of [J; t_prev^T] t = [0; 1], normalised: it spans the null space of J and keeps
+// the orientation of the previous tangent, so the branch goes through folds without reversing.
 // The first point is the guess corrected on the hyperplane through it orthogonal to the
-// direction hint. The curve is followed in the scaled unknowns x ./ typical_scale() (options.
-// scale_unknowns, scaled_problem.hpp): ds is dimensionless, the branch's points are returned in
-// the problem's own unknowns. The loop prints nothing (see callbacks.hpp); failures are a
+// direction hint. Scaling (ds, step_size and arclength dimensionless, in z = x ./ typical_scale()),
+// the first point, the step shrinking, hooks.reject_point and landing on bounds are shared with
+// natural continuation (loop_steps.hpp, continuation/README.md); the branch's points are returned
+// in the problem's own unknowns. The loop prints nothing (see callbacks.hpp); failures are a
 // StopReason.
 //
 //   auto newton = core::make_corrector("kinsol", core::NewtonOptions{});
@@ -31,29 +32,6 @@
 #include "core/problem.hpp"
 
 namespace backbone::continuation {
-
-// [F(x); tangent . (x - anchor) - ds]: n equations in n unknowns when F has n - 1.
-// Observables and typical scale are the base problem's. Holds a reference to base.
-class ArclengthSystem : public core::Problem {
- public:
-  ArclengthSystem(const core::Problem& base, core::Vector anchor, core::Vector tangent, double ds);
-  int num_unknowns() const override { return base_.num_unknowns(); }
-  int num_equations() const override { return base_.num_equations() + 1; }
-  std::string name() const override { return base_.name() + " + arclength"; }
-  core::Observables observables(const core::Vector& x) const override {
-    return base_.observables(x);
-  }
-  core::Vector typical_scale() const override { return base_.typical_scale(); }
-
- protected:
-  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
-  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
-
- private:
-  const core::Problem& base_;
-  core::Vector anchor_, tangent_;
-  double ds_;
-};
 
 // Unit tangent of F = 0 at x oriented like `orientation` (t . orientation > 0): minimum-norm
 // solution of [J; orientation^T] t = [0; 1], singular values below relative_threshold *

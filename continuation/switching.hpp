@@ -6,8 +6,9 @@
 // steeply in it. natural_then_arclength runs natural() and, when it ends at the step floor with
 // at least two points, restarts pseudo_arclength() from its last point in the direction of the
 // secant through its last two, for the remaining max_points. The result is one branch: indices
-// and arclength continue across the switch, switch_index says where it happened (-1: natural
-// reached its planned end), and the message says both parts.
+// and arclength continue across the switch (both loops measure it in the same scaled units,
+// options.hpp), switch_index says where it happened (-1: natural reached its planned end), and
+// the message says both parts.
 //
 //   NaturalParameter T = NaturalParameter::of_unknown(problem.period_index(), "period", -1.0);
 //   SwitchingBranch b = natural_then_arclength(problem, guess, T, *newton, options, hooks);

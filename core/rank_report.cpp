@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/bordered_system.hpp"
 #include "core/errors.hpp"
 
 namespace backbone::core {
@@ -26,6 +27,23 @@ void VerifyOptions::validate() const {
                      fmt::format("must be finite and > 0 (got {})", residual_tolerance));
   if (!(drift_ratio > 0 && drift_ratio < 1))
     throw InputError("verify.drift_ratio", fmt::format("must be in (0, 1) (got {})", drift_ratio));
+  if (max_iterations < 1)
+    throw InputError("verify.max_iterations", fmt::format("must be >= 1 (got {})", max_iterations));
+  if (!(corrector_tolerance_ratio > 0 && corrector_tolerance_ratio <= 1))
+    throw InputError("verify.corrector_tolerance_ratio",
+                     fmt::format("must be in (0, 1] (got {})", corrector_tolerance_ratio));
+}
+
+NewtonOptions VerifyOptions::corrector_options() const {
+  NewtonOptions newton;
+  newton.residual_tolerance = corrector_tolerance_ratio * residual_tolerance;
+  newton.max_iterations = max_iterations;
+  return newton;
+}
+
+std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options) {
+  options.validate();
+  return make_corrector("eigen", options.corrector_options());
 }
 
 RankReport rank_report(const Matrix& J, const RankOptions& options) {
@@ -66,41 +84,6 @@ std::string RankReport::summary() const {
 
 namespace {
 
-// F(y) = 0 restricted to the hyperplane direction . (y - anchor) = 0: m + 1 equations.
-class HyperplaneConstrained : public Problem {
- public:
-  HyperplaneConstrained(const Problem& base, Vector direction, Vector anchor)
-      : base_(base), direction_(std::move(direction)), anchor_(std::move(anchor)) {}
-  int num_unknowns() const override { return base_.num_unknowns(); }
-  int num_equations() const override { return base_.num_equations() + 1; }
-  std::string name() const override { return base_.name() + " on a hyperplane"; }
-  Vector typical_scale() const override { return base_.typical_scale(); }
-
- protected:
-  EvalStatus compute_residual(const Vector& y, Vector& r) const override {
-    Vector f;
-    const EvalStatus s = base_.residual(y, f);
-    if (s != EvalStatus::ok) return s;
-    const Eigen::Index m = f.size();
-    r.head(m) = f;
-    r[m] = direction_.dot(y - anchor_);
-    return EvalStatus::ok;
-  }
-  EvalStatus compute_jacobian(const Vector& y, Matrix& J) const override {
-    Matrix base_jacobian;
-    const EvalStatus s = base_.jacobian(y, base_jacobian);
-    if (s != EvalStatus::ok) return s;
-    const Eigen::Index m = base_jacobian.rows();
-    J.topRows(m) = base_jacobian;
-    J.row(m) = direction_.transpose();
-    return EvalStatus::ok;
-  }
-
- private:
-  const Problem& base_;
-  Vector direction_, anchor_;
-};
-
 struct Probe {
   bool converged = false;
   Vector secant;                                           // (corrected point - x) / h
@@ -112,7 +95,7 @@ Probe probe(const Problem& problem, const Vector& x, const Vector& d, double h,
             Corrector& corrector, const VerifyOptions& options) {
   Probe result;
   const Vector stepped = x + h * d;
-  HyperplaneConstrained constrained(problem, d, stepped);
+  const BorderedSystem constrained(problem, {BorderRow::hyperplane(d, stepped)});
   Vector y = stepped;
   const NewtonSummary s = corrector.solve(constrained, y);
   if (!y.allFinite()) return result;

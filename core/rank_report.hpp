@@ -3,17 +3,21 @@
 // The numerical rank of J (m x n) at a converged point comes from its singular values with a
 // relative threshold (tau * sigma_max, tau documented in RankOptions). nullity = n - rank is
 // the *candidate* dimension of the solution manifold. Because a rank count on a degenerate
-// residual says nothing (DESIGN.md section 3: the paper's shooting residual is a double root),
-// verify_null_directions steps along each candidate null direction, re-corrects with a Newton
-// corrector constrained to the hyperplane orthogonal to that direction, and counts the
-// directions along which nearby solutions really exist.
+// residual says nothing (core/README.md: the paper's shooting residual is a double root),
+// verify_null_directions steps along each candidate null direction, re-corrects F plus the
+// hyperplane through the stepped point orthogonal to that direction (a BorderedSystem with one
+// row, bordered_system.hpp), and counts the directions along which nearby solutions really exist.
+// VerifyOptions also carries the settings of the corrector that does this (make_verifier).
 //
 //   Matrix J; problem.jacobian(x, J);
 //   RankReport rep = rank_report(J, RankOptions{});
-//   verify_null_directions(problem, x, *newton, VerifyOptions{}, rep);
+//   const VerifyOptions verify;
+//   auto verifier = make_verifier(verify);        // eigen, least squares, verify's tolerances
+//   verify_null_directions(problem, x, *verifier, verify, rep);
 //   fmt::print("nullity {} verified {}\n", rep.nullity, rep.verified_dimension);
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -34,25 +38,37 @@ struct RankOptions {
 };
 
 struct VerifyOptions {
-  double step = 1e-3;               // step length along each null direction (scaled units)
-  double residual_tolerance = 1e-9; // re-corrected point must reach this
+  double step = 1e-3;                // step length along each null direction (scaled units)
+  double residual_tolerance = 1e-9;  // re-corrected point must reach this
   // A direction is real when the re-corrected point stays within drift_ratio * step of the
   // stepped point in the orthogonal complement (the solution set passes near it).
   double drift_ratio = 0.1;
+  // The verifier's corrector (make_verifier): at most max_iterations, because degenerate
+  // residuals converge linearly (the error halves per iteration at a double root), and it stops
+  // at ||F||_inf <= corrector_tolerance_ratio * residual_tolerance, so that a converged probe
+  // passes the residual_tolerance test with a margin.
+  int max_iterations = 60;
+  double corrector_tolerance_ratio = 0.1;
   void validate() const;
+  // NewtonOptions' defaults with the two settings above.
+  NewtonOptions corrector_options() const;
 };
 
+// The corrector verify_null_directions is meant to run with: eigen (each probe has m + 1
+// equations in n unknowns, solved in the least-squares sense) with options.corrector_options().
+std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options);
+
 struct RankReport {
-  Vector singular_values;      // descending
-  double threshold = 0;  // value used: max(relative_threshold * sigma_max, absolute_threshold)
+  Vector singular_values;  // descending
+  double threshold = 0;    // value used: max(relative_threshold * sigma_max, absolute_threshold)
   double relative_threshold = 0;
   int rank = 0;
-  int nullity = 0;             // num_unknowns - rank: candidate manifold dimension
-  double gap = 0;              // sigma_rank / sigma_{rank+1} (inf when no small one)
-  Matrix null_directions;      // n x nullity, orthonormal
-  int verified_dimension = -1; // -1 until verify_null_directions ran
+  int nullity = 0;              // num_unknowns - rank: candidate manifold dimension
+  double gap = 0;               // sigma_rank / sigma_{rank+1} (inf when no small one)
+  Matrix null_directions;       // n x nullity, orthonormal
+  int verified_dimension = -1;  // -1 until verify_null_directions ran
   std::vector<bool> direction_verified;
-  std::string summary() const; // one line for logs: "rank 40/41, nullity 1 (verified 1), ..."
+  std::string summary() const;  // one line for logs: "rank 40/41, nullity 1 (verified 1), ..."
 };
 
 RankReport rank_report(const Matrix& J, const RankOptions& options);
