@@ -32,16 +32,6 @@ namespace {
 
 const double nan = std::numeric_limits<double>::quiet_NaN();
 
-// THE ONE PLACE for the continuation's verifier settings (continuation/point_recorder.cpp):
-// eigen Newton, tolerance a tenth of VerifyOptions' residual tolerance, 60 iterations. To be
-// taken from core::VerifyOptions once it carries them (branch h1-bordered).
-std::unique_ptr<core::Corrector> continuation_verifier() {
-  core::NewtonOptions options;
-  options.residual_tolerance = 0.1 * core::VerifyOptions{}.residual_tolerance;
-  options.max_iterations = 60;
-  return core::make_corrector("eigen", options);
-}
-
 // End amplitudes (ratio * g0) along each branch, from grazing to E ~ 1e-2 J, the top of the
 // traced range: mode 1 E = (ratio g0)^2 / 2 (5e-3 J at 100), mode 2 E = ((2 ratio + 1) g0)^2 / 2
 // (9.9e-3 J at 70).
@@ -149,7 +139,9 @@ RankColumns rank_columns(const core::PeriodicOrbitProblem& problem, const core::
   c.period_column_forward = forward.col(period).lpNorm<Eigen::Infinity>();
   c.period_column_central = central.col(period).lpNorm<Eigen::Infinity>();
   c.uncertainty = Eigen::JacobiSVD<core::Matrix>(forward - central).singularValues()[0];
-  const auto verifier = continuation_verifier();
+  // The continuation's verifier (continuation/point_recorder.cpp): default VerifyOptions.
+  const core::VerifyOptions verify;
+  const auto verifier = core::make_verifier(verify);
   core::RankOptions absolute;
   absolute.absolute_threshold = c.uncertainty;
   core::RankOptions relative;
@@ -159,7 +151,7 @@ RankColumns rank_columns(const core::PeriodicOrbitProblem& problem, const core::
   c.absolute = core::rank_report(forward, absolute);
   c.central = core::rank_report(central, relative);
   for (core::RankReport* report : {&c.relative, &c.absolute, &c.central})
-    core::verify_null_directions(problem, x, *verifier, core::VerifyOptions{}, *report);
+    core::verify_null_directions(problem, x, *verifier, verify, *report);
   return c;
 }
 
