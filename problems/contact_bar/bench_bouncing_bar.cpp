@@ -56,8 +56,8 @@ int bench_bouncing_bar(const std::filesystem::path& out) {
       {"fem", [&](const auto& o) { return fem.simulate(setup, o); }, fem_force_window, 1},
       {"fem_c0.9", [&](const auto& o) { return fem.simulate(setup, o); }, fem_force_window, 0.9}};
 
-  bench::LabelledTable table({"method", "elements", "dt", "max_u_error", "force_error",
-                              "energy_drift", "seconds", "max_u_error_period1"});
+  core::Table table({"method", "elements", "dt", "max_u_error", "force_error", "energy_drift",
+                     "seconds", "max_u_error_period1"});
   for (const MethodRun& m : methods) {
     for (int elements : {25, 50, 100, 200, 400, 800, 1600}) {
       bar::SimulationOptions o;
@@ -85,14 +85,14 @@ int bench_bouncing_bar(const std::filesystem::path& out) {
       const bar::History he = m.simulate(o);
       double drift = 0;
       for (double e : he.energy) drift = std::max(drift, std::abs(e - he.energy.front()));
-      table.add_row({m.name, elements, o.dt, max_u_error, force_error, drift / energy_scale,
-                     seconds, max_u_error_period1});
+      table.add_row(m.name, {double(elements), o.dt, max_u_error, force_error, drift / energy_scale,
+                             seconds, max_u_error_period1});
     }
     fmt::print("  {} done\n", m.name);
   }
   const std::filesystem::path csv = out / "bouncing_bar.csv";
   table.write_csv(csv);
-  bench::print_table(table);
+  fmt::print("{}", table.aligned());
   fmt::print(
       "  force_error: relative L1 error of step-averaged contact forces; energy_drift: "
       "max |E(t) - E(0)| / (|b| A L h0 = {:g} J)\n",

@@ -18,6 +18,7 @@
 #include "core/periodic_orbit.hpp"
 #include "core/plot.hpp"
 #include "core/rank_report.hpp"
+#include "core/table.hpp"
 #include "problems/contact_bar/bench.hpp"
 #include "problems/contact_bar/bench_metrics.hpp"
 #include "problems/contact_bar/bench_support.hpp"
@@ -187,12 +188,12 @@ int bench_formulations(const std::filesystem::path& out) {
         {"central_sigma_min_relative", "nullity_central", "verified_central"},
         {"residual_unit", "seconds"}})
     columns.insert(columns.end(), group.begin(), group.end());
-  bench::LabelledTable table(columns);
-  bench::LabelledTable history({"mode", "amplitude_ratio", "formulation", "iteration", "residual",
-                                "energy_error", "u0_error"});
-  bench::LabelledTable screen({"mode", "A/g0", "form", "status", "it", "|F| [m]", "order_F",
-                               "order_err", "u0_err", "T_err", "return_err", "smin/smax",
-                               "null/ver", "abs", "central", "x*: smin/smax"});
+  core::Table table(columns);
+  core::Table history({"mode", "amplitude_ratio", "formulation", "iteration", "residual",
+                       "energy_error", "u0_error"});
+  core::Table screen({"mode", "A/g0", "form", "status", "it", "|F| [m]", "order_F", "order_err",
+                      "u0_err", "T_err", "return_err", "smin/smax", "null/ver", "abs", "central",
+                      "x*: smin/smax"});
   const auto counts = [](const core::RankReport& r) {
     return fmt::format("{}/{}", r.nullity, r.verified_dimension);
   };
@@ -251,54 +252,54 @@ int bench_formulations(const std::filesystem::path& out) {
         const double sigma_max =
             rank.relative.singular_values.size() ? rank.relative.singular_values[0] : nan;
         const std::string status = core::to_string(trace.status);
-        table.add_row({label,
-                       status,
-                       branch.mode,
-                       ratio,
-                       energy,
-                       exact_residual,
-                       exact_sigma_min,
-                       at_exact.nullity,
-                       trace.shooting_residual.front(),
-                       trace.u0_error.front(),
-                       trace.iterations,
-                       trace.shooting_residual.back(),
-                       trace.energy_error.back(),
-                       residual_rate.order,
-                       residual_rate.ratio,
-                       trace.u0_error.back(),
-                       error_rate.order,
-                       error_rate.ratio,
-                       period_error,
-                       knot_error,
-                       returned.displacement,
-                       returned.velocity,
-                       rank.period_column_forward,
-                       rank.period_column_central,
-                       rank.uncertainty,
-                       rank.sigma_min(1),
-                       rank.sigma_min(2),
-                       rank.sigma_min(3),
-                       sigma_max,
-                       rank.relative.threshold,
-                       rank.relative.nullity,
-                       rank.relative.verified_dimension,
-                       rank.absolute.threshold,
-                       rank.absolute.nullity,
-                       rank.absolute.verified_dimension,
-                       rank.central_sigma_min_relative(),
-                       rank.central.nullity,
-                       rank.central.verified_dimension,
-                       unit,
-                       trace.seconds});
+        table.add_cells({label,
+                         status,
+                         double(branch.mode),
+                         ratio,
+                         energy,
+                         exact_residual,
+                         exact_sigma_min,
+                         double(at_exact.nullity),
+                         trace.shooting_residual.front(),
+                         trace.u0_error.front(),
+                         double(trace.iterations),
+                         trace.shooting_residual.back(),
+                         trace.energy_error.back(),
+                         residual_rate.order,
+                         residual_rate.ratio,
+                         trace.u0_error.back(),
+                         error_rate.order,
+                         error_rate.ratio,
+                         period_error,
+                         knot_error,
+                         returned.displacement,
+                         returned.velocity,
+                         rank.period_column_forward,
+                         rank.period_column_central,
+                         rank.uncertainty,
+                         rank.sigma_min(1),
+                         rank.sigma_min(2),
+                         rank.sigma_min(3),
+                         sigma_max,
+                         rank.relative.threshold,
+                         double(rank.relative.nullity),
+                         double(rank.relative.verified_dimension),
+                         rank.absolute.threshold,
+                         double(rank.absolute.nullity),
+                         double(rank.absolute.verified_dimension),
+                         rank.central_sigma_min_relative(),
+                         double(rank.central.nullity),
+                         double(rank.central.verified_dimension),
+                         unit,
+                         trace.seconds});
         for (std::size_t k = 0; k < trace.shooting_residual.size(); ++k)
-          history.add_row({branch.mode, ratio, label, k, trace.shooting_residual[k],
-                           trace.energy_error[k], trace.u0_error[k]});
-        screen.add_row({branch.mode, ratio, label, status, trace.iterations,
-                        trace.shooting_residual.back(), residual_rate.order, error_rate.order,
-                        trace.u0_error.back(), period_error, returned.worst(),
-                        rank.sigma_min(1) / sigma_max, counts(rank.relative), counts(rank.absolute),
-                        counts(rank.central), exact_sigma_min});
+          history.add_cells({double(branch.mode), ratio, label, double(k),
+                             trace.shooting_residual[k], trace.energy_error[k], trace.u0_error[k]});
+        screen.add_cells({double(branch.mode), ratio, label, status, double(trace.iterations),
+                          trace.shooting_residual.back(), residual_rate.order, error_rate.order,
+                          trace.u0_error.back(), period_error, returned.worst(),
+                          rank.sigma_min(1) / sigma_max, counts(rank.relative),
+                          counts(rank.absolute), counts(rank.central), exact_sigma_min});
       }
     }
   }
@@ -306,7 +307,7 @@ int bench_formulations(const std::filesystem::path& out) {
   const std::filesystem::path hcsv = out / "formulations_history.csv";
   table.write_csv(csv);
   history.write_csv(hcsv);
-  bench::print_table(screen);
+  fmt::print("{}", screen.aligned());
   fmt::print(
       "  |F|: final ||F||_inf; order_F, order_err: median observed order of the residual and of "
       "u0_err = max|u0 - u0*| / max|u0*| (2 quadratic, 1 linear);\n  T_err: |T / T_closed(E) - "

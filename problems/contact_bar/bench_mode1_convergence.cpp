@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/plot.hpp"
+#include "core/table.hpp"
 #include "problems/contact_bar/bench.hpp"
 #include "problems/contact_bar/bench_metrics.hpp"
 #include "problems/contact_bar/bench_support.hpp"
@@ -106,9 +107,8 @@ int bench_mode1_convergence(const std::filesystem::path& out) {
   fmt::print(
       "bench mode1_convergence: exact mode 1 (eps = -0.01, g0 = 1e-3, T = 3.1), errors "
       "vs dt\n");
-  bench::LabelledTable table({"contact", "dt", "onset_error", "release_error", "force_error",
-                              "return_error", "order_onset", "order_release", "order_force",
-                              "order_return"});
+  core::Table table({"contact", "dt", "onset_error", "release_error", "force_error", "return_error",
+                     "order_onset", "order_release", "order_force", "order_return"});
   struct Series {
     std::string name;
     std::vector<double> dts;
@@ -136,11 +136,11 @@ int bench_mode1_convergence(const std::filesystem::path& out) {
     double previous_dt = nan;
     for (double dt : s.dts) {
       const Mode1Errors e = s.run(dt);
-      table.add_row({s.name, dt, e.onset, e.release, e.force, e.ret,
-                     observed_order(previous_dt, previous.onset, dt, e.onset),
-                     observed_order(previous_dt, previous.release, dt, e.release),
-                     observed_order(previous_dt, previous.force, dt, e.force),
-                     observed_order(previous_dt, previous.ret, dt, e.ret)});
+      table.add_row(s.name, {dt, e.onset, e.release, e.force, e.ret,
+                             observed_order(previous_dt, previous.onset, dt, e.onset),
+                             observed_order(previous_dt, previous.release, dt, e.release),
+                             observed_order(previous_dt, previous.force, dt, e.force),
+                             observed_order(previous_dt, previous.ret, dt, e.ret)});
       previous = e;
       previous_dt = dt;
     }
@@ -148,7 +148,7 @@ int bench_mode1_convergence(const std::filesystem::path& out) {
   }
   const std::filesystem::path csv = out / "mode1_convergence.csv";
   table.write_csv(csv);
-  bench::print_table(table);
+  fmt::print("{}", table.aligned());
   fmt::print(
       "  onset/release: |t - 1.1|, |t - 2| (TD-BEM: its contact events; FEM: first row "
       "with force > 0 and the next with force 0); force_error: relative L1 error of "

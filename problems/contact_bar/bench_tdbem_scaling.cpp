@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include "core/plot.hpp"
+#include "core/table.hpp"
 #include "problems/contact_bar/bench.hpp"
 #include "problems/contact_bar/bench_metrics.hpp"
 #include "problems/contact_bar/bench_support.hpp"
@@ -16,7 +17,7 @@ int bench_tdbem_scaling(const std::filesystem::path& out) {
   const bench::PaperMode1 mode1 = bench::paper_mode1();
   const TdbemSolver tdbem(ContactMethod::event);
   const double t_end = 10 * mode1.episode.period;
-  bench::LabelledTable table({"steps", "seconds", "seconds_per_step"});
+  core::Table table({"steps", "seconds", "seconds_per_step"});
   std::vector<double> steps, seconds;
   for (double n : {1e3, 1e4, 1e5, 1e6}) {
     bar::SimulationOptions o;
@@ -35,10 +36,10 @@ int bench_tdbem_scaling(const std::filesystem::path& out) {
   const double slope = log_log_slope(steps, seconds);
   const std::filesystem::path csv = out / "tdbem_scaling.csv";
   table.write_csv(csv);
-  bench::LabelledTable fit({"slope"});
+  core::Table fit({"slope"});
   fit.add_row({slope});
   fit.write_csv(out / "tdbem_scaling_fit.csv");
-  bench::print_table(table);
+  fmt::print("{}", table.aligned());
   fmt::print("  fitted slope of log(seconds) vs log(steps): {:.3f} (1 = linear cost)\n", slope);
   const std::filesystem::path png = out / "tdbem_scaling.png";
   bench::report_plot(

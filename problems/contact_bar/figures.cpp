@@ -10,7 +10,6 @@
 #include "core/plot.hpp"
 #include "core/scene.hpp"
 #include "core/table.hpp"
-#include "problems/contact_bar/bench_support.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/tdbem.hpp"
@@ -268,9 +267,8 @@ int write_closed_form_summary(const fs::path& out) {
           has_branch(entry.path()))
         dirs.push_back(entry.path());
   std::sort(dirs.begin(), dirs.end());
-  bench::LabelledTable summary({"branch", "points", "energy_first", "energy_last",
-                                "worst_relative_error", "worst_return_error_u",
-                                "worst_return_error_v", "point_seconds"});
+  Table summary({"branch", "points", "energy_first", "energy_last", "worst_relative_error",
+                 "worst_return_error_u", "worst_return_error_v", "point_seconds"});
   for (const fs::path& dir : dirs) {
     const Table check = Table::read_csv(dir / "closed_form_check.csv");
     const auto energy = check.column("energy");
@@ -282,7 +280,8 @@ int write_closed_form_summary(const fs::path& out) {
     double seconds = 0;
     for (double t : Table::read_csv(dir / "branch.csv").column("seconds")) seconds += t;
     const std::string name = dir.filename().string();
-    summary.add_row({name, energy.size(), energy.front(), energy.back(), worst("relative_error"),
+    summary.add_row(name,
+                    {double(energy.size()), energy.front(), energy.back(), worst("relative_error"),
                      worst("return_error_u"), worst("return_error_v"), seconds});
     fmt::print(
         "[figures] {}: {} points, E {:.3g} .. {:.3g}, worst closed-form error {:.2e}, "
