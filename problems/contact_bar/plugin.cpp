@@ -21,7 +21,9 @@
 
 #include "core/errors.hpp"
 #include "core/table.hpp"
+#include "problems/contact_bar/bench.hpp"
 #include "problems/contact_bar/family.hpp"
+#include "problems/contact_bar/figures.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/simulate.hpp"
@@ -170,6 +172,8 @@ void register_plugin(continuation::PluginRegistry& registry) {
   p.setup = &setup_trace;
   p.simulate_keys = &simulate_keys;
   p.simulate = &simulate_scene;
+  p.bench_cases = bench_cases();
+  p.figures = figure_jobs();
   const std::string scenes = "problems/contact_bar/scenes/";
   p.reproduce = {
       {"bouncing_bar",

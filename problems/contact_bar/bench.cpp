@@ -1,0 +1,18 @@
+#include "problems/contact_bar/bench.hpp"
+
+namespace backbone::contact_bar {
+
+std::vector<continuation::ProblemJob> bench_cases() {
+  return {
+      {"tdbem_scaling", "TD-BEM CPU time vs number of steps (slope 1 = O(1) per step)",
+       bench_tdbem_scaling},
+      {"bouncing_bar", "TD-BEM and FEM against the closed-form bouncing bar (work-precision)",
+       bench_bouncing_bar},
+      {"mode1_convergence", "TD-BEM and FEM errors on the exact mode 1 vs dt, observed orders",
+       bench_mode1_convergence},
+      {"formulations", "regular vs paper shooting residual, Newton from perturbed exact orbits",
+       bench_formulations},
+  };
+}
+
+}  // namespace backbone::contact_bar

@@ -1,0 +1,39 @@
+// The benchmarks of the contact bar: studies with known answers, not tests. Each case writes
+// CSV tables and PNG figures into its output folder, prints its table and returns 0 (1 on a
+// numerical failure it reports itself). The metrics they report are in bench_metrics.hpp.
+//
+//   tdbem_scaling      TD-BEM CPU time vs number of steps (mode 1, 10 periods): the slope of
+//                      log(time) vs log(steps) should be 1 (O(1) work per step).
+//   bouncing_bar       TD-BEM (projection, event) and FEM (Courant 1 and 0.9) against the
+//                      closed-form bouncing bar over 10 periods: end displacement, contact
+//                      force, energy drift, CPU time; plus the history figure (paper Fig. 3).
+//   mode1_convergence  TD-BEM errors on the exact mode 1 (onset, release, force, return to u0)
+//                      vs dt, with observed orders, for each contact method (FEM for reference).
+//   formulations       the paper's shooting residual u0 - u(T) vs the regular half-period
+//                      velocity one (problems/contact_bar/README.md) on the same exact orbits of
+//                      modes 1 and 2 (4 amplitudes each): Newton from one perturbed start per
+//                      orbit at fixed energy, iterations, observed orders, error to x*, exact-
+//                      oracle return error and rank reports at the final point, residuals in
+//                      metres whatever unit the problem uses.
+//
+//   for (const continuation::ProblemJob& job : contact_bar::bench_cases())
+//     if (job.name == "bouncing_bar") status = job.run("results/bench");
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "continuation/plugin.hpp"
+
+namespace backbone::contact_bar {
+
+// The four cases above, in that order (`backbone bench` runs them all).
+std::vector<continuation::ProblemJob> bench_cases();
+
+// The cases one by one (what bench_cases() calls).
+int bench_tdbem_scaling(const std::filesystem::path& out);
+int bench_bouncing_bar(const std::filesystem::path& out);
+int bench_mode1_convergence(const std::filesystem::path& out);
+int bench_formulations(const std::filesystem::path& out);
+
+}  // namespace backbone::contact_bar
