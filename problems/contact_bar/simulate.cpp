@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 using core::InputError;
 
 namespace {
-// About a minute of TD-BEM or FEM (100 elements) marching on one core, and well under 1 GB.
+// At most about a minute and 150 MB of any solver (check_run_size says what is counted).
 constexpr long default_max_steps = 100'000'000;
 }  // namespace
 
@@ -64,18 +64,19 @@ std::string history_defect(const bar::History& h, double t_end) {
         return fmt::format("non-finite values at t = {}", i < h.t.size() ? h.t[i] : 0.0);
   if (h.t.empty()) return "no rows";
   if (!(h.t.back() >= t_end * (1 - 1e-12)))
-    return fmt::format("the history stops at t = {} before t_end = {} (non-finite values next)",
+    return fmt::format("the history stops at t = {} before t_end = {} (the march failed there)",
                        h.t.back(), t_end);
   return "";
 }
 
-// The run's size against max_steps, before anything runs. Measured costs (one core): a TD-BEM
-// step ~1 us, a TD-BEM window knot ~0.6 us per energy row and 80 bytes, a FEM node-step ~5 ns,
-// an exact wave transit ~2 us and ~0.5 kB; so the default 1e8 is about a minute and well under
-// 1 GB. The march length t_end / dt (TD-BEM, FEM); the TD-BEM's window of w = min(L / c,
-// t_end) / dt steps per end, integrated for the energy of each of the R rows and held in memory
-// (max(R, 100) w); the FEM's node-steps (t_end / dt) (elements + 1) / 100; the exact
-// solution's stored wave transits, 1000 t_end / (L / c).
+// The run's size against max_steps, before anything runs. Counted, with their measured costs on
+// one (shared) core: the march length t_end / dt (TD-BEM, FEM; a TD-BEM step ~1 us); the
+// TD-BEM's window of w = min(L / c, t_end) / dt steps (one knot per end, ~100 bytes per step),
+// integrated for the energy of each of the R rows (~0.6 us per step and row) and held in memory:
+// max(R, 100) w; the FEM's node-steps (t_end / dt) (elements + 1) / 100 (~2 ns per node-step);
+// the exact solution's stored wave transits (~0.5 kB, ~2 us each), 1000 t_end / (L / c). The
+// default 1e8 is thus at most about a minute and 150 MB (measured: TD-BEM dt = 1e-4 on the
+// paper scene, 2e7 window-rows, 13 s; dt = 2e-6 with 50 rows, 5e7, 21 s and 72 MB).
 void check_run_size(const core::Scene& scene, const bar::BarSetup& setup,
                     const bar::SimulationOptions& o, const std::vector<std::string>& methods) {
   const long max_steps = scene.integer("max_steps", 1, std::numeric_limits<long>::max());
