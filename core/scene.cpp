@@ -4,8 +4,10 @@
 
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 #include "core/errors.hpp"
 
@@ -13,16 +15,28 @@ namespace backbone::core {
 
 namespace {
 
+constexpr const char* utf8_byte_order_mark = "\xEF\xBB\xBF";
+
 // Boost's messages quote the option with its dashes; the user wants the key.
 [[noreturn]] void rethrow_as_input_error(const po::error& e, const std::string& where) {
   std::string message = e.what();
   throw InputError("", where.empty() ? message : where + ": " + message);
 }
 
-std::ifstream open_scene(const std::string& ini_path) {
+// The file's text without a leading UTF-8 byte-order mark (Boost would read it as part of the
+// first key: "unrecognised option '\ufeffproblem'").
+std::istringstream open_scene(const std::string& ini_path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(ini_path, error))
+    throw InputError("scene", fmt::format("'{}' is a directory, not a scene file", ini_path));
   std::ifstream in(ini_path);
   if (!in) throw InputError("scene", fmt::format("cannot read scene file '{}'", ini_path));
-  return in;
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string content = text.str();
+  if (content.rfind(utf8_byte_order_mark, 0) == 0)
+    content.erase(0, std::string_view(utf8_byte_order_mark).size());
+  return std::istringstream(content);
 }
 
 // "--gap -1" would read "-1" as an option: glue a negative number to its key.
@@ -68,7 +82,7 @@ double Scene::non_negative(const std::string& key) const {
   return v;
 }
 
-long Scene::integer(const std::string& key, long min_value) const {
+long Scene::integer(const std::string& key, long min_value, long max_value) const {
   if (!has(key)) throw InputError(key, "is required but was not given");
   long v = 0;
   try {
@@ -77,6 +91,7 @@ long Scene::integer(const std::string& key, long min_value) const {
     throw InputError(key, "is not an integer");
   }
   if (v < min_value) throw InputError(key, fmt::format("must be >= {} (got {})", min_value, v));
+  if (v > max_value) throw InputError(key, fmt::format("must be <= {} (got {})", max_value, v));
   return v;
 }
 
@@ -114,17 +129,22 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
   try {
     // Command line first: po::store keeps the first value it sees, so the command line wins.
     std::vector<std::string> words = glue_negative_values(arguments);
-    po::store(
+    const po::parsed_options parsed =
         po::command_line_parser(words)
             .options(cli_keys)
             .style(po::command_line_style::unix_style ^ po::command_line_style::allow_guessing)
-            .run(),
-        vm);
+            .run();
+    // Boost keeps a word that is no `--key value` as a positional value and would drop it.
+    for (const std::string& word : po::collect_unrecognized(parsed.options, po::include_positional))
+      throw InputError(
+          "command line",
+          fmt::format("unexpected argument '{}' (keys are given as --key value)", word));
+    po::store(parsed, vm);
   } catch (const po::error& e) {
     rethrow_as_input_error(e, "command line");
   }
   if (!ini_path.empty()) {
-    std::ifstream in = open_scene(ini_path);
+    std::istringstream in = open_scene(ini_path);
     try {
       po::store(po::parse_config_file(in, file_keys, /*allow_unregistered=*/false), vm);
     } catch (const po::error& e) {
@@ -140,7 +160,7 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
 }
 
 std::string scene_problem_name(const std::string& ini_path) {
-  std::ifstream in = open_scene(ini_path);
+  std::istringstream in = open_scene(ini_path);
   po::options_description keys;
   keys.add_options()("problem", po::value<std::string>()->default_value(""), "");
   po::variables_map vm;

@@ -4,10 +4,12 @@
 // boost::program_options::options_description. read_scene parses the INI file against exactly
 // those keys and then the command-line overrides (`--key value`) against those keys plus the
 // driver's own options (`--gap -1` reads -1 as the value). Unknown keys, unreadable files,
-// malformed or non-finite numbers are InputErrors naming the key: the CLI turns them into one line
-// on stderr and exit code 2. Keys are flat (no INI sections) so that every key reads the same in
-// the file and on the command line. The key `problem` names the problem the scene is for (no
-// default: core knows no problem; the CLI says which are known when it is missing).
+// malformed or non-finite numbers, integers beyond the int range, a directory given as the file
+// and words that are not `--key value` pairs are InputErrors naming the key: the CLI turns them
+// into one line on stderr and exit code 2. A UTF-8 byte-order mark at the start of a file is
+// skipped (editors on Windows write one). Keys are flat (no INI sections) so that every key reads
+// the same in the file and on the command line. The key `problem` names the problem the scene is
+// for (no default: core knows no problem; the CLI says which are known when it is missing).
 //
 //   namespace po = boost::program_options;
 //   po::options_description keys("contact bar");
@@ -18,6 +20,7 @@
 
 #include <boost/program_options.hpp>
 #include <initializer_list>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -33,10 +36,13 @@ class Scene {
 
   bool has(const std::string& key) const { return values_.count(key) > 0; }
   // Typed, validated accessors. Each throws InputError(key, constraint) on violation.
-  double number(const std::string& key) const;                 // finite
-  double positive(const std::string& key) const;               // finite and > 0
-  double non_negative(const std::string& key) const;           // finite and >= 0
-  long integer(const std::string& key, long min_value) const;  // integral and >= min_value
+  double number(const std::string& key) const;        // finite
+  double positive(const std::string& key) const;      // finite and > 0
+  double non_negative(const std::string& key) const;  // finite and >= 0
+  // Integral and in [min_value, max_value]; the default max is INT_MAX since callers store the
+  // value in an int ("max_points: must be <= 2147483647 (got 4294967298)").
+  long integer(const std::string& key, long min_value,
+               long max_value = std::numeric_limits<int>::max()) const;
   std::string text(const std::string& key) const;
   std::string choice(const std::string& key, std::initializer_list<const char*> allowed) const;
   bool flag(const std::string& key) const;

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/output_folder.hpp"
 #include "core/scene.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/plugins.hpp"
@@ -52,11 +53,8 @@ int run_simulate(const std::vector<std::string>& args) {
   const core::Scene scene =
       core::read_scene(plugin.simulate_keys(), scene_path,
                        std::vector<std::string>(args.begin() + 1, args.end()), driver_keys());
-  const std::string out_text = scene.text("out");
-  if (out_text.empty()) throw core::InputError("out", "must not be empty");
-  const fs::path out(out_text);
-  if (fs::exists(out) && !fs::is_directory(out))
-    throw core::InputError("out", fmt::format("'{}' exists and is not a directory", out_text));
+  const fs::path out(scene.text("out"));
+  core::check_output_folder("out", out);
   const int code = plugin.simulate(scene, out);
   if (code == core::exit_ok) fmt::print("wrote {}\n", out.string());
   return code;

@@ -18,6 +18,7 @@
 #include "continuation/outputs.hpp"
 #include "continuation/scene_options.hpp"
 #include "core/errors.hpp"
+#include "core/output_folder.hpp"
 #include "core/periodic_orbit.hpp"
 #include "core/plot.hpp"
 #include "core/scene.hpp"
@@ -144,6 +145,7 @@ int run_trace(const std::vector<std::string>& args_in) {
                                                  branch_name, entry.name, joined(entry.branches)));
   const std::filesystem::path out =
       scene.has("out") ? scene.text("out") : fmt::format("out/{}_{}", entry.name, branch_name);
+  core::check_output_folder("out", out);
   cont::RunSettings run = cont::read_run_settings(scene);
   cont::ContinuationOptions& options = run.options;
   auto corrector = core::make_corrector(run.newton, run.newton_options);

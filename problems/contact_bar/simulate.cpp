@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/errors.hpp"
 #include "core/plot.hpp"
@@ -12,6 +14,12 @@
 namespace backbone::contact_bar {
 
 namespace fs = std::filesystem;
+using core::InputError;
+
+namespace {
+// At most about a minute and 150 MB of any solver (check_run_size says what is counted).
+constexpr long default_max_steps = 100'000'000;
+}  // namespace
 
 po::options_description simulate_keys() {
   po::options_description keys = scene_keys();
@@ -20,7 +28,11 @@ po::options_description simulate_keys() {
                     "solver: tdbem | fem | exact | all (= --compare)")(
       "periods", po::value<double>()->default_value(1.0),
       "simulated time in scene periods (t_end = periods * period) (> 0)")(
-      "compare", po::bool_switch(), "run tdbem, fem and exact; one figure with the three");
+      "compare", po::bool_switch(), "run tdbem, fem and exact; one figure with the three")(
+      "max_steps", po::value<long>()->default_value(default_max_steps),
+      "refuse a run larger than this many time steps: t_end / dt (tdbem, fem), max(rows, 100) "
+      "x min(L/c, t_end) / dt (the tdbem window, integrated per row), node-steps / 100 (fem), "
+      "1000 x t_end / (L/c) (exact: stored wave transits)");
   keys.add(run);
   return keys;
 }
@@ -44,12 +56,60 @@ std::string plot_script(const std::vector<std::pair<std::string, fs::path>>& cur
   return s;
 }
 
-bool history_is_complete(const bar::History& h, double t_end) {
-  if (h.t.empty() || !(h.t.back() >= t_end * (1 - 1e-12))) return false;
+// Empty when the history reaches t_end with finite values, else what is wrong with it.
+std::string history_defect(const bar::History& h, double t_end) {
   for (const auto* column : {&h.u_contact, &h.contact_force, &h.energy})
-    for (double v : *column)
-      if (!std::isfinite(v)) return false;
-  return true;
+    for (std::size_t i = 0; i < column->size(); ++i)
+      if (!std::isfinite((*column)[i]))
+        return fmt::format("non-finite values at t = {}", i < h.t.size() ? h.t[i] : 0.0);
+  if (h.t.empty()) return "no rows";
+  if (!(h.t.back() >= t_end * (1 - 1e-12)))
+    return fmt::format("the history stops at t = {} before t_end = {} (the march failed there)",
+                       h.t.back(), t_end);
+  return "";
+}
+
+// The run's size against max_steps, before anything runs. Counted, with their measured costs on
+// one (shared) core: the march length t_end / dt (TD-BEM, FEM; a TD-BEM step ~1 us); the
+// TD-BEM's window of w = min(L / c, t_end) / dt steps (one knot per end, ~100 bytes per step),
+// integrated for the energy of each of the R rows (~0.6 us per step and row) and held in memory:
+// max(R, 100) w; the FEM's node-steps (t_end / dt) (elements + 1) / 100 (~2 ns per node-step);
+// the exact solution's stored wave transits (~0.5 kB, ~2 us each), 1000 t_end / (L / c). The
+// default 1e8 is thus at most about a minute and 150 MB (measured: TD-BEM dt = 1e-4 on the
+// paper scene, 2e7 window-rows, 13 s; dt = 2e-6 with 50 rows, 5e7, 21 s and 72 MB).
+void check_run_size(const core::Scene& scene, const bar::BarSetup& setup,
+                    const bar::SimulationOptions& o, const std::vector<std::string>& methods) {
+  const long max_steps = scene.integer("max_steps", 1, std::numeric_limits<long>::max());
+  const double limit = static_cast<double>(max_steps);
+  const std::string raise = fmt::format("or raise max_steps (now {})", max_steps);
+  const double steps = o.t_end / o.dt;
+  const auto uses = [&](const char* m) {
+    return std::find(methods.begin(), methods.end(), m) != methods.end();
+  };
+  if ((uses("tdbem") || uses("fem")) && steps > limit)
+    throw InputError("dt", fmt::format("t_end / dt = {:.4g} s / {} s = {:.4g} time steps (t_end = "
+                                       "periods * period); use a larger dt or fewer periods, {}",
+                                       o.t_end, o.dt, steps, raise));
+  const double rows = std::min(static_cast<double>(o.history_samples), steps + 1);
+  const double tau = setup.material.travel_time();
+  if (uses("tdbem")) {
+    const double window = std::min(tau, o.t_end) / o.dt;
+    if (std::max(rows, 100.0) * window > limit)
+      throw InputError("dt", fmt::format("the TD-BEM keeps min(L / c, t_end) / dt = {:.4g} steps "
+                                         "per end and integrates them for each of {:.0f} history "
+                                         "rows (work max(rows, 100) x {:.4g} > max_steps); use a "
+                                         "larger dt or fewer history_samples, {}",
+                                         window, rows, window, raise));
+  }
+  if (uses("fem") && steps * (o.elements + 1.0) > 100 * limit)
+    throw InputError("elements", fmt::format("the FEM does {:.4g} steps on {} nodes (node-steps / "
+                                             "100 > max_steps); use fewer elements or periods, {}",
+                                             steps, o.elements + 1, raise));
+  if (uses("exact") && 1000 * (o.t_end / tau) > limit)
+    throw InputError("periods", fmt::format("the exact solution stores t_end / (L / c) = {:.4g} "
+                                            "wave transits (~0.5 kB each; 1000 x transits > "
+                                            "max_steps); use fewer periods, {}",
+                                            o.t_end / tau, raise));
 }
 
 }  // namespace
@@ -67,14 +127,14 @@ int simulate_scene(const core::Scene& scene, const fs::path& out) {
   if (methods.size() > 1) {  // the TD-BEM constraint on dt, checked up front
     TdbemMarch check(setup, options.dt, contact);
   }
+  check_run_size(scene, setup, options, methods);
 
   std::vector<std::pair<std::string, bar::History>> histories;
   for (const auto& name : methods) {
     auto solver = make_bar_solver(name, contact);
     bar::History h = solver->simulate(setup, options);  // InputError: nothing written yet
-    if (!history_is_complete(h, options.t_end)) {
-      fmt::print(stderr, "backbone simulate: {} failed (non-finite values) before t = {}\n", name,
-                 options.t_end);
+    if (const std::string defect = history_defect(h, options.t_end); !defect.empty()) {
+      fmt::print(stderr, "backbone simulate: {} failed: {}\n", name, defect);
       return core::exit_numerical_failure;
     }
     histories.emplace_back(name, std::move(h));

@@ -30,7 +30,10 @@ bar::History ExactBarSolver::simulate(const bar::BarSetup& setup,
   h.probe_u.assign(options.probes.size(), {});
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t i = 0; i < rows; ++i) {
-    const double t = options.t_end * static_cast<double>(i) / static_cast<double>(rows - 1);
+    // The last row is t_end itself (t_end * n / n can be one ulp below it).
+    const double t = i + 1 == rows
+                         ? options.t_end
+                         : options.t_end * static_cast<double>(i) / static_cast<double>(rows - 1);
     h.t.push_back(t);
     if (!solution.ok()) {
       h.u_contact.push_back(nan);

@@ -175,6 +175,20 @@ std::vector<double> project(const std::vector<double>& w, double h, Projection p
   return p;
 }
 
+// A march to t in equal steps no longer than dt: n = ceil(t / dt) steps of t / n, where a t / dt
+// within 1e-12 of an integer counts as that integer and keeps dt itself (the grid n dt, and the
+// exactness of Courant 1, are then unchanged).
+struct March {
+  long steps = 0;
+  double dt = 0;
+};
+March march_to(double t, double dt) {
+  if (t == 0) return {0, dt};
+  const long steps = std::max(1L, static_cast<long>(std::ceil(t / dt * (1 - 1e-12))));
+  const bool on_grid = std::abs(static_cast<double>(steps) * dt - t) <= 1e-12 * t;
+  return {steps, on_grid ? dt : t / static_cast<double>(steps)};
+}
+
 }  // namespace
 
 double FemBarSolver::stable_time_step(const bar::BarSetup& setup, int elements) {
@@ -191,14 +205,15 @@ bar::History FemBarSolver::simulate(const bar::BarSetup& setup,
     if (p < 0 || p > L)
       throw InputError("probes", fmt::format("probe x = {} lies outside [0, {}]", p, L));
 
-  const long steps = static_cast<long>(std::floor(options.t_end / options.dt * (1 + 1e-12)));
+  const March plan = march_to(options.t_end, options.dt);
+  const long steps = plan.steps;
   const long rows = std::min<long>(options.history_samples, steps + 1);
   const bool right = setup.observed_end_is_right();
 
   bar::History history;
   history.probes = options.probes;
   history.probe_u.resize(options.probes.size());
-  CentralDifference march(setup, options.elements, options.dt);
+  CentralDifference march(setup, options.elements, plan.dt);
   const double h = march.h();
   const std::size_t last = march.nodes() - 1;
   long next_row = 0;  // index of the next recorded row; step of row k: round(k steps / (rows-1))
@@ -212,7 +227,7 @@ bar::History FemBarSolver::simulate(const bar::BarSetup& setup,
     if (!march.finite()) break;
     if (n == row_step(next_row)) {
       const auto& u = march.u();
-      history.t.push_back(static_cast<double>(n) * options.dt);
+      history.t.push_back(n == steps ? options.t_end : static_cast<double>(n) * plan.dt);
       history.u_contact.push_back(right ? u[last] : u[0]);
       history.contact_force.push_back(right ? march.lambda_right() : march.lambda_left());
       if (options.energy) history.energy.push_back(march.energy());
@@ -239,9 +254,9 @@ bar::FieldSnapshot FemBarSolver::snapshot(const bar::BarSetup& setup, double t,
     throw InputError("dt", fmt::format("must be > 0 (got {})", request.dt));
   check_stability(setup, request.elements, request.dt);
 
-  const long steps =
-      t == 0 ? 0 : std::max(1L, static_cast<long>(std::ceil(t / request.dt * (1 - 1e-12))));
-  const double dt = steps == 0 ? request.dt : t / static_cast<double>(steps);
+  const March plan = march_to(t, request.dt);
+  const long steps = plan.steps;
+  const double dt = plan.dt;
   CentralDifference march(setup, request.elements, dt);
   bar::FieldSnapshot snap;
   snap.t = t;

@@ -43,7 +43,8 @@ class FemBarSolver : public bar::BarSolver {
   explicit FemBarSolver(FemOptions options = {}) : options_(options) {}
   std::string name() const override { return "fem"; }
 
-  // Rows at t_n = n dt for n = 0..floor(t_end / dt) (decimated to history_samples). u_contact
+  // Rows at t_n = n dt' for n = 0..N, N = ceil(t_end / dt), dt' = t_end / N <= dt (dt' = dt when
+  // t_end is a multiple of dt), so the last row is t_end (decimated to history_samples). u_contact
   // is u at the observed end, contact_force the multiplier lambda_n of the balance at t_n (its
   // impulse lambda_n dt acts between t_n - dt/2 and t_n + dt/2); energy uses v_n = (u_{n+1} -
   // u_{n-1}) / (2 dt) with the lumped mass (so it fluctuates by (omega_h dt / 2)^2 of each mode's
@@ -54,8 +55,9 @@ class FemBarSolver : public bar::BarSolver {
                         const bar::SimulationOptions& options) const override;
 
   // The field at t: marches n = ceil(t / dt) steps of dt' = t / n <= dt (so t is hit exactly
-  // and the result is smooth in t while n is fixed). Nodal v is the central difference
-  // (u_{n+1} - u_{n-1}) / (2 dt'). Projections follow FemOptions::projection.
+  // and the result is smooth in t while n is fixed; dt' = dt when t is a multiple of dt). Nodal v
+  // is the central difference (u_{n+1} - u_{n-1}) / (2 dt'). Projections follow
+  // FemOptions::projection.
   bar::FieldSnapshot snapshot(const bar::BarSetup& setup, double t,
                               const bar::SnapshotRequest& request) const override;
 

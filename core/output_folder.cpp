@@ -1,0 +1,58 @@
+#include "core/output_folder.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <system_error>
+
+#include "core/errors.hpp"
+
+namespace backbone::core {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Creates and removes an empty folder inside `directory`; the error if that fails.
+std::error_code probe_folder_creation(const fs::path& directory) {
+  static std::atomic<unsigned> counter{0};
+  const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
+  const fs::path probe =
+      directory / fmt::format(".backbone_probe_{}_{}_{}", ::getpid(), counter++, stamp);
+  std::error_code error;
+  if (!fs::create_directory(probe, error) && !error)
+    error = std::make_error_code(std::errc::file_exists);
+  if (error) return error;
+  fs::remove(probe, error);
+  return error;
+}
+
+}  // namespace
+
+void check_output_folder(const std::string& key, const fs::path& folder) {
+  if (folder.empty()) throw InputError(key, "must not be empty");
+  std::error_code error;
+  const fs::file_status status = fs::status(folder, error);
+  if (fs::exists(status)) {
+    if (!fs::is_directory(status))
+      throw InputError(key, fmt::format("'{}' exists and is not a directory", folder.string()));
+    if (const std::error_code e = probe_folder_creation(folder))
+      throw InputError(key,
+                       fmt::format("cannot write into '{}' ({})", folder.string(), e.message()));
+    return;
+  }
+  // The nearest existing ancestor must be a directory in which a folder can be created.
+  fs::path ancestor = fs::absolute(folder, error).parent_path();
+  while (!ancestor.empty() && !fs::exists(ancestor, error) && ancestor != ancestor.parent_path())
+    ancestor = ancestor.parent_path();
+  if (!fs::is_directory(ancestor, error))
+    throw InputError(key, fmt::format("cannot create '{}': '{}' is not a directory",
+                                      folder.string(), ancestor.string()));
+  if (const std::error_code e = probe_folder_creation(ancestor))
+    throw InputError(key, fmt::format("cannot create '{}': no folder can be created in '{}' ({})",
+                                      folder.string(), ancestor.string(), e.message()));
+}
+
+}  // namespace backbone::core
