@@ -1,14 +1,12 @@
 // The conservative Duffing oscillator x'' + x + x^3 = 0 as a periodic-orbit problem.
 //
-// Unknowns [x0 | T] (core::PeriodicOrbitProblem layout, state size 1, no parameters): the orbit
-// starts at rest at amplitude x0 (v0 = 0). Residuals (DESIGN.md section 3):
+// A core::OdeOrbitProblem of dimension 1 (core/ode_orbit.hpp): unknowns [x0 | T], the orbit starts
+// at rest at amplitude x0 (v0 = 0); the flow (CVODE, Adams, rtol 1e-13), both shooting
+// formulations and the analytic Jacobian (variational equations) come from core. Residuals (see
+// core/README.md and problems/duffing/README.md):
 //   displacement_periodicity ("paper"):  (x0 - x(T)) / |x0|       (double root on the backbone)
 //   half_period_velocity ("regular"):    v(T/2) / v_max(x0)       (simple root, J ~ [2, 1])
-// Both are made dimensionless by the orbit's own scale (v_max = sqrt(2 V(x0)), the largest
-// speed on the orbit), so one Newton tolerance means the same relative accuracy from
-// amplitude 0.01 to 10 (an absolute ||v|| <= 1e-10 would pin T to 2e-8 at A = 0.01).
-// The flow comes from CVODE (cvode_integrator.hpp, Adams, rtol 1e-13); the Jacobian is
-// analytic, from the variational equations integrated alongside. exact_period is the oracle:
+// with v_max = sqrt(2 V(x0)), the largest speed on the orbit. exact_period is the oracle:
 // T(A) = 4 int_0^A dx / sqrt(2 (V(A) - V(x))), V = x^2/2 + x^4/4, by quadrature.
 //
 //   Duffing duffing;                                    // regular formulation by default
@@ -23,8 +21,7 @@
 
 #include <boost/program_options.hpp>
 
-#include "core/periodic_orbit.hpp"
-#include "problems/duffing/cvode_integrator.hpp"
+#include "core/ode_orbit.hpp"
 
 namespace backbone::duffing {
 
@@ -38,39 +35,19 @@ double potential(double x);
 // 4 K(k) / sqrt(1 + A^2), k^2 = A^2 / (2 (1 + A^2)).
 double exact_period(double amplitude);
 
-// Divisor of the residual and its derivative with respect to x0 (see above).
-struct ResidualScale {
-  double value = 1;
-  double derivative = 0;
-};
-ResidualScale residual_scale(double amplitude, core::ShootingFormulation formulation);
+// relative_tolerance is the scene key rtol.
+using DuffingOptions = core::OdeOrbitOptions;
 
-struct DuffingOptions {
-  double relative_tolerance = 1e-13;  // CVODE rtol; absolute tolerances scale with the orbit
-  void validate() const;              // InputError("rtol", ...)
-};
-
-class Duffing : public core::PeriodicOrbitProblem {
+class Duffing : public core::OdeOrbitProblem {
  public:
-  explicit Duffing(DuffingOptions options = {});
+  explicit Duffing(DuffingOptions options = {}) : OdeOrbitProblem(1, options) {}
   std::string name() const override { return "duffing"; }
-  int state_size() const override { return 1; }
+  void acceleration(const double* q, double* a) const override;
+  void acceleration_jacobian(const double* q, core::Matrix& J) const override;
   double energy(const core::Vector& x) const override { return potential(x[0]); }
   // period, frequency, energy, amplitude.
   core::Observables observables(const core::Vector& x) const override;
-  core::Vector typical_scale() const override;
-
-  // Flow from (x0, 0) over time t: (x, v) and, with sensitivities, (dx/dx0, dv/dx0).
-  // Returns false when CVODE fails.
-  bool flow(double x0, double t, double& x, double& v, double* dx_dx0 = nullptr,
-            double* dv_dx0 = nullptr) const;
-
- protected:
-  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
-  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
-
- private:
-  DuffingOptions options_;
+  core::Vector typical_scale() const override;  // (1, 2 pi): amplitude, linear period
 };
 
 // Scene keys of the Duffing problem (amplitude, period_guess, rtol) with defaults.

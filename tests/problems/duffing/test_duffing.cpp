@@ -1,5 +1,5 @@
 // The Duffing backbone against its exact period, across Newton backends and shooting
-// formulations (DESIGN.md section 3).
+// formulations (core/README.md, problems/duffing/README.md).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,17 +1,18 @@
 // A small RAII adapter over SUNDIALS CVODE for non-stiff ODE systems y' = f(t, y).
 //
-// Every CVODE call of backbone::duffing lives in cvode_integrator.cpp. The integrator uses the
+// Every CVODE call of backbone lives in cvode_integrator.cpp (ode_orbit.hpp builds periodic-orbit
+// problems on it; see core/README.md). The integrator uses the
 // variable-order Adams-Moulton method (orders up to 12) with a fixed-point corrector: the
 // problems here are smooth and non-stiff, where high-order Adams needs far fewer steps than
 // BDF (order <= 5) at the tight tolerances (rtol ~ 1e-13) a period accurate to 1e-9 asks for.
 // The end time is imposed as a stop time, so the solution is never interpolated. Each
-// integrate() call creates and frees its own CVODE memory, so concurrent calls are safe.
+// integrate_ode() call creates and frees its own CVODE memory, so concurrent calls are safe.
 //
 //   CvodeOptions opt; opt.relative_tolerance = 1e-13;
 //   opt.absolute_tolerance = Vector::Constant(2, 1e-16);
 //   auto rhs = [](double, const double* y, double* dy) { dy[0] = y[1]; dy[1] = -y[0]; };
 //   Vector y(2); y << 1.0, 0.0;
-//   IntegrationResult r = integrate(rhs, y, 2 * std::numbers::pi, opt);  // y ~ (1, 0)
+//   IntegrationResult r = integrate_ode(rhs, y, 2 * std::numbers::pi, opt);  // y ~ (1, 0)
 //   if (!r.ok) fmt::print("{}\n", r.message);
 #pragma once
 
@@ -20,11 +21,11 @@
 
 #include "core/types.hpp"
 
-namespace backbone::duffing {
+namespace backbone::core {
 
 struct CvodeOptions {
   double relative_tolerance = 1e-13;
-  core::Vector absolute_tolerance;  // one per component; empty: 1e-15 * relative... see .cpp
+  Vector absolute_tolerance;  // one per component; empty: 1e-3 * relative_tolerance each
   long max_steps = 1000000;
 };
 
@@ -35,10 +36,10 @@ struct IntegrationResult {
 };
 
 // dy = f(t, y); y and dy have the size of the initial state.
-using RightHandSide = std::function<void(double t, const double* y, double* dy)>;
+using OdeRightHandSide = std::function<void(double t, const double* y, double* dy)>;
 
 // Integrates from t = 0 to t_end > 0; y holds the initial state on entry, y(t_end) on return.
-IntegrationResult integrate(const RightHandSide& rhs, core::Vector& y, double t_end,
-                            const CvodeOptions& options);
+IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t_end,
+                                const CvodeOptions& options);
 
-}  // namespace backbone::duffing
+}  // namespace backbone::core

@@ -1,6 +1,6 @@
-// Every CVODE call of backbone::duffing. SUNDIALS objects are owned by RAII handles; Eigen maps
+// Every CVODE call of backbone. SUNDIALS objects are owned by RAII handles; Eigen maps
 // over N_VGetArrayPointer instead of copying.
-#include "problems/duffing/cvode_integrator.hpp"
+#include "core/cvode_integrator.hpp"
 
 #include <cvode/cvode.h>
 #include <fmt/format.h>
@@ -12,7 +12,7 @@
 #include <cstdlib>
 #include <memory>
 
-namespace backbone::duffing {
+namespace backbone::core {
 
 namespace {
 
@@ -34,7 +34,7 @@ using SolverHandle = std::unique_ptr<std::remove_pointer_t<SUNNonlinearSolver>, 
 using CvodeHandle = std::unique_ptr<void, CvodeDeleter>;
 
 int rhs_trampoline(sunrealtype t, N_Vector y, N_Vector dy, void* user_data) {
-  const auto* f = static_cast<const RightHandSide*>(user_data);
+  const auto* f = static_cast<const OdeRightHandSide*>(user_data);
   (*f)(t, N_VGetArrayPointer(y), N_VGetArrayPointer(dy));
   const long n = N_VGetLength(dy);
   const double* d = N_VGetArrayPointer(dy);
@@ -60,8 +60,8 @@ IntegrationResult failure(const char* what, int flag) {
 
 }  // namespace
 
-IntegrationResult integrate(const RightHandSide& rhs, core::Vector& y, double t_end,
-                            const CvodeOptions& options) {
+IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t_end,
+                                const CvodeOptions& options) {
   const auto n = static_cast<sunindextype>(y.size());
   SUNContext raw_context = nullptr;
   if (SUNContext_Create(nullptr, &raw_context) != 0)
@@ -70,8 +70,8 @@ IntegrationResult integrate(const RightHandSide& rhs, core::Vector& y, double t_
   VectorHandle state(N_VNew_Serial(n, raw_context));
   VectorHandle abs_tol(N_VNew_Serial(n, raw_context));
   if (!state || !abs_tol) return {false, 0, "cvode: N_VNew_Serial failed"};
-  Eigen::Map<core::Vector>(N_VGetArrayPointer(state.get()), n) = y;
-  Eigen::Map<core::Vector> tolerance(N_VGetArrayPointer(abs_tol.get()), n);
+  Eigen::Map<Vector>(N_VGetArrayPointer(state.get()), n) = y;
+  Eigen::Map<Vector> tolerance(N_VGetArrayPointer(abs_tol.get()), n);
   if (options.absolute_tolerance.size() == n)
     tolerance = options.absolute_tolerance;
   else
@@ -82,7 +82,7 @@ IntegrationResult integrate(const RightHandSide& rhs, core::Vector& y, double t_
   void* mem = memory.get();
   int flag = CVodeInit(mem, rhs_trampoline, 0.0, state.get());
   if (flag != CV_SUCCESS) return failure("CVodeInit", flag);
-  flag = CVodeSetUserData(mem, const_cast<RightHandSide*>(&rhs));
+  flag = CVodeSetUserData(mem, const_cast<OdeRightHandSide*>(&rhs));
   if (flag != CV_SUCCESS) return failure("CVodeSetUserData", flag);
   flag = CVodeSVtolerances(mem, options.relative_tolerance, abs_tol.get());
   if (flag != CV_SUCCESS) return failure("CVodeSVtolerances", flag);
@@ -106,9 +106,9 @@ IntegrationResult integrate(const RightHandSide& rhs, core::Vector& y, double t_
         fmt::format("cvode: CVode failed at t = {} of {} ({})", t, t_end, flag_name(flag));
     return result;
   }
-  y = Eigen::Map<core::Vector>(N_VGetArrayPointer(state.get()), n);
+  y = Eigen::Map<Vector>(N_VGetArrayPointer(state.get()), n);
   result.ok = true;
   return result;
 }
 
-}  // namespace backbone::duffing
+}  // namespace backbone::core
