@@ -55,7 +55,8 @@ class OdeOrbitProblem : public PeriodicOrbitProblem {
   // differences of acceleration, step cbrt(eps) max(|q_j|, typical scale of q_j). Used by the
   // variational equations (analytic shooting Jacobian); must be safe to call concurrently.
   virtual void acceleration_jacobian(const double* q, Matrix& J) const;
-  // energy(x) stays pure virtual (PeriodicOrbitProblem): the potential at q0.
+  // energy(x) stays pure virtual (PeriodicOrbitProblem): the potential at q0. It must read
+  // x.head(d) only (flow calls it with T = 0 for the velocity scale of the tolerances).
 
   // Flow from (q0, 0) over time t >= 0; with sensitivities (d x d each) when non-null.
   // Returns false when CVODE fails (or t < 0); q0 must have d entries.
