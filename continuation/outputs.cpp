@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -12,7 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "continuation/point_recorder.hpp"
+#include "continuation/loop_steps.hpp"
 #include "core/errors.hpp"
 
 namespace backbone::continuation {
@@ -167,9 +168,20 @@ core::Vector read_unknowns(const std::filesystem::path& path, int point, const s
   if (points.empty())
     throw core::InputError(key, fmt::format("'{}' holds no point", path.string()));
   const double wanted = point < 0 ? points.back() : point;
+  if (!(wanted >= 0 && wanted < 1e9 && wanted == std::floor(wanted)))
+    throw core::InputError(key, fmt::format("'{}': point {} is not a whole number in [0, 1e9)",
+                                            path.string(), wanted));
   std::map<int, double> entries;
-  for (std::size_t i = 0; i < points.size(); ++i)
-    if (points[i] == wanted) entries[static_cast<int>(index[i])] = value[i];
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i] != wanted) continue;
+    // An index must be a whole number below a million (the size of any problem here); a
+    // cast of anything else would be undefined.
+    if (!(index[i] >= 0 && index[i] < 1e6 && index[i] == std::floor(index[i])))
+      throw core::InputError(key, fmt::format("'{}': index {} of point {} is not a whole number "
+                                              "in [0, 1e6)",
+                                              path.string(), index[i], wanted));
+    entries[static_cast<int>(index[i])] = value[i];
+  }
   if (entries.empty())
     throw core::InputError(key, fmt::format("'{}' has no point {}", path.string(), point));
   core::Vector x(static_cast<Eigen::Index>(entries.size()));
@@ -203,7 +215,6 @@ std::pair<std::filesystem::path, int> parse_saved_point(const std::string& text,
 RestartPoint restart_point(const std::filesystem::path& dir, int point,
                            const ContinuationOptions& options, const std::string& key) {
   RestartPoint r;
-  r.x = read_unknowns(dir / "unknowns.csv", point, key);
   std::vector<double> index, step, iterations, arclength;
   try {
     const core::Table branch = core::Table::read_csv(dir / "branch.csv");
@@ -214,13 +225,21 @@ RestartPoint restart_point(const std::filesystem::path& dir, int point,
   } catch (const core::InputError& e) {
     throw core::InputError(key, e.what());
   }
+  if (index.empty())
+    throw core::InputError(key, fmt::format("'{}' holds no point", (dir / "branch.csv").string()));
   const double wanted = point < 0 ? index.back() : point;
   const auto row = std::find(index.begin(), index.end(), wanted);
   if (row == index.end())
     throw core::InputError(key, fmt::format("'{}' has no point {}", (dir / "branch.csv").string(),
                                             static_cast<int>(wanted)));
   const std::size_t i = static_cast<std::size_t>(row - index.begin());
+  if (!(wanted >= 0 && wanted < 1e9 && iterations[i] >= 0 && iterations[i] < 1e6 &&
+        std::isfinite(step[i]) && std::isfinite(arclength[i])))
+    throw core::InputError(key, fmt::format("'{}': point {} has no valid step, iterations and "
+                                            "arclength",
+                                            (dir / "branch.csv").string(), wanted));
   r.index = static_cast<int>(wanted);
+  r.x = read_unknowns(dir / "unknowns.csv", r.index, key);
   r.arclength = arclength[i];
   if (r.index > 0) {
     r.secant = r.x - read_unknowns(dir / "unknowns.csv", r.index - 1, key);
