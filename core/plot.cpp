@@ -12,8 +12,10 @@ namespace backbone::core {
 std::string gnuplot_quote(const std::filesystem::path& p) {
   std::string out = "'";
   for (char ch : p.string()) {
-    if (ch == '\'') out += "''";
-    else out += ch;
+    if (ch == '\'')
+      out += "''";
+    else
+      out += ch;
   }
   return out + "'";
 }
@@ -25,11 +27,11 @@ PlotResult render_png(const std::filesystem::path& png, const std::string& gnupl
   std::filesystem::path script = png;
   script += ".gp";
   if (png.has_parent_path()) std::filesystem::create_directories(png.parent_path());
-  const std::string text =
-      fmt::format("set terminal pngcairo size {},{} enhanced font 'DejaVu Sans,11'\n"
-                  "set output {}\nset datafile separator ','\nset key autotitle columnhead\n"
-                  "{}\nunset output\n",
-                  size.width, size.height, gnuplot_quote(part), gnuplot_commands);
+  const std::string text = fmt::format(
+      "set terminal pngcairo size {},{} enhanced font 'DejaVu Sans,11'\n"
+      "set output {}\nset datafile separator ','\nset key autotitle columnhead\n"
+      "{}\nunset output\n",
+      size.width, size.height, gnuplot_quote(part), gnuplot_commands);
   write_text_atomically(script, text);
   const std::string command =
       fmt::format("gnuplot {} 2>{}.log", gnuplot_quote(script), gnuplot_quote(png.string()));

@@ -13,9 +13,12 @@ using core::InputError;
 
 const char* to_string(EndType e) {
   switch (e) {
-    case EndType::fixed: return "fixed";
-    case EndType::free: return "free";
-    case EndType::contact: return "contact";
+    case EndType::fixed:
+      return "fixed";
+    case EndType::free:
+      return "free";
+    case EndType::contact:
+      return "contact";
   }
   return "?";
 }
@@ -27,10 +30,18 @@ EndType parse_end_type(const std::string& key, const std::string& value) {
   throw InputError(key, fmt::format("must be one of fixed, free, contact (got '{}')", value));
 }
 
-double Material::wave_speed() const { return std::sqrt(youngs_modulus / density); }
-double Material::axial_stiffness() const { return youngs_modulus * area; }
-double Material::impedance() const { return density * area * wave_speed(); }
-double Material::travel_time() const { return length / wave_speed(); }
+double Material::wave_speed() const {
+  return std::sqrt(youngs_modulus / density);
+}
+double Material::axial_stiffness() const {
+  return youngs_modulus * area;
+}
+double Material::impedance() const {
+  return density * area * wave_speed();
+}
+double Material::travel_time() const {
+  return length / wave_speed();
+}
 
 PiecewiseLinear::PiecewiseLinear(std::vector<double> x, std::vector<double> y)
     : x_(std::move(x)), y_(std::move(y)) {
@@ -41,8 +52,8 @@ PiecewiseLinear::PiecewiseLinear(std::vector<double> x, std::vector<double> y)
     if (!std::isfinite(x_[i]) || !std::isfinite(y_[i]))
       throw InputError("knots", fmt::format("knot {} is not finite ({}, {})", i, x_[i], y_[i]));
     if (i > 0 && !(x_[i] > x_[i - 1]))
-      throw InputError("knots", fmt::format("knots must increase strictly ({} after {})", x_[i],
-                                            x_[i - 1]));
+      throw InputError("knots",
+                       fmt::format("knots must increase strictly ({} after {})", x_[i], x_[i - 1]));
   }
 }
 
@@ -88,7 +99,8 @@ double PiecewiseLinear::integral(double a, double b) const {
 
 void BarSetup::validate() const {
   auto positive = [](const char* key, double v) {
-    if (!std::isfinite(v) || !(v > 0)) throw InputError(key, fmt::format("must be > 0 (got {})", v));
+    if (!std::isfinite(v) || !(v > 0))
+      throw InputError(key, fmt::format("must be > 0 (got {})", v));
   };
   positive("length", material.length);
   positive("youngs_modulus", material.youngs_modulus);
@@ -108,9 +120,11 @@ void BarSetup::validate() const {
   }
   // A contact end must start on the admissible side of its wall.
   if (right.type == EndType::contact && u0(L) > right.gap * (1 + 1e-12) + 1e-300)
-    throw InputError("u0", fmt::format("u0(L) = {} penetrates the wall at gap {}", u0(L), right.gap));
+    throw InputError("u0",
+                     fmt::format("u0(L) = {} penetrates the wall at gap {}", u0(L), right.gap));
   if (left.type == EndType::contact && -u0(0.0) > left.gap * (1 + 1e-12) + 1e-300)
-    throw InputError("u0", fmt::format("u0(0) = {} penetrates the wall at gap {}", u0(0.0), left.gap));
+    throw InputError("u0",
+                     fmt::format("u0(0) = {} penetrates the wall at gap {}", u0(0.0), left.gap));
 }
 
 bool BarSetup::observed_end_is_right() const {
@@ -120,7 +134,8 @@ bool BarSetup::observed_end_is_right() const {
 void SimulationOptions::validate() const {
   if (!std::isfinite(t_end) || !(t_end > 0))
     throw InputError("t_end", fmt::format("must be > 0 (got {})", t_end));
-  if (!std::isfinite(dt) || !(dt > 0)) throw InputError("dt", fmt::format("must be > 0 (got {})", dt));
+  if (!std::isfinite(dt) || !(dt > 0))
+    throw InputError("dt", fmt::format("must be > 0 (got {})", dt));
   if (elements < 1) throw InputError("elements", fmt::format("must be >= 1 (got {})", elements));
   if (history_samples < 2)
     throw InputError("history_samples", fmt::format("must be >= 2 (got {})", history_samples));

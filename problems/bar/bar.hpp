@@ -6,9 +6,10 @@
 // (u = 0), free (u_x = 0) or in unilateral contact with a rigid wall at outward gap g:
 //     g(t) = gap - n u(end, t) >= 0,  lambda = -EA u_x >= 0,  g * lambda = 0   (Signorini)
 // so at x = L the wall sits at u = +gap, at x = 0 at u = -gap. lambda is the compressive
-// contact force [N] (compression, u_x < 0, at either end). body_force is a constant force per unit volume along +x [N/m^3]; its
-// potential enters the energy: E = 1/2 int (rho A v^2 + EA u_x^2) dx - int body_force A u dx.
-// Initial displacement and velocity are piecewise linear (knots may be anywhere in [0, L]).
+// contact force [N] (compression, u_x < 0, at either end). body_force is a constant force per unit
+// volume along +x [N/m^3]; its potential enters the energy: E = 1/2 int (rho A v^2 + EA u_x^2) dx -
+// int body_force A u dx. Initial displacement and velocity are piecewise linear (knots may be
+// anywhere in [0, L]).
 //
 //   bar::BarSetup s;
 //   s.material = {1.0, 1.0, 1.0, 1.0};                     // L, E, rho, A  (c = 1)
@@ -35,14 +36,14 @@ struct End {
 };
 
 struct Material {
-  double length = 1;          // L [m]
-  double youngs_modulus = 1;  // E [Pa]
-  double density = 1;         // rho [kg/m^3]
-  double area = 1;            // A [m^2]
-  double wave_speed() const;        // c = sqrt(E / rho)
-  double axial_stiffness() const;   // EA
-  double impedance() const;         // rho A c
-  double travel_time() const;       // L / c
+  double length = 1;               // L [m]
+  double youngs_modulus = 1;       // E [Pa]
+  double density = 1;              // rho [kg/m^3]
+  double area = 1;                 // A [m^2]
+  double wave_speed() const;       // c = sqrt(E / rho)
+  double axial_stiffness() const;  // EA
+  double impedance() const;        // rho A c
+  double travel_time() const;      // L / c
 };
 
 // Continuous piecewise-linear function on sorted knots (constant extrapolation outside).
@@ -52,7 +53,7 @@ class PiecewiseLinear {
   PiecewiseLinear(std::vector<double> x, std::vector<double> y);  // throws InputError
   static PiecewiseLinear zero(double length) { return {{0.0, length}, {0.0, 0.0}}; }
   double operator()(double x) const;
-  double slope(double x, int side) const;  // side -1: left derivative, +1: right derivative
+  double slope(double x, int side) const;     // side -1: left derivative, +1: right derivative
   double integral(double a, double b) const;  // exact
   const std::vector<double>& knots() const { return x_; }
   const std::vector<double>& values() const { return y_; }
@@ -74,12 +75,12 @@ struct BarSetup {
 };
 
 struct SimulationOptions {
-  double t_end = 1;        // [s]
-  double dt = 1e-3;        // [s] time step (TD-BEM, FEM); ignored by the exact solver except
-                           // as the default sampling interval
-  int elements = 100;      // space intervals of the node grid (TD-BEM interior output, FEM mesh)
+  double t_end = 1;    // [s]
+  double dt = 1e-3;    // [s] time step (TD-BEM, FEM); ignored by the exact solver except
+                       // as the default sampling interval
+  int elements = 100;  // space intervals of the node grid (TD-BEM interior output, FEM mesh)
   int history_samples = 2000;  // at most this many rows in the history (decimated evenly)
-  bool energy = true;      // compute the energy column (costs an interior evaluation per row)
+  bool energy = true;          // compute the energy column (costs an interior evaluation per row)
   std::vector<double> probes;  // interior points whose u is recorded per row
   void validate() const;
 };
@@ -95,20 +96,20 @@ struct History {
 // What a shooting residual needs from a simulation: the field at ONE instant t, on the uniform
 // node grid x_i = i L / elements (i = 0..elements). Only the requested parts are computed.
 struct SnapshotRequest {
-  double dt = 1e-3;         // time step of the march (TD-BEM, FEM); the exact solver ignores it
-  int elements = 100;       // node grid: elements + 1 nodes including both ends
-  bool nodal_u = true;      // u(x_i, t)
-  bool nodal_v = false;     // v(x_i, t) (one-sided limits are ambiguous on a front: prefer
-                            // the projection below for residuals)
-  bool projected_u = false; // int_0^L u(x, t) psi_i(x) dx, psi_i the hat function of node i
-  bool projected_v = false; // int_0^L v(x, t) psi_i(x) dx (exact for piecewise fields)
+  double dt = 1e-3;          // time step of the march (TD-BEM, FEM); the exact solver ignores it
+  int elements = 100;        // node grid: elements + 1 nodes including both ends
+  bool nodal_u = true;       // u(x_i, t)
+  bool nodal_v = false;      // v(x_i, t) (one-sided limits are ambiguous on a front: prefer
+                             // the projection below for residuals)
+  bool projected_u = false;  // int_0^L u(x, t) psi_i(x) dx, psi_i the hat function of node i
+  bool projected_v = false;  // int_0^L v(x, t) psi_i(x) dx (exact for piecewise fields)
 };
 
 struct FieldSnapshot {
   double t = 0;
-  std::vector<double> x;                      // node positions (size elements + 1)
+  std::vector<double> x;                               // node positions (size elements + 1)
   std::vector<double> u, v, u_projected, v_projected;  // empty unless requested
-  bool ok = true;             // false: the march failed (non-finite values)
+  bool ok = true;  // false: the march failed (non-finite values)
   std::string message;
 };
 

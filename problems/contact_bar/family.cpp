@@ -28,6 +28,13 @@ double ContactFamily::grazing_energy() const {
   return material_.axial_stiffness() * g * g / (2 * material_.length);
 }
 
+// Mode 1: README.md, section 'Mode 1'. Mode 2 closed form. With c = L = 1 and u = F(t + x) - F(t -
+// x), let H(t) = F'(t - 1) be the wave arriving at x = L. Free end: H(t + 2) = -H(t) and the end
+// moves at -2 H(t); closed contact: H(t + 2) = H(t) while H(t) <= 0. v0 = 0 makes H symmetric about
+// t = 1 on [0, 2], H(1 +- x) = u0'(x) / 2. Take H = +h on (1 - b, 1 + b), -h elsewhere (the tent u0
+// of slopes s = 2h, -2h with crest at b). The end approaches for 2b, sticks for 1 - 3b, recedes for
+// 2b: the pattern is periodic with T = 1 + b iff the approach from u0(1) = s (2b - 1) reaches g0 in
+// 2b, i.e. b = (1 + g0 / s) / 4, in [1/4, 1/3] (grazing at s = 3 g0). E = s^2 / 2 (EA = 1).
 double ContactFamily::period(double energy) const {
   const double length = material_.length, s = slope(energy);
   if (!(s * length >= (2 * mode_ - 1) * gap_)) return std::nan("");

@@ -305,26 +305,4 @@ ReturnError return_error(const ContactBarOrbitProblem& problem, const Vector& x,
   return {du / u_max, s.material.travel_time() * v_max / u_max};
 }
 
-// Mode 2 closed form. With c = L = 1 and u = F(t + x) - F(t - x), let H(t) = F'(t - 1) be the
-// wave arriving at x = L. Free end: H(t + 2) = -H(t) and the end moves at -2 H(t); closed
-// contact: H(t + 2) = H(t) while H(t) <= 0. v0 = 0 makes H symmetric about t = 1 on [0, 2],
-// H(1 +- x) = u0'(x) / 2. Take H = +h on (1 - b, 1 + b), -h elsewhere (the tent u0 of slopes
-// s = 2h, -2h with crest at b). The end approaches for 2b, sticks for 1 - 3b, recedes for 2b:
-// the pattern is periodic with T = 1 + b iff the approach from u0(1) = s (2b - 1) reaches g0
-// in 2b, i.e. b = (1 + g0 / s) / 4, in [1/4, 1/3] (grazing at s = 3 g0). E = s^2 / 2 (EA = 1).
-double mode2_frequency(const bar::Material& material, double gap, double energy) {
-  const double length = material.length, ea = material.axial_stiffness();
-  const double slope = std::sqrt(2 * energy / (ea * length));
-  if (!(slope * length >= 3 * gap)) return std::nan("");
-  const double period = (5 * length + gap / slope) / (4 * material.wave_speed());
-  return 2 * std::numbers::pi / period;
-}
-
-double mode1_frequency(const bar::Material& material, double gap, double energy) {
-  const double length = material.length, ea = material.axial_stiffness();
-  const double slope = std::sqrt(2 * energy / (ea * length));
-  if (!(slope * length >= gap)) return std::nan("");
-  return 2 * std::numbers::pi * material.wave_speed() / (3 * length + gap / slope);
-}
-
 }  // namespace backbone::contact_bar

@@ -132,12 +132,6 @@ struct ReturnError {
 ReturnError return_error(const ContactBarOrbitProblem& problem, const core::Vector& x,
                          const bar::BarSolver& oracle, int elements = 1000);
 
-// Closed forms of the contact family (c = sqrt(E/rho), EA, g0 from the setup), for tests and
-// reports. Mode 1 (README.md 'Mode 1'): T = (3L + g0 sqrt(EA L / (2E))) / c above grazing
-// E = EA g0^2 / (2L). Mode 2 (derived the same way from d'Alembert, see the .cpp): a tent
-// u0 of slopes +-s with its crest at bL, T = (5L + g0 sqrt(EA L / (2E))) / (4c) above grazing
-// E = EA (3 g0)^2 / (2L). Both return 2 pi / T, NaN below grazing.
-double mode1_frequency(const bar::Material& material, double gap, double energy);
-double mode2_frequency(const bar::Material& material, double gap, double energy);
+// Closed forms of the contact family: problems/contact_bar/family.hpp (ContactFamily).
 
 }  // namespace backbone::contact_bar

@@ -1,4 +1,9 @@
 // Small algebraic problems with known roots and Jacobians, shared by the core tests.
+//
+//   backbone::core::testing::Rosenbrock rosenbrock;     // root (1, 1)
+//   Vector x(2); x << -1.2, 1.0;
+//   auto newton = make_corrector("eigen", NewtonOptions{});
+//   EXPECT_TRUE(newton->solve(rosenbrock, x).converged());
 #pragma once
 
 #include <cmath>

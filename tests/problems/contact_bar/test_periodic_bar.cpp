@@ -12,6 +12,7 @@
 #include "core/finite_difference.hpp"
 #include "core/newton.hpp"
 #include "core/rank_report.hpp"
+#include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
@@ -152,8 +153,7 @@ double worst_branch_error(const ContactBarOrbitProblem& p, int mode, int points,
   for (const auto& point : b.points) {
     const double energy = point.observable("energy");
     const double exact =
-        mode == 1 ? contact_bar::mode1_frequency(p.setup_template().material, kGap, energy)
-                  : contact_bar::mode2_frequency(p.setup_template().material, kGap, energy);
+        contact_bar::ContactFamily(p.setup_template().material, kGap, mode).frequency(energy);
     worst = std::max(worst, std::abs(point.observable("frequency") / exact - 1));
   }
   return worst;
