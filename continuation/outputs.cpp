@@ -15,6 +15,7 @@
 
 #include "continuation/loop_steps.hpp"
 #include "core/errors.hpp"
+#include "core/plot.hpp"
 
 namespace backbone::continuation {
 
@@ -27,6 +28,32 @@ core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch&
       t.add_row({static_cast<double>(p.index), coordinates[i], values[i]});
   }
   return t;
+}
+
+void plot_branch(const std::filesystem::path& out, const core::Table& table,
+                 const std::string& title) {
+  const auto& columns = table.columns();
+  const auto column_of = [&](const std::string& name) {
+    for (std::size_t i = 0; i < columns.size(); ++i)
+      if (columns[i] == name) return static_cast<int>(i) + 1;
+    return 0;
+  };
+  int x = column_of("energy"), y = column_of("frequency");
+  bool log_x = x > 0 && y > 0;
+  if (!log_x) {
+    x = 2;
+    y = 3;
+  }
+  if (static_cast<int>(columns.size()) < std::max(x, y)) return;
+  const std::string script = fmt::format(
+      "set datafile separator ','\nset key top left\nset grid\n{}"
+      "set xlabel '{}'\nset ylabel '{}'\nset title '{}' noenhanced\n"
+      "plot {} using {}:{} skip 1 with linespoints pt 7 ps 0.6 title 'branch'\n",
+      log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", columns[x - 1],
+      columns[y - 1] + (columns[y - 1] == "frequency" ? " [rad/time]" : ""), title,
+      core::gnuplot_quote(out / "branch.csv"), x, y);
+  core::PlotResult r = core::render_png(out / "branch.png", script);
+  if (!r.ok) fmt::print(stderr, "figure skipped: {}\n", r.message);
 }
 
 struct BranchWriter::File {
@@ -246,6 +273,22 @@ RestartPoint restart_point(const std::filesystem::path& dir, int point,
     r.next_step = adapted_step(step[i], static_cast<int>(iterations[i]), options);
   }
   return r;
+}
+
+void take_up(const RestartPoint& restart, const std::string& key, ContinuationOptions& options,
+             core::Vector& guess, core::Vector& direction) {
+  if (restart.x.size() != guess.size())
+    throw core::InputError(key, fmt::format("the saved point has {} unknowns, this scene's "
+                                            "problem {} (same grid keys?)",
+                                            restart.x.size(), guess.size()));
+  guess = restart.x;
+  if (restart.secant.size() == guess.size()) direction = restart.secant;
+  if (restart.next_step > 0)
+    options.ds = std::clamp(restart.next_step, options.ds_min, options.ds_max);
+  options.max_points -= restart.index;  // the saved point is the restart's first
+  if (options.max_points < 2)
+    throw core::InputError(
+        "max_points", fmt::format("the saved branch has {} points already", restart.index + 1));
 }
 
 }  // namespace backbone::continuation

@@ -31,6 +31,12 @@ namespace backbone::continuation {
 
 core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch& branch);
 
+// out/branch.png from the rows of out/branch.csv (`table`), every point: frequency against
+// energy (log axis) when the problem reports them, else the first two observables. A figure
+// that cannot be drawn (no gnuplot) is reported on stderr, not an error.
+void plot_branch(const std::filesystem::path& out, const core::Table& table,
+                 const std::string& title);
+
 class BranchWriter {
  public:
   // Creates `out` (and its parents). periodic: the problem when it is a periodic-orbit problem
@@ -76,6 +82,12 @@ struct RestartPoint {
   double arclength = 0;
 };
 // InputError naming `key` when the folder lacks the files or the point.
+// Makes a run start from the saved point: guess = its unknowns, direction = its secant, ds =
+// the step it would have taken next (within [ds_min, ds_max]), max_points less the points
+// already saved. InputError naming `key` when the guess's size differs (another grid) or no
+// point would be left.
+void take_up(const RestartPoint& restart, const std::string& key, ContinuationOptions& options,
+             core::Vector& guess, core::Vector& direction);
 // "DIR:K" or "DIR/orbits.csv:K" (any file of DIR) -> (DIR, K); InputError naming `key`.
 std::pair<std::filesystem::path, int> parse_saved_point(const std::string& text,
                                                         const std::string& key);

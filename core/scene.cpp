@@ -159,6 +159,18 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
   return Scene(std::move(vm), ini_path);
 }
 
+po::variables_map parse_options(const po::options_description& keys,
+                                const std::vector<std::string>& arguments) {
+  po::variables_map vm;
+  try {
+    po::store(po::command_line_parser(arguments).options(keys).run(), vm);
+    po::notify(vm);
+  } catch (const po::error& e) {
+    throw InputError("", e.what());
+  }
+  return vm;
+}
+
 std::string scene_problem_name(const std::string& ini_path) {
   std::istringstream in = open_scene(ini_path);
   po::options_description keys;

@@ -62,6 +62,11 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
                  const std::vector<std::string>& arguments,
                  const po::options_description& driver_keys);
 
+// Options of a command without a scene (bench, figures, reproduce): parses `arguments` against
+// `keys`; an unknown option, a missing value or a stray word is an InputError.
+po::variables_map parse_options(const po::options_description& keys,
+                                const std::vector<std::string>& arguments);
+
 // The value of the `problem` key of an INI file (empty when absent), read before the
 // problem's keys are known. Throws InputError when the file cannot be read.
 std::string scene_problem_name(const std::string& ini_path);

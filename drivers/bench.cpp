@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/scene.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/plugins.hpp"
 
@@ -33,13 +34,7 @@ int run_bench(const std::vector<std::string>& args) {
       "case", po::value<std::string>(), "only this case (default: all)")(
       "out", po::value<std::string>()->default_value("results/bench"), "output directory")(
       "help", "describe the command");
-  po::variables_map vm;
-  try {
-    po::store(po::command_line_parser(args).options(keys).run(), vm);
-    po::notify(vm);
-  } catch (const po::error& e) {
-    throw core::InputError("", e.what());
-  }
+  const po::variables_map vm = backbone::core::parse_options(keys, args);
   if (vm.count("help")) {
     std::ostringstream text;
     text << keys;

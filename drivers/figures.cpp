@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/scene.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/plugins.hpp"
 
@@ -22,13 +23,7 @@ int run_figures(const std::vector<std::string>& args) {
   keys.add_options()("out", po::value<std::string>()->default_value("results"),
                      "folder holding the traced branches; the figures go there too")(
       "help", "describe the command");
-  po::variables_map vm;
-  try {
-    po::store(po::command_line_parser(args).options(keys).run(), vm);
-    po::notify(vm);
-  } catch (const po::error& e) {
-    throw core::InputError("", e.what());
-  }
+  const po::variables_map vm = backbone::core::parse_options(keys, args);
   if (vm.count("help")) {
     std::ostringstream text;
     text << keys;

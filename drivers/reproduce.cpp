@@ -42,13 +42,7 @@ int run_reproduce(const std::vector<std::string>& args) {
       "out", po::value<std::string>()->default_value("results"), "output folder")(
       "quick", po::bool_switch(), "skip the benchmarks (bench)")("only", po::value<std::string>(),
                                                                  "run one step by name");
-  po::variables_map vm;
-  try {
-    po::store(po::command_line_parser(args).options(keys).run(), vm);
-    po::notify(vm);
-  } catch (const po::error& e) {
-    throw backbone::core::InputError("", e.what());
-  }
+  const po::variables_map vm = backbone::core::parse_options(keys, args);
   if (vm.count("help")) {
     std::string names;
     for (const ReproduceStep& s : plan("OUT", false)) names += " " + s.name;

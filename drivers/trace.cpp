@@ -20,7 +20,6 @@
 #include "core/errors.hpp"
 #include "core/output_folder.hpp"
 #include "core/periodic_orbit.hpp"
-#include "core/plot.hpp"
 #include "core/scene.hpp"
 #include "core/scene_ini.hpp"
 #include "core/table.hpp"
@@ -70,34 +69,6 @@ void print_help(const cont::ProblemPlugin* problem) {
          << "\n(defaults of a problem's own keys: backbone trace SCENE --help)\n";
   }
   fmt::print("{}\n", text.str());
-}
-
-// The figure: frequency against energy (log axis) when the problem reports them, else the
-// first two observables.
-void write_figure(const std::filesystem::path& out, const core::Table& table,
-                  const std::string& title) {
-  const auto& columns = table.columns();
-  const auto column_of = [&](const std::string& name) {
-    for (std::size_t i = 0; i < columns.size(); ++i)
-      if (columns[i] == name) return static_cast<int>(i) + 1;
-    return 0;
-  };
-  int x = column_of("energy"), y = column_of("frequency");
-  bool log_x = x > 0 && y > 0;
-  if (!log_x) {
-    x = 2;
-    y = 3;
-  }
-  if (static_cast<int>(columns.size()) < std::max(x, y)) return;
-  const std::string script = fmt::format(
-      "set datafile separator ','\nset key top left\nset grid\n{}"
-      "set xlabel '{}'\nset ylabel '{}'\nset title '{}' noenhanced\n"
-      "plot {} using {}:{} skip 1 with linespoints pt 7 ps 0.6 title 'branch'\n",
-      log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", columns[x - 1],
-      columns[y - 1] + (columns[y - 1] == "frequency" ? " [rad/time]" : ""), title,
-      core::gnuplot_quote(out / "branch.csv"), x, y);
-  core::PlotResult r = core::render_png(out / "branch.png", script);
-  if (!r.ok) fmt::print(stderr, "figure skipped: {}\n", r.message);
 }
 
 // SIGINT / SIGTERM ask the continuation to stop before its next step (ContinuationHooks::
@@ -174,21 +145,8 @@ int run_trace(const std::vector<std::string>& args_in) {
     if (restart->secant.size() == 0) restart->secant = direction;
     restart->secant *= static_cast<double>(start_direction);
   }
-  if (restart) {
-    if (restart->x.size() != problem.num_unknowns())
-      throw core::InputError(resume.empty() ? "start" : "resume",
-                             fmt::format("the saved point has {} unknowns, this scene's problem "
-                                         "{} (same grid keys?)",
-                                         restart->x.size(), problem.num_unknowns()));
-    setup.guess = restart->x;
-    direction = restart->secant;
-    if (restart->next_step > 0)
-      options.ds = std::clamp(restart->next_step, options.ds_min, options.ds_max);
-    options.max_points -= restart->index;  // the saved point is the restart's first
-    if (options.max_points < 2)
-      throw core::InputError(
-          "max_points", fmt::format("the saved branch has {} points already", restart->index + 1));
-  }
+  if (restart)
+    cont::take_up(*restart, resume.empty() ? "start" : "resume", options, setup.guess, direction);
 
   const int n = problem.num_unknowns(), m = problem.num_equations();
   if (m != n - 1 && corrector->name() == "kinsol")
@@ -265,8 +223,8 @@ int run_trace(const std::vector<std::string>& args_in) {
   if (!branch.points.empty()) {
     // The figure and the extra outputs show the whole branch, saved points included.
     const core::Table table = core::Table::read_csv(out / "branch.csv");
-    write_figure(out, table,
-                 fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()));
+    cont::plot_branch(out, table,
+                      fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()));
     if (setup.write_extra_outputs) setup.write_extra_outputs(out, branch);
   }
   core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",
