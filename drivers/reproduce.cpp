@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 
@@ -21,7 +22,8 @@ using backbone::drivers::commands;
 
 using backbone::continuation::ReproduceStep;
 
-// Every plugin's steps, in registration order, with "{out}" replaced by the output folder.
+// Every plugin's steps, "{out}" replaced; figures and benchmarks after the rest.
+// replaced by the output folder.
 std::vector<ReproduceStep> plan(const std::string& out, bool quick) {
   std::vector<ReproduceStep> steps;
   for (const auto& plugin : backbone::drivers::plugins().all())
@@ -33,6 +35,12 @@ std::vector<ReproduceStep> plan(const std::string& out, bool quick) {
           word.replace(at, 5, out);
       steps.push_back(std::move(step));
     }
+  // Figures read what the traces wrote; benchmarks come last (the longest).
+  const auto rank = [](const ReproduceStep& s) {
+    return s.command == "bench" ? 2 : s.command == "figures" ? 1 : 0;
+  };
+  std::stable_sort(steps.begin(), steps.end(),
+                   [&](const auto& a, const auto& b) { return rank(a) < rank(b); });
   return steps;
 }
 
