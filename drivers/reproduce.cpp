@@ -23,7 +23,6 @@ using backbone::drivers::commands;
 using backbone::continuation::ReproduceStep;
 
 // Every plugin's steps, "{out}" replaced; figures and benchmarks after the rest.
-// replaced by the output folder.
 std::vector<ReproduceStep> plan(const std::string& out, bool quick) {
   std::vector<ReproduceStep> steps;
   for (const auto& plugin : backbone::drivers::plugins().all())
