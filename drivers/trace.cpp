@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "continuation/outputs.hpp"
+#include "continuation/progress.hpp"
 #include "continuation/scene_options.hpp"
 #include "core/errors.hpp"
 #include "core/output_folder.hpp"
@@ -188,6 +189,7 @@ int run_trace(const std::vector<std::string>& args_in) {
   std::signal(SIGTERM, request_stop);
   const int offset = restart ? restart->index : 0;
   const double arclength_offset = restart ? restart->arclength : 0;
+  cont::ProgressLine progress(options);
   cont::ContinuationHooks hooks;
   hooks.cancel_requested = [] { return stop_signal != 0; };
   hooks.on_point = [&](const cont::BranchPoint& p_in) {
@@ -196,13 +198,11 @@ int run_trace(const std::vector<std::string>& args_in) {
     p.index += offset;
     p.arclength += arclength_offset;
     writer.append(p);
-    std::string observables;
-    for (const auto& [key, value] : p.observables)
-      observables += fmt::format(" {} {:.10g}", key, value);
-    fmt::print("  point {:4d}{}  dim {}  |F| {:.1e}  newton {}  ds {:.3g}  {:.3f} s{}\n", p.index,
-               observables, p.dimension, p.residual, p.newton_iterations, p.step_size, p.seconds,
+    progress.finish();  // the point's line replaces the progress line, which follows it
+    fmt::print("  {}{}\n", cont::point_line(p),
                setup.describe_point ? "  " + setup.describe_point(p) : "");
     std::fflush(stdout);
+    progress.update(p);
   };
   long rejected = 0;
   hooks.reject_point = setup.reject_point;
@@ -216,6 +216,7 @@ int run_trace(const std::vector<std::string>& args_in) {
       cont::run_continuation(problem, setup.guess, direction, run, *corrector, hooks);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
+  progress.finish();
   cont::Branch& branch = result.branch;
   for (cont::BranchPoint& p : branch.points) p.index += offset;
   const bool complete = !branch.points.empty() && !branch.ended_early();
