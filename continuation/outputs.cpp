@@ -30,8 +30,9 @@ core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch&
   return t;
 }
 
-void plot_branch(const std::filesystem::path& out, const core::Table& table,
-                 const std::string& title) {
+std::string branch_plot_script(const std::filesystem::path& csv, const core::Table& table,
+                               const std::string& title,
+                               const std::map<std::string, std::string>& units) {
   const auto& columns = table.columns();
   const auto column_of = [&](const std::string& name) {
     for (std::size_t i = 0; i < columns.size(); ++i)
@@ -39,19 +40,31 @@ void plot_branch(const std::filesystem::path& out, const core::Table& table,
     return 0;
   };
   int x = column_of("energy"), y = column_of("frequency");
-  bool log_x = x > 0 && y > 0;
+  const bool log_x = x > 0 && y > 0;
   if (!log_x) {
     x = 2;
     y = 3;
   }
-  if (static_cast<int>(columns.size()) < std::max(x, y)) return;
-  const std::string script = fmt::format(
-      "set datafile separator ','\nset key top left\nset grid\n{}"
-      "set xlabel '{}'\nset ylabel '{}'\nset title '{}' noenhanced\n"
-      "plot {} using {}:{} skip 1 with linespoints pt 7 ps 0.6 title 'branch'\n",
-      log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", columns[x - 1],
-      columns[y - 1] + (columns[y - 1] == "frequency" ? " [rad/time]" : ""), title,
-      core::gnuplot_quote(out / "branch.csv"), x, y);
+  if (static_cast<int>(columns.size()) < std::max(x, y)) return {};
+  const auto label = [&](int column) {
+    const std::string& name = columns[column - 1];
+    const auto unit = units.find(name);
+    return unit == units.end() ? name : fmt::format("{} [{}]", name, unit->second);
+  };
+  // The header is read by `set key autotitle columnhead` (core::render_png): no `skip`, which
+  // would drop the first point as well.
+  return fmt::format(
+      "set key top left\nset grid\n{}set xlabel '{}' noenhanced\nset ylabel '{}' noenhanced\n"
+      "set title '{}' noenhanced\n"
+      "plot {} using {}:{} with linespoints pt 7 ps 0.6 title 'branch'\n",
+      log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", label(x), label(y), title,
+      core::gnuplot_quote(csv), x, y);
+}
+
+void plot_branch(const std::filesystem::path& out, const core::Table& table,
+                 const std::string& title, const std::map<std::string, std::string>& units) {
+  const std::string script = branch_plot_script(out / "branch.csv", table, title, units);
+  if (script.empty()) return;
   core::PlotResult r = core::render_png(out / "branch.png", script);
   if (!r.ok) fmt::print(stderr, "figure skipped: {}\n", r.message);
 }

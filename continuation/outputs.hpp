@@ -19,6 +19,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -32,10 +33,15 @@ namespace backbone::continuation {
 core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch& branch);
 
 // out/branch.png from the rows of out/branch.csv (`table`), every point: frequency against
-// energy (log axis) when the problem reports them, else the first two observables. A figure
-// that cannot be drawn (no gnuplot) is reported on stderr, not an error.
+// energy (log axis) when the problem reports them, else the first two observables; axis labels
+// carry the units the problem gives (ProblemPlugin::units). A figure that cannot be drawn (no
+// gnuplot) is reported on stderr, not an error. branch_plot_script is its gnuplot text (empty
+// when the table has too few columns).
 void plot_branch(const std::filesystem::path& out, const core::Table& table,
-                 const std::string& title);
+                 const std::string& title, const std::map<std::string, std::string>& units = {});
+std::string branch_plot_script(const std::filesystem::path& csv, const core::Table& table,
+                               const std::string& title,
+                               const std::map<std::string, std::string>& units = {});
 
 class BranchWriter {
  public:

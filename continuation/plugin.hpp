@@ -26,6 +26,7 @@
 #include <boost/program_options.hpp>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -90,6 +91,9 @@ struct ProblemPlugin {
   // validates everything before it creates `out` (bad input writes nothing).
   std::function<boost::program_options::options_description()> simulate_keys;
   std::function<int(const core::Scene& scene, const std::filesystem::path& out)> simulate;
+
+  // Units of the observables (branch.csv columns) for axis labels and docs: {"energy", "J"}.
+  std::map<std::string, std::string> units;
 
   std::vector<ProblemJob> bench_cases;
   std::vector<ProblemJob> figures;  // run(out): reads the traced branches in out, draws

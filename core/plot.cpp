@@ -40,9 +40,19 @@ PlotResult render_png(const std::filesystem::path& png, const std::string& gnupl
   log += ".log";
   std::error_code ec;
   if (rc != 0 || !std::filesystem::exists(part)) {
-    std::filesystem::remove(part, ec);
-    return {false, fmt::format("gnuplot failed (exit {}) for {}; see {} and {}", rc, png.string(),
-                               script.string(), log.string())};
+    // Nothing is left behind: the message carries gnuplot's error line.
+    std::string complaint;
+    if (std::FILE* f = std::fopen(log.c_str(), "r")) {
+      char line[512];
+      while (std::fgets(line, sizeof line, f))
+        if (std::string(line).find_first_not_of(" \t\n^") != std::string::npos) complaint = line;
+      std::fclose(f);
+    }
+    while (!complaint.empty() && (complaint.back() == '\n' || complaint.back() == ' '))
+      complaint.pop_back();
+    for (const auto& p : {part, script, log}) std::filesystem::remove(p, ec);
+    return {false, fmt::format("gnuplot failed (exit {}) for {}{}", rc, png.string(),
+                               complaint.empty() ? "" : ": " + complaint)};
   }
   std::filesystem::rename(part, png);
   std::filesystem::remove(script, ec);

@@ -225,7 +225,8 @@ int run_trace(const std::vector<std::string>& args_in) {
     // The figure and the extra outputs show the whole branch, saved points included.
     const core::Table table = core::Table::read_csv(out / "branch.csv");
     cont::plot_branch(out, table,
-                      fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()));
+                      fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()),
+                      entry.units);
     if (setup.write_extra_outputs) setup.write_extra_outputs(out, branch);
   }
   core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",

@@ -172,6 +172,11 @@ void register_plugin(continuation::PluginRegistry& registry) {
   p.setup = &setup_trace;
   p.simulate_keys = &simulate_keys;
   p.simulate = &simulate_scene;
+  p.units = {{"period", "s"},
+             {"frequency", "rad/s"},
+             {"energy", "J"},
+             {"end_amplitude", "m"},
+             {"knot", "m"}};
   p.bench_cases = bench_cases();
   p.figures = figure_jobs();
   const std::string scenes = "problems/contact_bar/scenes/";

@@ -47,11 +47,11 @@ std::string plot_script(const std::vector<std::pair<std::string, fs::path>>& cur
   s += "set xlabel 't [s]'\nset ylabel 'contact-end displacement u [m]'\nplot ";
   for (std::size_t i = 0; i < curves.size(); ++i)
     s += (i ? ", " : "") + core::gnuplot_quote(curves[i].second) +
-         " skip 1 using 1:2 with lines lw 1.5 title " + core::gnuplot_quote(curves[i].first);
+         " using 1:2 with lines lw 1.5 title " + core::gnuplot_quote(curves[i].first);
   s += "\nset xlabel 't [s]'\nset ylabel 'contact force {/Symbol l} [N]'\nplot ";
   for (std::size_t i = 0; i < curves.size(); ++i)
     s += (i ? ", " : "") + core::gnuplot_quote(curves[i].second) +
-         " skip 1 using 1:3 with lines lw 1.5 title " + core::gnuplot_quote(curves[i].first);
+         " using 1:3 with lines lw 1.5 title " + core::gnuplot_quote(curves[i].first);
   s += "\nunset multiplot\n";
   return s;
 }
