@@ -6,8 +6,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "continuation/scaled_problem.hpp"
+#include "core/errors.hpp"
+#include "core/rank_report.hpp"
 #include "problems/contact_bar/family.hpp"
+#include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/tdbem.hpp"
+#include "problems/exact_bar/exact_bar_solver.hpp"
 #include "problems/exact_bar/exact_solution.hpp"
 
 namespace backbone::contact_bar {
@@ -107,6 +112,101 @@ TEST(TdbemStartsInContact, MatchesExactSolver) {
     }
     EXPECT_LT(worst_u / 1e-3, 1e-12) << shape;
   }
+}
+
+OrbitOptions on_wall(int elements, int free_knots) {
+  OrbitOptions o;
+  o.elements = elements;
+  o.steps_per_period = 40;
+  o.free_knots = free_knots;
+  o.start_on_wall = true;
+  o.test_elements = 2 * o.state_size();
+  return o;
+}
+
+// Two free knots and u0(L) = g0 held by the representation: every member is a root of the
+// residual to round-off with both solvers (the event TD-BEM is exact for piecewise-linear data;
+// 1e-12 in units of g0), and u0 is the closed form at every node.
+TEST(SubharmonicRepresentation, TwoKnotsHoldTheMembersExactly) {
+  const exact_bar::ExactBarSolver exact;
+  const TdbemSolver tdbem(ContactMethod::event);
+  for (const bar::BarSolver* solver :
+       {static_cast<const bar::BarSolver*>(&exact), static_cast<const bar::BarSolver*>(&tdbem)})
+    for (double energy : {4.6e-6, 1.25e-5, 1e-4})
+      for (double shape : {0.1, 0.5, 0.8, 1.0}) {
+        const ContactBarOrbitProblem p(paper_setup({}), *solver, on_wall(20, 2));
+        const core::Vector x = p.subharmonic_guess(energy, shape);
+        EXPECT_EQ(x.size(), 19 + 2 + 1);  // u0 at nodes 1..19, two knots, T
+        core::Vector r;
+        ASSERT_EQ(p.residual(x, r), core::EvalStatus::ok);
+        EXPECT_LT(r.lpNorm<Eigen::Infinity>(), 1e-12) << energy << " " << shape;
+        EXPECT_DOUBLE_EQ(p.initial_displacement(x)(1.0), 1e-3);
+        EXPECT_NEAR(p.energy(x) / energy, 1, 1e-12);
+      }
+}
+
+// One knot cannot hold a member with two kinks off the grid: the residual stays O(1) in units
+// of g0 (measured 1e-1 .. 1), so the count of knots matters (README.md, 'Representability').
+TEST(SubharmonicRepresentation, OneKnotIsNotEnough) {
+  const TdbemSolver tdbem(ContactMethod::event);
+  OrbitOptions o = on_wall(20, 2);
+  const ContactBarOrbitProblem two(paper_setup({}), tdbem, o);
+  const core::Vector x2 = two.subharmonic_guess(1.25e-5, 0.8);
+  o.free_knots = 1;
+  o.test_elements = 2 * o.state_size();
+  const ContactBarOrbitProblem one(paper_setup({}), tdbem, o);
+  core::Vector x1(one.num_unknowns());
+  const bar::PiecewiseLinear u0 = two.initial_displacement(x2);
+  x1[one.knot_index(0)] = x2[two.knot_index(0)];  // first kink on the knot, second between nodes
+  const core::Vector y = one.node_positions(x1);
+  for (int i = 0; i < o.nodal_unknowns(); ++i) x1[i] = u0(y[i]);
+  x1[one.period_index()] = x2[two.period_index()];
+  core::Vector r;
+  ASSERT_EQ(one.residual(x1, r), core::EvalStatus::ok);
+  EXPECT_GT(r.lpNorm<Eigen::Infinity>(), 1e-2);
+}
+
+// Knot settings are checked: at most N - 1 knots, reference nodes strictly increasing.
+TEST(SubharmonicRepresentation, KnotSettingsAreChecked) {
+  OrbitOptions o = on_wall(10, 10);
+  EXPECT_THROW(o.validate(), core::InputError);
+  o = on_wall(10, 2);
+  o.knot_nodes = {5, 3};
+  EXPECT_THROW(o.validate(), core::InputError);
+  o.knot_nodes = {3};
+  EXPECT_THROW(o.validate(), core::InputError);
+  o.knot_nodes = {3, 5};
+  EXPECT_NO_THROW(o.validate());
+}
+
+// The dimension: at members of the continuum the verified rank report of the (column-scaled)
+// residual Jacobian finds two null directions (energy and shape) at N = 20 and 40, with a gap
+// of at least 1e4 between the kept and the dropped singular values (measured 5e4 .. 1e6).
+// Shapes 0.1 and 0.8: at some other shapes (0.5 = mode 2 itself, 0.25 at N = 40) forward
+// differences see one side of a non-smooth coincidence and report extra candidates (README.md,
+// 'Subharmonic continuum'). The knots' reference nodes are the nodes nearest the kinks.
+TEST(SubharmonicRepresentation, VerifiedDimensionIsTwo) {
+  const TdbemSolver tdbem(ContactMethod::event);
+  for (int n : {20, 40})
+    for (double shape : {0.1, 0.8}) {
+      OrbitOptions o = on_wall(n, 2);
+      const SubharmonicMember member = subharmonic_member(bar::Material{}, 1e-3, 1.25e-5, shape);
+      o.knot_nodes = nearest_knot_nodes(n, 1.0, {member.kinks[0], member.kinks[1]});
+      const ContactBarOrbitProblem p(paper_setup({}), tdbem, o);
+      const continuation::ScaledProblem scaled(p);
+      const core::Vector z = scaled.to_scaled(p.subharmonic_guess(1.25e-5, shape));
+      core::Matrix J;
+      ASSERT_EQ(scaled.jacobian(z, J), core::EvalStatus::ok);
+      core::RankOptions rank;
+      rank.relative_threshold = 1e-5;  // the trace default (plugin.cpp, rank_threshold)
+      core::RankReport report = core::rank_report(J, rank);
+      const core::VerifyOptions verify;
+      auto verifier = core::make_verifier(verify);
+      core::verify_null_directions(scaled, z, *verifier, verify, report);
+      EXPECT_EQ(report.nullity, 2) << n << " " << shape << " " << report.summary();
+      EXPECT_EQ(report.verified_dimension, 2) << n << " " << shape << " " << report.summary();
+      EXPECT_GT(report.gap, 1e4) << report.summary();
+    }
 }
 
 }  // namespace
