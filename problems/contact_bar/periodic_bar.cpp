@@ -9,6 +9,7 @@
 
 #include "core/errors.hpp"
 #include "problems/contact_bar/family.hpp"
+#include "problems/contact_bar/subharmonic.hpp"
 
 namespace backbone::contact_bar {
 
@@ -52,6 +53,13 @@ void OrbitOptions::validate() const {
                      fmt::format("must be 0 (square system) or >= elements + free_knots{} = {} "
                                  "(got {})",
                                  start_on_wall ? " - 1" : "", state_size(), test_elements));
+  if (!std::isfinite(fixed_energy) || fixed_energy < 0)
+    throw InputError("energy",
+                     fmt::format("must be > 0, or 0 for no energy row (got {})", fixed_energy));
+  if (fixed_shape >= 0 && (fixed_shape > 1 || !start_on_wall || free_knots < 2))
+    throw InputError("shape", fmt::format("must be in [0, 1], with start_on_wall and two free "
+                                          "knots (got {})",
+                                          fixed_shape));
   if (!std::isfinite(fixed_dt) || fixed_dt < 0)
     throw InputError("fixed_dt", fmt::format("must be >= 0 (0: dt = T / steps_per_period; "
                                              "got {})",
@@ -195,8 +203,24 @@ double ContactBarOrbitProblem::energy(const Vector& x) const {
   return 0.5 * setup_.material.axial_stiffness() * sum;
 }
 
+double ContactBarOrbitProblem::subharmonic_shape(const Vector& x) const {
+  if (options_.free_knots < 2) return std::nan("");
+  const double length = setup_.material.length;
+  const double k1 = x[knot_index(0)] / length, k2 = x[knot_index(1)] / length;
+  return (1 - k2) / (1 - 1.5 * (k2 - k1));
+}
+
 core::Observables ContactBarOrbitProblem::observables(const Vector& x) const {
   core::Observables o = PeriodicOrbitProblem::observables(x);
+  if (options_.start_on_wall) {
+    const ContactStructure c = contact_structure(setup_at(x), x[period_index()]);
+    const double nan = std::nan("");
+    o.emplace_back("shape", subharmonic_shape(x));
+    o.emplace_back("contact_phases", c.ok ? c.contact_phases : nan);
+    o.emplace_back("grazing_instants", c.ok ? c.grazing_instants : nan);
+    o.emplace_back("min_gap", c.ok ? c.min_gap : nan);
+    o.emplace_back("first_contact", c.ok ? c.first_contact : nan);
+  }
   o.emplace_back("end_amplitude", std::abs(node_value(x, options_.elements)));
   if (options_.free_knots == 1) o.emplace_back("knot", x[knot_index(0)]);
   if (options_.free_knots > 1)
@@ -217,7 +241,7 @@ Vector ContactBarOrbitProblem::typical_scale() const {
 
 EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
   const int n = options_.elements;
-  const int m = num_equations();  // equations = snapshot grid elements
+  const int m = options_.test_elements > 0 ? options_.test_elements : state_size();  // grid
   const double length = setup_.material.length;
   const double period = x[period_index()];
   if (!std::isfinite(period) || !(period > 0)) return EvalStatus::failed;
@@ -255,7 +279,15 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
   }
   if (!snap.ok) return EvalStatus::failed;
 
-  r.resize(m);
+  const int rows = path_rows_enabled_ ? options_.path_rows() : 0;
+  r.resize(m + rows);
+  int row = m;
+  if (rows > 0 && options_.fixed_energy > 0)
+    r[row++] = (energy(x) - options_.fixed_energy) / options_.fixed_energy;
+  if (rows > 0 && options_.fixed_shape >= 0) {
+    const double k1 = x[knot_index(0)] / length, k2 = x[knot_index(1)] / length;
+    r[row++] = 1 - k2 - options_.fixed_shape * (1 - 1.5 * (k2 - k1));
+  }
   const double u_scale = displacement_scale();
   if (paper) {
     if (static_cast<int>(snap.u.size()) != m + 1) return EvalStatus::failed;

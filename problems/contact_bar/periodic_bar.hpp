@@ -61,6 +61,14 @@ struct OrbitOptions {
                                 // M >= 2N removes (measured, see trace_contact_bar.cpp)
   int steps_per_period = 2000;  // dt = T / steps_per_period; must be even
   double fixed_dt = 0;          // > 0: this dt instead (T/2 and T then fall between steps)
+  // Path rows: equations appended after the M residual rows that pick a path on a manifold of
+  // orbits (README.md, 'Subharmonic continuum'); ContactBarOrbitProblem::set_path_rows(false)
+  // drops them, e.g. to measure the dimension of the periodicity residual alone.
+  double fixed_energy = 0;  // > 0: (energy(x) - fixed_energy) / fixed_energy = 0
+  double fixed_shape = -1;  // in [0, 1]: the subharmonic shape (first contact phase / total
+                            // contact time) fixed, a linear row in knots 1 and 2 (needs
+                            // start_on_wall, K >= 2): 1 - k2 = shape (1 - 3 (k2 - k1) / 2)
+  int path_rows() const { return (fixed_energy > 0 ? 1 : 0) + (fixed_shape >= 0 ? 1 : 0); }
   int nodal_unknowns() const { return elements - (start_on_wall ? 1 : 0); }
   int state_size() const { return nodal_unknowns() + free_knots; }
   void validate() const;  // throws core::InputError naming the field
@@ -79,8 +87,15 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   int state_size() const override { return options_.state_size(); }
   // M = test_elements (state_size() when 0).
   int num_equations() const override {
-    return options_.test_elements > 0 ? options_.test_elements : state_size();
+    return (options_.test_elements > 0 ? options_.test_elements : state_size()) +
+           (path_rows_enabled_ ? options_.path_rows() : 0);
   }
+  // Path rows on (default) or off: off, the residual is the periodicity residual F alone.
+  void set_path_rows(bool enabled) { path_rows_enabled_ = enabled; }
+  bool path_rows_enabled() const { return path_rows_enabled_; }
+  // The subharmonic shape of x from its first two knots (README.md, 'Subharmonic continuum'):
+  // (1 - k2) / (1 - 3 (k2 - k1) / 2) with lengths in units of L. NaN without two knots.
+  double subharmonic_shape(const core::Vector& x) const;
   // Potential energy of u0: 1/2 int EA u0_x^2 dx (v0 = 0), exact for piecewise-linear u0.
   double energy(const core::Vector& x) const override;
   // Node positions y_1..y_N of the representation grid at x (mapped when a knot is free),
@@ -92,7 +107,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   // them), so the written orbit is exactly the piecewise-linear u0 the residual simulated.
   void initial_state_samples(const core::Vector& x, core::Vector& coordinates,
                              core::Vector& values) const override;
-  // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (K = 1) or knot_1..knot_K.
+  // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (K = 1) or knot_1..knot_K;
+  // with start_on_wall also shape, contact_phases, grazing_instants, min_gap and first_contact,
+  // counted from an exact simulation over T (subharmonic.hpp).
   core::Observables observables(const core::Vector& x) const override;
   // u_s for the u0 entries, L for a free knot, L/c for the period.
   core::Vector typical_scale() const override;
@@ -137,6 +154,7 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   bar::BarSetup setup_;
   const bar::BarSolver& solver_;
   OrbitOptions options_;
+  bool path_rows_enabled_ = true;
 };
 
 // Reference nodes for knots at the given positions (increasing, in (0, L)): the nearest nodes

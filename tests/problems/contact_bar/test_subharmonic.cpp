@@ -11,6 +11,7 @@
 #include "core/rank_report.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
+#include "problems/contact_bar/subharmonic.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
 #include "problems/exact_bar/exact_solution.hpp"
@@ -207,6 +208,47 @@ TEST(SubharmonicRepresentation, VerifiedDimensionIsTwo) {
       EXPECT_EQ(report.verified_dimension, 2) << n << " " << shape << " " << report.summary();
       EXPECT_GT(report.gap, 1e4) << report.summary();
     }
+}
+
+// The contact structure counted from the exact simulation: two phases inside the continuum, one
+// phase plus one grazing instant at either limit (the description), no penetration
+// (min_gap >= 0 to round-off) and the phase through t = 0 measured across t = T.
+TEST(SubharmonicContinuum, ContactStructureFromTheExactSimulation) {
+  const bar::Material m;
+  for (double shape : {0.0, 0.2, 0.5, 0.9, 1.0}) {
+    const SubharmonicMember member = subharmonic_member(m, 1e-3, 1.25e-5, shape);
+    const ContactStructure c = contact_structure(paper_setup(member.u0), member.period);
+    ASSERT_TRUE(c.ok);
+    const bool limit = shape == 0.0 || shape == 1.0;
+    EXPECT_EQ(c.contact_phases, limit ? 1 : 2) << shape;
+    EXPECT_EQ(c.grazing_instants, limit ? 1 : 0) << shape;
+    EXPECT_GE(c.min_gap, -1e-15) << shape;
+    EXPECT_NEAR(c.first_contact, member.first_contact, 1e-12) << shape;
+  }
+}
+
+// Path rows: the energy row and the shape row vanish at a member of that energy and shape and
+// not elsewhere; set_path_rows(false) leaves the periodicity residual F alone.
+TEST(SubharmonicRepresentation, PathRowsPickTheMember) {
+  const TdbemSolver tdbem(ContactMethod::event);
+  OrbitOptions o = on_wall(20, 2);
+  o.fixed_energy = 1.25e-5;
+  o.fixed_shape = 0.3;
+  ContactBarOrbitProblem p(paper_setup({}), tdbem, o);
+  EXPECT_EQ(p.num_equations(), o.test_elements + 2);
+  core::Vector r;
+  ASSERT_EQ(p.residual(p.subharmonic_guess(1.25e-5, 0.3), r), core::EvalStatus::ok);
+  EXPECT_LT(r.lpNorm<Eigen::Infinity>(), 1e-12);
+  EXPECT_NEAR(p.subharmonic_shape(p.subharmonic_guess(1.25e-5, 0.3)), 0.3, 1e-14);
+  ASSERT_EQ(p.residual(p.subharmonic_guess(2e-5, 0.3), r), core::EvalStatus::ok);
+  EXPECT_NEAR(r[o.test_elements], 0.6, 1e-12);  // (2e-5 - 1.25e-5) / 1.25e-5
+  EXPECT_NEAR(r[o.test_elements + 1], 0, 1e-14);
+  ASSERT_EQ(p.residual(p.subharmonic_guess(1.25e-5, 0.7), r), core::EvalStatus::ok);
+  EXPECT_GT(std::abs(r[o.test_elements + 1]), 1e-3);
+  p.set_path_rows(false);
+  EXPECT_EQ(p.num_equations(), o.test_elements);
+  ASSERT_EQ(p.residual(p.subharmonic_guess(2e-5, 0.7), r), core::EvalStatus::ok);
+  EXPECT_LT(r.lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
 }  // namespace
