@@ -47,6 +47,10 @@ po::options_description subharmonic_keys() {
        "subharmonic shape in [0, 1] (first contact phase / total contact time; 0 and 1 are "
        "the grazing limits, 0.5 mode 2). subharmonic: the shape kept along the backbone "
        "(-1: 0.3); subharmonic_continuum: the first member (-1: 1, a grazing limit)")  //
+      ("path_rows", po::value<bool>()->default_value(true),
+       "subharmonic branches: append the row that picks the path (shape or energy); false "
+       "leaves the periodicity residual F alone, whose solutions form a 2D manifold (for "
+       "`backbone inspect`: trace needs the row)")  //
       ("dimension_check", po::value<bool>()->default_value(true),
        "subharmonic branches: replace branch.csv's dimension (that of F plus the path rows) by "
        "the verified dimension of the periodicity residual F alone at each point");
@@ -283,6 +287,7 @@ continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::
                               const std::filesystem::path& out, const continuation::Branch& b) {
     write_subharmonic_outputs(*p, mode2, b, out, dimension_check ? rank_threshold : std::nan(""));
   };
+  problem->set_path_rows(scene.flag("path_rows"));
   s.problem = std::move(problem);
   return s;
 }
