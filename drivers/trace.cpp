@@ -15,12 +15,12 @@
 #include <optional>
 #include <sstream>
 
+#include "continuation/branch_figure.hpp"
 #include "continuation/outputs.hpp"
 #include "continuation/scene_options.hpp"
 #include "core/errors.hpp"
 #include "core/output_folder.hpp"
 #include "core/periodic_orbit.hpp"
-#include "core/plot.hpp"
 #include "core/scene.hpp"
 #include "core/scene_ini.hpp"
 #include "core/table.hpp"
@@ -70,34 +70,6 @@ void print_help(const cont::ProblemPlugin* problem) {
          << "\n(defaults of a problem's own keys: backbone trace SCENE --help)\n";
   }
   fmt::print("{}\n", text.str());
-}
-
-// The figure: frequency against energy (log axis) when the problem reports them, else the
-// first two observables.
-void write_figure(const std::filesystem::path& out, const core::Table& table,
-                  const std::string& title) {
-  const auto& columns = table.columns();
-  const auto column_of = [&](const std::string& name) {
-    for (std::size_t i = 0; i < columns.size(); ++i)
-      if (columns[i] == name) return static_cast<int>(i) + 1;
-    return 0;
-  };
-  int x = column_of("energy"), y = column_of("frequency");
-  bool log_x = x > 0 && y > 0;
-  if (!log_x) {
-    x = 2;
-    y = 3;
-  }
-  if (static_cast<int>(columns.size()) < std::max(x, y)) return;
-  const std::string script = fmt::format(
-      "set datafile separator ','\nset key top left\nset grid\n{}"
-      "set xlabel '{}'\nset ylabel '{}'\nset title '{}' noenhanced\n"
-      "plot {} using {}:{} skip 1 with linespoints pt 7 ps 0.6 title 'branch'\n",
-      log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", columns[x - 1],
-      columns[y - 1] + (columns[y - 1] == "frequency" ? " [rad/time]" : ""), title,
-      core::gnuplot_quote(out / "branch.csv"), x, y);
-  core::PlotResult r = core::render_png(out / "branch.png", script);
-  if (!r.ok) fmt::print(stderr, "figure skipped: {}\n", r.message);
 }
 
 // SIGINT / SIGTERM ask the continuation to stop before its next step (ContinuationHooks::
@@ -265,8 +237,8 @@ int run_trace(const std::vector<std::string>& args_in) {
   if (!branch.points.empty()) {
     // The figure and the extra outputs show the whole branch, saved points included.
     const core::Table table = core::Table::read_csv(out / "branch.csv");
-    write_figure(out, table,
-                 fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()));
+    cont::write_branch_figure(
+        out, table, fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()));
     if (setup.write_extra_outputs) setup.write_extra_outputs(out, branch);
   }
   core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",

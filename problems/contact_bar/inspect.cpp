@@ -4,8 +4,13 @@
 
 #include <chrono>
 
+#include "continuation/outputs.hpp"
 #include "continuation/scaled_problem.hpp"
+#include "continuation/scene_options.hpp"
 #include "core/bordered_system.hpp"
+#include "core/errors.hpp"
+#include "core/periodic_orbit.hpp"
+#include "core/scene_ini.hpp"
 
 namespace backbone::contact_bar {
 
@@ -68,6 +73,36 @@ DimensionEvidence dimension_evidence(const core::Problem& problem, const core::V
   }
   e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return e;
+}
+
+int inspect_command(const continuation::ProblemPlugin& plugin,
+                    const std::vector<std::string>& args) {
+  namespace po = boost::program_options;
+  if (args.empty()) throw core::InputError("SCENE", "a scene file is required");
+  po::options_description keys = plugin.scene_keys(), own("inspect");
+  own.add_options()("orbit", po::value<std::string>(), "DIR/orbits.csv:K")  //
+      ("branch", po::value<std::string>(), "branch of the problem (default: DIR's)");
+  keys.add(continuation::continuation_keys(keys));
+  const core::Scene scene = core::read_scene(keys, args[0], {args.begin() + 1, args.end()}, own);
+  if (!scene.has("orbit")) throw core::InputError("orbit", "needs DIR/orbits.csv:K");
+  const auto [dir, point] = continuation::parse_saved_point(scene.text("orbit"), "orbit");
+  const std::string branch = scene.has("branch")
+                                 ? scene.text("branch")
+                                 : core::read_text_value(dir / "summary.txt", "branch");
+  const continuation::RunSettings run = continuation::read_run_settings(scene);
+  continuation::TraceSetup setup = plugin.setup(scene, branch);
+  if (auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get()))
+    periodic->set_formulation(run.formulation);
+  const core::Vector x = continuation::read_unknowns(dir / "unknowns.csv", point, "orbit");
+  if (x.size() != setup.problem->num_unknowns())
+    throw core::InputError("orbit", fmt::format("the point has {} unknowns, the problem {} (same "
+                                                "grid keys as the trace?)",
+                                                x.size(), setup.problem->num_unknowns()));
+  const DimensionEvidence e =
+      dimension_evidence(*setup.problem, x, run.options.rank, run.options.verification);
+  fmt::print("{} / {} point {}: {} equations, {} unknowns\n{}", plugin.name, branch, point,
+             setup.problem->num_equations(), x.size(), e.text());
+  return e.report.verified_dimension >= 0 ? core::exit_ok : core::exit_numerical_failure;
 }
 
 }  // namespace backbone::contact_bar

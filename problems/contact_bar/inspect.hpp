@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "continuation/plugin.hpp"
 #include "core/problem.hpp"
 #include "core/rank_report.hpp"
 
@@ -37,5 +38,12 @@ struct DimensionEvidence {
 DimensionEvidence dimension_evidence(const core::Problem& problem, const core::Vector& x,
                                      const core::RankOptions& rank,
                                      const core::VerifyOptions& verify);
+
+// `backbone inspect SCENE --orbit DIR/orbits.csv:K [--branch NAME] [--key value ...]` for the
+// plugin of SCENE: builds the problem with plugin.setup (the branch of DIR/summary.txt unless
+// --branch), reads point K of DIR/unknowns.csv, prints the evidence. The scene must give the
+// trace's grid keys (DIR/scene.ini does). Returns the exit code; InputError for bad input.
+int inspect_command(const continuation::ProblemPlugin& plugin,
+                    const std::vector<std::string>& args);
 
 }  // namespace backbone::contact_bar
