@@ -9,7 +9,6 @@
 
 #include "core/errors.hpp"
 #include "problems/contact_bar/family.hpp"
-#include "problems/contact_bar/subharmonic.hpp"
 
 namespace backbone::contact_bar {
 
@@ -212,15 +211,7 @@ double ContactBarOrbitProblem::subharmonic_shape(const Vector& x) const {
 
 core::Observables ContactBarOrbitProblem::observables(const Vector& x) const {
   core::Observables o = PeriodicOrbitProblem::observables(x);
-  if (options_.start_on_wall) {
-    const ContactStructure c = contact_structure(setup_at(x), x[period_index()]);
-    const double nan = std::nan("");
-    o.emplace_back("shape", subharmonic_shape(x));
-    o.emplace_back("contact_phases", c.ok ? c.contact_phases : nan);
-    o.emplace_back("grazing_instants", c.ok ? c.grazing_instants : nan);
-    o.emplace_back("min_gap", c.ok ? c.min_gap : nan);
-    o.emplace_back("first_contact", c.ok ? c.first_contact : nan);
-  }
+  if (options_.free_knots >= 2) o.emplace_back("shape", subharmonic_shape(x));
   o.emplace_back("end_amplitude", std::abs(node_value(x, options_.elements)));
   if (options_.free_knots == 1) o.emplace_back("knot", x[knot_index(0)]);
   if (options_.free_knots > 1)
@@ -286,7 +277,10 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
     r[row++] = (energy(x) - options_.fixed_energy) / options_.fixed_energy;
   if (rows > 0 && options_.fixed_shape >= 0) {
     const double k1 = x[knot_index(0)] / length, k2 = x[knot_index(1)] / length;
-    r[row++] = 1 - k2 - options_.fixed_shape * (1 - 1.5 * (k2 - k1));
+    // In units of g0 like the residual rows (a knot moved by dk moves u0 by about s dk): in
+    // units of L the row weighs 1e-3 of them and the rank report counts it as null.
+    r[row++] =
+        (1 - k2 - options_.fixed_shape * (1 - 1.5 * (k2 - k1))) * length / displacement_scale();
   }
   const double u_scale = displacement_scale();
   if (paper) {

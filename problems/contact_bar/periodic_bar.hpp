@@ -68,6 +68,7 @@ struct OrbitOptions {
   double fixed_shape = -1;  // in [0, 1]: the subharmonic shape (first contact phase / total
                             // contact time) fixed, a linear row in knots 1 and 2 (needs
                             // start_on_wall, K >= 2): 1 - k2 = shape (1 - 3 (k2 - k1) / 2)
+                            // (knots in units of L), times L / g0 as the residual rows
   int path_rows() const { return (fixed_energy > 0 ? 1 : 0) + (fixed_shape >= 0 ? 1 : 0); }
   int nodal_unknowns() const { return elements - (start_on_wall ? 1 : 0); }
   int state_size() const { return nodal_unknowns() + free_knots; }
@@ -107,9 +108,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   // them), so the written orbit is exactly the piecewise-linear u0 the residual simulated.
   void initial_state_samples(const core::Vector& x, core::Vector& coordinates,
                              core::Vector& values) const override;
-  // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (K = 1) or knot_1..knot_K;
-  // with start_on_wall also shape, contact_phases, grazing_instants, min_gap and first_contact,
-  // counted from an exact simulation over T (subharmonic.hpp).
+  // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (K = 1) or knot_1..knot_K,
+  // and shape with K >= 2. (The contact structure of a member costs an exact simulation:
+  // subharmonic.hpp adds it to branch.csv after the trace, not per observable call.)
   core::Observables observables(const core::Vector& x) const override;
   // u_s for the u0 entries, L for a free knot, L/c for the period.
   core::Vector typical_scale() const override;

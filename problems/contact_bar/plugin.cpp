@@ -1,5 +1,7 @@
 // The contact bar as a CLI plugin (continuation/plugin.hpp): `trace` branches mode1 and mode2
 // (the nonlinear modes born from the linear modes omega_k = (2k-1) pi c / (2L) at grazing),
+// subharmonic and subharmonic_continuum (mode 2 over two periods: a 2D manifold of orbits,
+// README.md section 'Subharmonic continuum'),
 // `simulate` (simulate.hpp), its benchmarks and figures, and its steps of the main job.
 //
 // The scene gives the bar (scene.hpp: length, youngs_modulus, density, area, gap, contact,
@@ -80,7 +82,8 @@ po::options_description trace_keys() {
       ("start_guess", po::value<std::string>()->default_value("contact_family"),
        "contact_family (exact piecewise-linear orbit) or linear_mode (sine, linear period)")  //
       ("free_knots", po::value<long>()->default_value(-1),
-       "movable knots of the u0 grid: 0, 1, or -1 = auto (0 for mode1, 1 for mode2)")         //
+       "movable knots of the u0 grid, kept ordered: K >= 0, or -1 = auto (one per kink of the "
+       "branch's exact u0: 0 for mode1, 1 for mode2, 2 for the subharmonic branches)")        //
       ("energy_max", po::value<double>()->default_value(1e-2), "stop above this energy [J]")  //
       ("max_points", po::value<long>()->default_value(1000),
        "points on the branch, first included")  //
@@ -277,9 +280,8 @@ continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::
   }
   s.describe_point = [mode2](const continuation::BranchPoint& point) {
     const double exact = 2 * mode2.period(point.observable("energy"));
-    return fmt::format("T / (2 T2) - 1 = {:.2e}, shape {:.4f}, phases {:g} + grazing {:g}",
-                       point.observable("period") / exact - 1, point.observable("shape"),
-                       point.observable("contact_phases"), point.observable("grazing_instants"));
+    return fmt::format("T / (2 T2) - 1 = {:.2e}, shape {:.4f}",
+                       point.observable("period") / exact - 1, point.observable("shape"));
   };
   const bool dimension_check = scene.flag("dimension_check");
   const double rank_threshold = scene.positive("rank_threshold");

@@ -92,7 +92,11 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
                      "contact_phases", "grazing_instants", "min_gap", "return_error", "dimension_F",
                      "nullity_F", "gap_F", "seconds_F"});
   std::vector<double> dimensions;
+  std::vector<ContactStructure> structures;
   for (const auto& point : branch.points) {
+    structures.push_back(
+        contact_structure(problem.setup_at(point.x), point.x[problem.period_index()]));
+    const ContactStructure& c = structures.back();
     const double energy = point.observable("energy"), period = point.observable("period");
     const double exact = 2 * mode2.period(energy);
     const ReturnError re = return_error(problem, point.x, oracle);
@@ -102,23 +106,31 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
     dimensions.push_back(check ? e.report.verified_dimension : nan);
     table.add_row({static_cast<double>(point.index), energy, period, exact,
                    std::abs(period / exact - 1), point.observable("shape"),
-                   point.observable("contact_phases"), point.observable("grazing_instants"),
-                   point.observable("min_gap"), re.worst(),
+                   c.ok ? c.contact_phases : nan, c.ok ? c.grazing_instants : nan,
+                   c.ok ? c.min_gap : nan, re.worst(),
                    check ? static_cast<double>(e.report.verified_dimension) : nan,
                    check ? static_cast<double>(e.report.nullity) : nan, check ? e.report.gap : nan,
                    check ? e.seconds : nan});
   }
   table.write_csv(out / "subharmonic_check.csv");
-  if (!check) return;
+  // branch.csv gains the contact structure (columns contact_phases, grazing_instants, min_gap)
+  // and, with the check, F's dimension in its dimension column.
   const core::Table saved = core::Table::read_csv(out / "branch.csv");
   const auto& names = saved.columns();
-  const auto column = static_cast<std::size_t>(
-      std::find(names.begin(), names.end(), "dimension") - names.begin());
-  if (column == names.size()) return;
-  core::Table rewritten(saved.columns());
+  const auto column =
+      static_cast<std::size_t>(std::find(names.begin(), names.end(), "dimension") - names.begin());
+  std::vector<std::string> columns = names;
+  for (const char* name : {"contact_phases", "grazing_instants", "min_gap"})
+    columns.emplace_back(name);
+  core::Table rewritten(columns);
   for (std::size_t i = 0; i < saved.rows(); ++i) {
     std::vector<core::Table::Cell> cells = saved.cells(i);
-    if (i < dimensions.size()) cells[column] = dimensions[i];
+    if (check && column < names.size() && i < dimensions.size()) cells[column] = dimensions[i];
+    const bool known = i < structures.size() && structures[i].ok;
+    const double nan = std::nan("");
+    cells.emplace_back(known ? structures[i].contact_phases : nan);
+    cells.emplace_back(known ? structures[i].grazing_instants : nan);
+    cells.emplace_back(known ? structures[i].min_gap : nan);
     rewritten.add_cells(std::move(cells));
   }
   rewritten.write_csv(out / "branch.csv");

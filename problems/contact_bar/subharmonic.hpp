@@ -39,8 +39,9 @@ ContactStructure contact_structure(const bar::BarSetup& setup, double period);
 // After a subharmonic trace: DIR/subharmonic_check.csv, per point the energy, the period against
 // 2 T2 of mode 2 at that energy, the shape, the contact structure, the exact-oracle return error
 // and the verified dimension of the periodicity residual F alone (path rows off: dimension_F,
-// nullity_F, gap_F, seconds_F). When rank_threshold is a number, branch.csv's dimension column
-// is replaced by dimension_F (the traced system F plus its path row has one dimension less).
+// nullity_F, gap_F, seconds_F). branch.csv gains the columns contact_phases, grazing_instants
+// and min_gap; when rank_threshold is a number its dimension column is replaced by dimension_F
+// (the traced system F plus its path row has one dimension less).
 void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const ContactFamily& mode2,
                                const continuation::Branch& branch, const std::filesystem::path& out,
                                double rank_threshold);
