@@ -88,6 +88,26 @@ TEST(SubharmonicContinuum, ContactPhasesAndGrazingLimits) {
   EXPECT_NEAR(middle.second_contact, 0.1, 1e-12);
 }
 
+// The two grazing limits are one orbit shifted by T2 = T / 2: the shape-1 member, simulated
+// exactly to T / 2, is at rest in the shape-0 member's u0 (round-off, 1e-12 relative).
+TEST(SubharmonicContinuum, GrazingLimitsAreOneOrbitShiftedByHalfThePeriod) {
+  const bar::Material m;
+  for (double energy : {8e-6, 1.25e-5, 1e-3}) {
+    const SubharmonicMember one = subharmonic_member(m, 1e-3, energy, 1.0);
+    const SubharmonicMember zero = subharmonic_member(m, 1e-3, energy, 0.0);
+    const exact_bar::ExactBarSolution sol(paper_setup(one.u0), one.period);
+    double du = 0, dv = 0, u_max = 0;
+    for (int i = 0; i <= 400; ++i) {
+      const double x = i / 400.0;
+      u_max = std::max(u_max, std::abs(zero.u0(x)));
+      du = std::max(du, std::abs(sol.u(x, 0.5 * one.period) - zero.u0(x)));
+      dv = std::max(dv, std::abs(sol.v(x, 0.5 * one.period)));
+    }
+    EXPECT_LT(du / u_max, 1e-12) << energy;
+    EXPECT_LT(dv / u_max, 1e-12) << energy;
+  }
+}
+
 // The TD-BEM from a state that starts on the wall with a compressive strain (issue 9, item 0):
 // the contact force at t = 0 is the true -EA u0_x(L) (it was 0), and the event march follows the
 // exact solver off the time grid (dt = 0.013 does not divide the contact instants): the event
