@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "core/errors.hpp"
 
@@ -70,6 +71,42 @@ double node_of(const bar::PiecewiseLinear& u0) {
     if ((ys[i - 1] > 0 && ys[i] <= 0) || (ys[i - 1] < 0 && ys[i] >= 0))
       return xs[i - 1] + (xs[i] - xs[i - 1]) * ys[i - 1] / (ys[i - 1] - ys[i]);
   return std::nan("");
+}
+
+// Derivation (c = L = 1, u = F(t + x) - F(t - x), H(t) = F'(t - 1) the wave arriving at x = 1,
+// README.md sections 'Mode 2' and 'Subharmonic continuum'): v0 = 0 makes H symmetric about 1 on
+// [0, 2] and u0'(x) = 2 H(1 + x). Take H = +h on a pulse of width 2b centred at c in [0, 1]
+// (mirrored about 1), -h elsewhere: u0(1) = s (4b - 1) = g0 whatever c, so the end starts on the
+// wall. Marching the free / closed reflections over T = 2 (1 + b) returns the state for every c
+// in [b, 1 - 2b]: contact phases of 2 (c - b) around t = 0 and 2 (1 - 2b - c) around T / 2.
+SubharmonicMember subharmonic_member(const bar::Material& material, double gap, double energy,
+                                     double shape) {
+  const double length = material.length;
+  const double s = std::sqrt(2 * energy / (material.axial_stiffness() * length));
+  if (!(s * length >= 3 * gap) || !std::isfinite(s))
+    throw core::InputError("energy",
+                           fmt::format("the subharmonic continuum needs E >= the mode-2 "
+                                       "grazing energy {} (got {})",
+                                       ContactFamily(material, gap, 2).grazing_energy(), energy));
+  if (!(shape >= 0 && shape <= 1))
+    throw core::InputError("shape", fmt::format("must be in [0, 1] (got {})", shape));
+  const double b = 0.25 * (1 + gap / (s * length));
+  const double c = b + shape * (1 - 3 * b);
+  const double x1 = (1 - c - b) * length, x2 = (1 - c + b) * length;
+  std::vector<double> knots{0.0, x1}, values{0.0, -s * x1};
+  if (x2 < length) {
+    knots.push_back(x2);
+    values.push_back(values.back() + s * (x2 - x1));
+  }
+  values.push_back(gap);  // s (4b - 1) L = g0 exactly (the sum of the slopes rounds)
+  knots.push_back(length);
+  const double tau = length / material.wave_speed();
+  SubharmonicMember m{bar::PiecewiseLinear(std::move(knots), std::move(values)),
+                      2 * (1 + b) * tau,
+                      2 * (c - b) * tau,
+                      2 * (1 - 2 * b - c) * tau,
+                      {x1, x2}};
+  return m;
 }
 
 }  // namespace backbone::contact_bar

@@ -17,6 +17,8 @@
 //   ContactFamily mode2(setup.material, gap, 2);
 //   double x_node = mode2.node(1e-3);                 // 2 b L
 //   double x_num = node_of(orbit_u0);                 // where a traced u0 changes sign
+//   SubharmonicMember m = subharmonic_member(material, gap, 1e-3, 0.25);  // T = 2 T2
+//   m.u0;  m.period;  m.first_contact;  m.second_contact;                 // durations [s]
 #pragma once
 
 #include "problems/bar/bar.hpp"
@@ -53,5 +55,23 @@ class ContactFamily {
 // linearly interpolated; NaN when it does not. The numerical counterpart of
 // ContactFamily::node.
 double node_of(const bar::PiecewiseLinear& u0);
+
+// One member of the subharmonic continuum near omega2 / 2 (README.md, section 'Subharmonic
+// continuum'): period T = 2 T2 (mode 2 taken over two periods), started at rest at the centre
+// of a contact phase, so u0(L) = g0 with a compressive strain there. With b = (1 + g0/(sL))/4
+// and c = b + shape (1 - 3b), u0 has slopes -s, +s, -s with kinks at (1 - c - b) L and
+// (1 - c + b) L. shape in [0, 1]: 0 and 1 are the grazing limits (one contact phase, one
+// grazing instant; the same orbit shifted by T2), 1/2 is mode 2 shifted by T2 / 2 (two equal
+// phases). Energy EA L s^2 / 2 and period are those of mode 2 (x2), whatever the shape.
+struct SubharmonicMember {
+  bar::PiecewiseLinear u0;
+  double period = 0;
+  double first_contact = 0;   // duration of the phase centred at t = 0 [s]
+  double second_contact = 0;  // duration of the phase centred at t = T / 2 [s]
+  double kinks[2] = {0, 0};   // positions of the two kinks of u0 [m] (the second may be L)
+};
+// InputError "energy" below the mode-2 grazing energy, "shape" outside [0, 1].
+SubharmonicMember subharmonic_member(const bar::Material& material, double gap, double energy,
+                                     double shape);
 
 }  // namespace backbone::contact_bar

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "problems/contact_bar/family.hpp"
 
 namespace backbone::contact_bar {
 
@@ -24,21 +25,40 @@ const bar::BarSolver& solver_or_throw(const std::shared_ptr<const bar::BarSolver
 
 void OrbitOptions::validate() const {
   if (elements < 2) throw InputError("elements", fmt::format("must be >= 2 (got {})", elements));
-  if (free_knots < 0 || free_knots > 1)
-    throw InputError("free_knots", fmt::format("must be 0 or 1 (got {})", free_knots));
-  if (free_knots == 1 && (knot_node < 0 || knot_node >= elements))
+  if (free_knots < 0 || free_knots > elements - 1)
+    throw InputError("free_knots", fmt::format("must be in 0..elements-1 = 0..{} (got {})",
+                                               elements - 1, free_knots));
+  if (free_knots == 1 && knot_nodes.empty() && (knot_node < 0 || knot_node >= elements))
     throw InputError("knot_node", fmt::format("must be in 1..elements-1 = 1..{}, or 0 for "
                                               "round(elements/3) (got {})",
                                               elements - 1, knot_node));
+  if (!knot_nodes.empty()) {
+    if (static_cast<int>(knot_nodes.size()) != free_knots)
+      throw InputError("knot_nodes", fmt::format("needs free_knots = {} entries (got {})",
+                                                 free_knots, knot_nodes.size()));
+    for (std::size_t j = 0; j < knot_nodes.size(); ++j)
+      if (knot_nodes[j] < 1 || knot_nodes[j] >= elements ||
+          (j > 0 && knot_nodes[j] <= knot_nodes[j - 1]))
+        throw InputError("knot_nodes", fmt::format("must increase strictly inside 1..{} (entry "
+                                                   "{} is {})",
+                                                   elements - 1, j, knot_nodes[j]));
+  }
   if (steps_per_period < 2 || steps_per_period % 2 != 0)
     throw InputError(
         "steps_per_period",
         fmt::format("must be even and >= 2 so that T/2 is a step (got {})", steps_per_period));
-  if (test_elements != 0 && test_elements < elements + free_knots)
+  if (test_elements != 0 && test_elements < state_size())
     throw InputError("test_elements",
-                     fmt::format("must be 0 (square system) or >= elements + free_knots = {} "
+                     fmt::format("must be 0 (square system) or >= elements + free_knots{} = {} "
                                  "(got {})",
-                                 elements + free_knots, test_elements));
+                                 start_on_wall ? " - 1" : "", state_size(), test_elements));
+  if (!std::isfinite(fixed_energy) || fixed_energy < 0)
+    throw InputError("energy",
+                     fmt::format("must be > 0, or 0 for no energy row (got {})", fixed_energy));
+  if (fixed_shape >= 0 && (fixed_shape > 1 || !start_on_wall || free_knots < 2))
+    throw InputError("shape", fmt::format("must be in [0, 1], with start_on_wall and two free "
+                                          "knots (got {})",
+                                          fixed_shape));
   if (!std::isfinite(fixed_dt) || fixed_dt < 0)
     throw InputError("fixed_dt", fmt::format("must be >= 0 (0: dt = T / steps_per_period; "
                                              "got {})",
@@ -61,6 +81,8 @@ ContactBarOrbitProblem::ContactBarOrbitProblem(bar::BarSetup setup, const bar::B
     throw InputError("body_force", fmt::format("the orbit problem is conservative without body "
                                                "force (got {})",
                                                setup_.body_force));
+  if (options_.start_on_wall && !(setup_.right.type == bar::EndType::contact && gap() > 0))
+    throw InputError("start_on_wall", "needs right = contact with a gap > 0");
 }
 
 ContactBarOrbitProblem::ContactBarOrbitProblem(bar::BarSetup setup,
@@ -70,10 +92,24 @@ ContactBarOrbitProblem::ContactBarOrbitProblem(bar::BarSetup setup,
   owned_solver_ = std::move(solver);
 }
 
-int ContactBarOrbitProblem::reference_knot_node() const {
-  if (options_.knot_node > 0) return options_.knot_node;
-  const int m = static_cast<int>(std::lround(options_.elements / 3.0));
-  return std::clamp(m, 1, options_.elements - 1);
+std::vector<int> ContactBarOrbitProblem::reference_knot_nodes() const {
+  const int n = options_.elements, k = options_.free_knots;
+  if (!options_.knot_nodes.empty()) return options_.knot_nodes;
+  if (k == 1) {
+    if (options_.knot_node > 0) return {options_.knot_node};
+    return {std::clamp(static_cast<int>(std::lround(n / 3.0)), 1, n - 1)};
+  }
+  // Evenly spread, strictly increasing (K <= N - 1 leaves room for one node per knot).
+  std::vector<int> m(k);
+  for (int j = 0; j < k; ++j)
+    m[j] = std::clamp(static_cast<int>(std::lround(static_cast<double>(j + 1) * n / (k + 1))),
+                      j + 1, n - k + j);
+  for (int j = 1; j < k; ++j) m[j] = std::max(m[j], m[j - 1] + 1);
+  return m;
+}
+
+double ContactBarOrbitProblem::node_value(const Vector& x, int i) const {
+  return i <= options_.nodal_unknowns() ? x[i - 1] : gap();
 }
 
 double ContactBarOrbitProblem::gap() const {
@@ -87,16 +123,24 @@ double ContactBarOrbitProblem::displacement_scale() const {
 Vector ContactBarOrbitProblem::node_positions(const Vector& x) const {
   const int n = options_.elements;
   const double length = setup_.material.length;
-  Vector y(n + options_.free_knots);
-  if (options_.free_knots == 0) {
+  const int k = options_.free_knots;
+  Vector y(n + k);
+  if (k == 0) {
     for (int i = 1; i <= n; ++i) y[i - 1] = length * i / n;
     return y;
   }
-  const int m = reference_knot_node();
-  const double knot = x[n];
-  for (int i = 1; i <= n; ++i)
-    y[i - 1] = i <= m ? knot * i / m : knot + (length - knot) * (i - m) / (n - m);
-  y[n] = knot;
+  // Segments between consecutive anchors (node 0 at 0, knot nodes at the knots, node N at L).
+  const std::vector<int> m = reference_knot_nodes();
+  int segment = 0;
+  for (int i = 1; i <= n; ++i) {
+    while (segment < k && i > m[segment]) ++segment;
+    const int i0 = segment == 0 ? 0 : m[segment - 1];
+    const int i1 = segment == k ? n : m[segment];
+    const double y0 = segment == 0 ? 0.0 : x[knot_index(segment - 1)];
+    const double y1 = segment == k ? length : x[knot_index(segment)];
+    y[i - 1] = i == i1 ? y1 : y0 + (y1 - y0) * (i - i0) / (i1 - i0);
+  }
+  for (int j = 0; j < k; ++j) y[n + j] = x[knot_index(j)];
   return y;
 }
 
@@ -104,8 +148,9 @@ Vector ContactBarOrbitProblem::state_coordinates() const {
   const int n = options_.elements;
   const double length = setup_.material.length;
   Vector y(state_size());
-  for (int i = 1; i <= n; ++i) y[i - 1] = length * i / n;
-  if (options_.free_knots == 1) y[n] = length * reference_knot_node() / n;
+  for (int i = 1; i <= options_.nodal_unknowns(); ++i) y[i - 1] = length * i / n;
+  const std::vector<int> m = reference_knot_nodes();
+  for (int j = 0; j < options_.free_knots; ++j) y[knot_index(j)] = length * m[j] / n;
   return y;
 }
 
@@ -126,7 +171,7 @@ bar::PiecewiseLinear ContactBarOrbitProblem::initial_displacement(const Vector& 
   values[0] = 0;
   for (int i = 1; i <= n; ++i) {
     knots[i] = y[i - 1];
-    values[i] = x[i - 1];
+    values[i] = node_value(x, i);
   }
   knots[n] = setup_.material.length;  // exactly L, whatever the rounding of the map
   return bar::PiecewiseLinear(std::move(knots), std::move(values));
@@ -149,18 +194,29 @@ double ContactBarOrbitProblem::energy(const Vector& x) const {
   double sum = 0, y_prev = 0, u_prev = 0;
   for (int i = 1; i <= n; ++i) {
     const double h = (i == n ? setup_.material.length : y[i - 1]) - y_prev;
-    const double strain = (x[i - 1] - u_prev) / h;
+    const double strain = (node_value(x, i) - u_prev) / h;
     sum += strain * strain * h;
     y_prev = y[i - 1];
-    u_prev = x[i - 1];
+    u_prev = node_value(x, i);
   }
   return 0.5 * setup_.material.axial_stiffness() * sum;
 }
 
+double ContactBarOrbitProblem::subharmonic_shape(const Vector& x) const {
+  if (options_.free_knots < 2) return std::nan("");
+  const double length = setup_.material.length;
+  const double k1 = x[knot_index(0)] / length, k2 = x[knot_index(1)] / length;
+  return (1 - k2) / (1 - 1.5 * (k2 - k1));
+}
+
 core::Observables ContactBarOrbitProblem::observables(const Vector& x) const {
   core::Observables o = PeriodicOrbitProblem::observables(x);
-  o.emplace_back("end_amplitude", std::abs(x[options_.elements - 1]));
-  if (options_.free_knots == 1) o.emplace_back("knot", x[options_.elements]);
+  if (options_.free_knots >= 2) o.emplace_back("shape", subharmonic_shape(x));
+  o.emplace_back("end_amplitude", std::abs(node_value(x, options_.elements)));
+  if (options_.free_knots == 1) o.emplace_back("knot", x[knot_index(0)]);
+  if (options_.free_knots > 1)
+    for (int j = 0; j < options_.free_knots; ++j)
+      o.emplace_back(fmt::format("knot_{}", j + 1), x[knot_index(j)]);
   return o;
 }
 
@@ -169,25 +225,29 @@ Vector ContactBarOrbitProblem::typical_scale() const {
   // the period with the travel time.
   const double length = setup_.material.length;
   Vector s = Vector::Constant(num_unknowns(), displacement_scale());
-  if (options_.free_knots == 1) s[options_.elements] = length;
+  for (int j = 0; j < options_.free_knots; ++j) s[knot_index(j)] = length;
   s[period_index()] = setup_.material.travel_time();
   return s;
 }
 
 EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
   const int n = options_.elements;
-  const int m = num_equations();  // equations = snapshot grid elements
+  const int m = options_.test_elements > 0 ? options_.test_elements : state_size();  // grid
   const double length = setup_.material.length;
   const double period = x[period_index()];
   if (!std::isfinite(period) || !(period > 0)) return EvalStatus::failed;
-  if (options_.free_knots == 1) {
-    const double knot = x[n];
-    if (!std::isfinite(knot) || !(knot > 0) || !(knot < length)) return EvalStatus::failed;
+  // Knots stay ordered inside (0, L): a crossing is outside the representation.
+  double previous = 0;
+  for (int j = 0; j < options_.free_knots; ++j) {
+    const double knot = x[knot_index(j)];
+    if (!std::isfinite(knot) || !(knot > previous)) return EvalStatus::failed;
+    previous = knot;
   }
-  for (int i = 0; i < n; ++i)
+  if (options_.free_knots > 0 && !(previous < length)) return EvalStatus::failed;
+  for (int i = 0; i < options_.nodal_unknowns(); ++i)
     if (!std::isfinite(x[i])) return EvalStatus::non_finite;
   // A u0 through the wall is outside the admissible set: no orbit starts there.
-  if (setup_.right.type == bar::EndType::contact && x[n - 1] > setup_.right.gap)
+  if (setup_.right.type == bar::EndType::contact && node_value(x, n) > setup_.right.gap)
     return EvalStatus::failed;
 
   const bar::BarSetup s = setup_at(x);
@@ -210,7 +270,18 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
   }
   if (!snap.ok) return EvalStatus::failed;
 
-  r.resize(m);
+  const int rows = path_rows_enabled_ ? options_.path_rows() : 0;
+  r.resize(m + rows);
+  int row = m;
+  if (rows > 0 && options_.fixed_energy > 0)
+    r[row++] = (energy(x) - options_.fixed_energy) / options_.fixed_energy;
+  if (rows > 0 && options_.fixed_shape >= 0) {
+    const double k1 = x[knot_index(0)] / length, k2 = x[knot_index(1)] / length;
+    // In units of g0 like the residual rows (a knot moved by dk moves u0 by about s dk): in
+    // units of L the row weighs 1e-3 of them and the rank report counts it as null.
+    r[row++] =
+        (1 - k2 - options_.fixed_shape * (1 - 1.5 * (k2 - k1))) * length / displacement_scale();
+  }
   const double u_scale = displacement_scale();
   if (paper) {
     if (static_cast<int>(snap.u.size()) != m + 1) return EvalStatus::failed;
@@ -238,9 +309,12 @@ Vector ContactBarOrbitProblem::linear_mode_guess(int mode, double amplitude_rati
   const double amplitude = -amplitude_ratio * displacement_scale() * sign_at_end;  // u0(L) < 0
   Vector x(num_unknowns());
   const int n = options_.elements;
-  if (options_.free_knots == 1) x[n] = length / (2 * mode - 1);  // first crest of the sine
+  const std::vector<int> m = reference_knot_nodes();
+  for (int j = 0; j < options_.free_knots; ++j) x[knot_index(j)] = length * m[j] / n;
+  if (options_.free_knots == 1) x[knot_index(0)] = length / (2 * mode - 1);  // first crest
   const Vector y = node_positions(x);
-  for (int i = 1; i <= n; ++i) x[i - 1] = amplitude * std::sin(k * y[i - 1]);
+  for (int i = 1; i <= options_.nodal_unknowns(); ++i)
+    x[i - 1] = amplitude * std::sin(k * y[i - 1]);
   x[period_index()] = 4 * setup_.material.travel_time() / (2 * mode - 1);
   return x;
 }
@@ -256,10 +330,13 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
   const double tau = setup_.material.travel_time();
   const int n = options_.elements;
   Vector x(num_unknowns());
+  if (options_.start_on_wall)
+    throw InputError("start_on_wall", "modes 1 and 2 start at rest away from the wall");
+  const std::vector<int> m = reference_knot_nodes();
+  for (int j = 0; j < options_.free_knots; ++j) x[knot_index(j)] = length * m[j] / n;
   if (mode == 1) {
     // u0 = eps x, end at -amplitude_ratio g0; T = (3L + g0/|eps|)/c (README.md, 'Mode 1').
     const double slope = amplitude_ratio * g0 / length;
-    if (options_.free_knots == 1) x[n] = length * reference_knot_node() / n;
     const Vector y = node_positions(x);
     for (int i = 1; i <= n; ++i) x[i - 1] = -slope * y[i - 1];
     const double ratio = std::max(amplitude_ratio, 1.0);  // below grazing: linear period 4L/c
@@ -270,7 +347,17 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
   const double ratio = std::max(amplitude_ratio, 1.0);
   const double slope = (2 * ratio + 1) * g0 / length;
   const double b = 0.25 * (1 + g0 / (slope * length));
-  if (options_.free_knots == 1) x[n] = b * length;
+  if (options_.free_knots >= 1) {
+    // The crest on the knot whose reference position is nearest b L, the others where they are.
+    int nearest = 0;
+    for (int j = 1; j < options_.free_knots; ++j)
+      if (std::abs(x[knot_index(j)] - b * length) < std::abs(x[knot_index(nearest)] - b * length))
+        nearest = j;
+    x[knot_index(nearest)] = b * length;
+    for (int j = 1; j < options_.free_knots; ++j)
+      if (!(x[knot_index(j)] > x[knot_index(j - 1)]))
+        throw InputError("knot_nodes", "the mode-2 crest does not fit between the other knots");
+  }
   const Vector y = node_positions(x);
   for (int i = 1; i <= n; ++i) {
     const double yi = y[i - 1];
@@ -278,6 +365,45 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
   }
   x[period_index()] = tau * (1 + b);
   return x;
+}
+
+Vector ContactBarOrbitProblem::subharmonic_guess(double energy, double shape) const {
+  if (!options_.start_on_wall || options_.free_knots < 2)
+    throw InputError("free_knots",
+                     "the subharmonic members start on the wall (start_on_wall) "
+                     "and have two kinks (free_knots >= 2)");
+  if (!(shape > 0 && shape <= 1))
+    throw InputError("shape", fmt::format("must be in (0, 1] (got {}): at 0 the second kink "
+                                          "reaches x = L",
+                                          shape));
+  const SubharmonicMember member = subharmonic_member(setup_.material, gap(), energy, shape);
+  const double length = setup_.material.length;
+  const int n = options_.elements;
+  Vector x(num_unknowns());
+  const std::vector<int> m = reference_knot_nodes();
+  for (int j = 0; j < options_.free_knots; ++j) x[knot_index(j)] = length * m[j] / n;
+  x[knot_index(0)] = member.kinks[0];
+  x[knot_index(1)] = member.kinks[1];
+  for (int j = 1; j < options_.free_knots; ++j)
+    if (!(x[knot_index(j)] > x[knot_index(j - 1)]))
+      throw InputError("knot_nodes", "the subharmonic kinks do not fit between the other knots");
+  const Vector y = node_positions(x);
+  for (int i = 1; i <= options_.nodal_unknowns(); ++i) x[i - 1] = member.u0(y[i - 1]);
+  x[period_index()] = member.period;
+  return x;
+}
+
+std::vector<int> nearest_knot_nodes(int elements, double length, const std::vector<double>& at) {
+  const int k = static_cast<int>(at.size());
+  if (k > elements - 1)
+    throw InputError("free_knots", fmt::format("{} knots need at least {} elements (got {})", k,
+                                               k + 1, elements));
+  std::vector<int> m(at.size());
+  for (int j = 0; j < k; ++j)
+    m[j] = std::clamp(static_cast<int>(std::lround(at[j] / length * elements)), j + 1,
+                      elements - k + j);
+  for (int j = 1; j < k; ++j) m[j] = std::max(m[j], m[j - 1] + 1);
+  return m;
 }
 
 ReturnError return_error(const ContactBarOrbitProblem& problem, const Vector& x,

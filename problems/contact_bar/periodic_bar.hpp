@@ -5,12 +5,13 @@
 // (the TD-BEM by default, the exact characteristics oracle for validation). Unknowns, in the
 // layout of core::PeriodicOrbitProblem:
 //     x = [ u0(y_1) ... u0(y_N) | k_1 ... k_K | T ]
-// u0 at the nodes y_1..y_N of the representation grid (y_0 = 0 is the fixed end, u0 = 0 there),
-// then K = free_knots movable knot positions (0 by default: y_i = i L / N, uniform), then the
-// period. With one free knot the grid is mapped piecewise-linearly so that node knot_node sits
-// at k_1: a u0 with one kink anywhere (mode 2; README.md, section 'Representability') is then
-// held exactly, which a uniform grid only does to O(dx). Residual (N + K equations, sampled on
-// the uniform snapshot grid of N + K elements, nodes 1..N+K):
+// u0 at the nodes y_1..y_N of the representation grid (y_0 = 0 is the fixed end, u0 = 0 there;
+// with start_on_wall u0(y_N) = u0(L) = g0 is no unknown), then K = free_knots ordered knot
+// positions (0 by default: y_i = i L / N, uniform), then the period. With K free knots the grid
+// is mapped piecewise-linearly so that node knot_nodes[j] sits at k_j: a u0 with K kinks
+// anywhere (mode 2: one; the subharmonic members: two; README.md, section 'Representability')
+// is then held exactly, which a uniform grid only does to O(dx). Residual (M equations, sampled
+// on the uniform snapshot grid of M elements, nodes 1..M):
 //  - displacement_periodicity (paper): f_i = u0(x_i) - u(x_i, T)
 //  - half_period_velocity (regular, default): r_i = (L / c) * int v(x, T/2) psi_i dx / int psi_i
 //    i.e. the hat-weighted average of v at T/2 times the travel time L/c. The scale makes r a
@@ -32,6 +33,7 @@
 #include <algorithm>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/periodic_orbit.hpp"
 #include "problems/bar/bar.hpp"
@@ -40,18 +42,37 @@ namespace backbone::contact_bar {
 
 struct OrbitOptions {
   int elements = 20;            // N: u0 unknowns at nodes 1..N of the representation grid
-  int free_knots = 0;           // 0: uniform grid; 1: node knot_node moves (its position is
-                                // an unknown)
-  int knot_node = 0;            // 1..N-1; 0 picks round(N / 3) (the crest of mode 2)
+  int free_knots = 0;           // K movable knots, kept ordered (0 < k_1 < ... < k_K < L): node
+                                // knot_nodes[j] sits at k_j, the grid is mapped piecewise
+                                // linearly between them. 0: uniform grid. A u0 with K kinks
+                                // anywhere is then held exactly (README.md, 'Representability')
+  int knot_node = 0;            // K = 1 only, when knot_nodes is empty: 1..N-1; 0 picks
+                                // round(N / 3) (the crest of mode 2)
+  std::vector<int> knot_nodes;  // K reference nodes, increasing in 1..N-1; empty: K = 1 uses
+                                // knot_node, K >= 2 round(j N / (K + 1)), j = 1..K
+  bool start_on_wall = false;   // u0(L) = g0 is not an unknown (N - 1 nodal unknowns): states
+                                // that start in contact, e.g. the subharmonic members at the
+                                // centre of a contact phase (README.md, 'Subharmonic continuum')
   int test_elements = 0;        // M: residual sampled on a uniform grid of M elements (M
-                                // equations); 0: M = elements + free_knots (square system).
+                                // equations); 0: M = state size (square system).
                                 // M > that: overdetermined but consistent (true orbits zero
                                 // every test function), solved by least squares; the N
                                 // projections of a square system have spurious roots that
                                 // M >= 2N removes (measured, see trace_contact_bar.cpp)
   int steps_per_period = 2000;  // dt = T / steps_per_period; must be even
   double fixed_dt = 0;          // > 0: this dt instead (T/2 and T then fall between steps)
-  void validate() const;        // throws core::InputError naming the field
+  // Path rows: equations appended after the M residual rows that pick a path on a manifold of
+  // orbits (README.md, 'Subharmonic continuum'); ContactBarOrbitProblem::set_path_rows(false)
+  // drops them, e.g. to measure the dimension of the periodicity residual alone.
+  double fixed_energy = 0;  // > 0: (energy(x) - fixed_energy) / fixed_energy = 0
+  double fixed_shape = -1;  // in [0, 1]: the subharmonic shape (first contact phase / total
+                            // contact time) fixed, a linear row in knots 1 and 2 (needs
+                            // start_on_wall, K >= 2): 1 - k2 = shape (1 - 3 (k2 - k1) / 2)
+                            // (knots in units of L), times L / g0 as the residual rows
+  int path_rows() const { return (fixed_energy > 0 ? 1 : 0) + (fixed_shape >= 0 ? 1 : 0); }
+  int nodal_unknowns() const { return elements - (start_on_wall ? 1 : 0); }
+  int state_size() const { return nodal_unknowns() + free_knots; }
+  void validate() const;  // throws core::InputError naming the field
 };
 
 class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
@@ -64,11 +85,18 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
                          OrbitOptions options);
 
   std::string name() const override { return "contact_bar"; }
-  int state_size() const override { return options_.elements + options_.free_knots; }
+  int state_size() const override { return options_.state_size(); }
   // M = test_elements (state_size() when 0).
   int num_equations() const override {
-    return options_.test_elements > 0 ? options_.test_elements : state_size();
+    return (options_.test_elements > 0 ? options_.test_elements : state_size()) +
+           (path_rows_enabled_ ? options_.path_rows() : 0);
   }
+  // Path rows on (default) or off: off, the residual is the periodicity residual F alone.
+  void set_path_rows(bool enabled) { path_rows_enabled_ = enabled; }
+  bool path_rows_enabled() const { return path_rows_enabled_; }
+  // The subharmonic shape of x from its first two knots (README.md, 'Subharmonic continuum'):
+  // (1 - k2) / (1 - 3 (k2 - k1) / 2) with lengths in units of L. NaN without two knots.
+  double subharmonic_shape(const core::Vector& x) const;
   // Potential energy of u0: 1/2 int EA u0_x^2 dx (v0 = 0), exact for piecewise-linear u0.
   double energy(const core::Vector& x) const override;
   // Node positions y_1..y_N of the representation grid at x (mapped when a knot is free),
@@ -80,7 +108,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   // them), so the written orbit is exactly the piecewise-linear u0 the residual simulated.
   void initial_state_samples(const core::Vector& x, core::Vector& coordinates,
                              core::Vector& values) const override;
-  // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (free knot only).
+  // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (K = 1) or knot_1..knot_K,
+  // and shape with K >= 2. (The contact structure of a member costs an exact simulation:
+  // subharmonic.hpp adds it to branch.csv after the trace, not per observable call.)
   core::Observables observables(const core::Vector& x) const override;
   // u_s for the u0 entries, L for a free knot, L/c for the period.
   core::Vector typical_scale() const override;
@@ -102,6 +132,15 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   // 'Mode 1': u0 = eps x, T = (3L + g0/|eps|)/c; 'Mode 2': a tent with its crest
   // at b L, b = (1 + g0/(s L))/4, slope +-s, T = (1 + b) L / c), sampled on the grid.
   core::Vector contact_family_guess(int mode, double amplitude_ratio) const;
+  // The subharmonic member of family.hpp at this energy and shape in (0, 1], T = 2 T2; needs
+  // start_on_wall and K >= 2 free knots (its two kinks are the first two knots). InputError.
+  core::Vector subharmonic_guess(double energy, double shape) const;
+  // u0 at node i = 1..N (the wall position g0 at node N with start_on_wall).
+  double node_value(const core::Vector& x, int i) const;
+  // Index of knot j (0-based) in x.
+  int knot_index(int j) const { return options_.nodal_unknowns() + j; }
+  // The K reference nodes of the knots (options.knot_nodes or the automatic rule).
+  std::vector<int> reference_knot_nodes() const;
 
   const bar::BarSetup& setup_template() const { return setup_; }
   const OrbitOptions& options() const { return options_; }
@@ -111,13 +150,18 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
 
  private:
-  int reference_knot_node() const;
   double gap() const;
   std::shared_ptr<const bar::BarSolver> owned_solver_;  // empty unless shared
   bar::BarSetup setup_;
   const bar::BarSolver& solver_;
   OrbitOptions options_;
+  bool path_rows_enabled_ = true;
 };
+
+// Reference nodes for knots at the given positions (increasing, in (0, L)): the nearest nodes
+// of the uniform grid of `elements` intervals, pushed apart to stay strictly increasing in
+// 1..elements-1, so that the mapped grid starts nearly uniform (OrbitOptions::knot_nodes).
+std::vector<int> nearest_knot_nodes(int elements, double length, const std::vector<double>& at);
 
 // How far the orbit at x is from periodic, re-simulated over one period T by `oracle` (the
 // exact solver for validation) and sampled on a uniform grid of `elements` intervals:

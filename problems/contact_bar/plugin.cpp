@@ -1,5 +1,7 @@
 // The contact bar as a CLI plugin (continuation/plugin.hpp): `trace` branches mode1 and mode2
 // (the nonlinear modes born from the linear modes omega_k = (2k-1) pi c / (2L) at grazing),
+// subharmonic and subharmonic_continuum (mode 2 over two periods: a 2D manifold of orbits,
+// README.md section 'Subharmonic continuum'),
 // `simulate` (simulate.hpp), its benchmarks and figures, and its steps of the main job.
 //
 // The scene gives the bar (scene.hpp: length, youngs_modulus, density, area, gap, contact,
@@ -27,6 +29,7 @@
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/simulate.hpp"
+#include "problems/contact_bar/subharmonic.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
 
@@ -35,6 +38,26 @@ namespace backbone::contact_bar {
 namespace {
 
 namespace po = boost::program_options;
+
+po::options_description subharmonic_keys() {
+  po::options_description keys("subharmonic branches (subharmonic, subharmonic_continuum)");
+  keys.add_options()  //
+      ("energy", po::value<double>()->default_value(0),
+       "subharmonic_continuum: the energy of the members [J] (0: that of strain 5 g0 / L, "
+       "EA L (5 g0 / L)^2 / 2)")  //
+      ("shape", po::value<double>()->default_value(-1),
+       "subharmonic shape in [0, 1] (first contact phase / total contact time; 0 and 1 are "
+       "the grazing limits, 0.5 mode 2). subharmonic: the shape kept along the backbone "
+       "(-1: 0.3); subharmonic_continuum: the first member (-1: 1, a grazing limit)")  //
+      ("path_rows", po::value<bool>()->default_value(true),
+       "subharmonic branches: append the row that picks the path (shape or energy); false "
+       "leaves the periodicity residual F alone, whose solutions form a 2D manifold (for "
+       "`backbone inspect`: trace needs the row)")  //
+      ("dimension_check", po::value<bool>()->default_value(true),
+       "subharmonic branches: replace branch.csv's dimension (that of F plus the path rows) by "
+       "the verified dimension of the periodicity residual F alone at each point");
+  return keys;
+}
 
 po::options_description trace_keys() {
   po::options_description keys = contact_bar::scene_keys();
@@ -59,7 +82,8 @@ po::options_description trace_keys() {
       ("start_guess", po::value<std::string>()->default_value("contact_family"),
        "contact_family (exact piecewise-linear orbit) or linear_mode (sine, linear period)")  //
       ("free_knots", po::value<long>()->default_value(-1),
-       "movable knots of the u0 grid: 0, 1, or -1 = auto (0 for mode1, 1 for mode2)")         //
+       "movable knots of the u0 grid, kept ordered: K >= 0, or -1 = auto (one per kink of the "
+       "branch's exact u0: 0 for mode1, 1 for mode2, 2 for the subharmonic branches)")        //
       ("energy_max", po::value<double>()->default_value(1e-2), "stop above this energy [J]")  //
       ("max_points", po::value<long>()->default_value(1000),
        "points on the branch, first included")  //
@@ -80,10 +104,14 @@ po::options_description trace_keys() {
        "u0 or v0 = 0 by more than this, relative to max|u0| (0: no check). Catches spurious "
        "roots of the projected residual");
   keys.add(shooting);
+  keys.add(subharmonic_keys());
   return keys;
 }
 
+continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch);
+
 continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
+  if (branch.rfind("subharmonic", 0) == 0) return setup_subharmonic(scene, branch);
   const int mode = branch == "mode2" ? 2 : 1;
   bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
   if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
@@ -161,6 +189,111 @@ continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string
   return s;
 }
 
+std::shared_ptr<const bar::BarSolver> shooting_solver(const core::Scene& scene) {
+  if (scene.choice("shooting_solver", {"tdbem", "exact"}) == "exact")
+    return std::make_shared<exact_bar::ExactBarSolver>();
+  return std::make_shared<TdbemSolver>(contact_method_from_scene(scene));
+}
+
+// The subharmonic branches (README.md, section 'Subharmonic continuum'): mode 2 taken over two
+// periods, T = 2 T2, started at rest at the centre of a contact phase (start_on_wall), two free
+// knots at its two kinks. The periodic orbits form a 2D manifold (energy x shape); a path on it
+// is picked by one path row: the shape (subharmonic: the backbone at constant shape) or the
+// energy (subharmonic_continuum: the members at one energy, from a grazing limit on).
+continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch) {
+  bar::BarSetup setup = bar_from_scene(scene);
+  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
+    throw core::InputError("right_end",
+                           "the subharmonic branches need right_end = contact and gap > 0");
+  const bool continuum = branch == "subharmonic_continuum";
+  const bar::Material& material = setup.material;
+  const double g0 = setup.right.gap;
+  const ContactFamily mode2(material, g0, 2);
+  double energy = scene.non_negative("energy");
+  if (energy == 0) energy = 0.5 * material.axial_stiffness() * 25 * g0 * g0 / material.length;
+  const double shape_key = scene.number("shape");
+  const double shape = shape_key >= 0 ? shape_key : (continuum ? 1.0 : 0.3);
+  if (!(shape > 0 && shape <= 1))
+    throw core::InputError("shape", fmt::format("must be in (0, 1] (got {})", shape));
+  // The backbone starts near the mode-2 grazing energy (end amplitude (1 + start_offset) g0).
+  const double ratio = 1 + scene.positive("start_offset");
+  const double start_energy = continuum ? energy
+                                        : 0.5 * material.axial_stiffness() *
+                                              std::pow((2 * ratio + 1) * g0, 2) / material.length;
+  const SubharmonicMember first = subharmonic_member(material, g0, start_energy, shape);
+
+  OrbitOptions options;
+  const long shooting_elements = scene.integer("shooting_elements", 0);
+  options.elements =
+      static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
+  options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
+  options.start_on_wall = true;
+  const long knots = scene.integer("free_knots", -1);
+  options.free_knots = knots < 0 ? 2 : static_cast<int>(knots);
+  if (options.free_knots < 2)
+    throw core::InputError("free_knots", "the subharmonic members have two kinks: >= 2 or -1");
+  // Knot 1 on the node nearest the first kink; the last knot on node N - 1: beyond the second
+  // kink u0 is linear up to L for every member, and that segment shrinks to nothing at the
+  // shape-0 limit, where interior nodes would be free of the residual (spurious roots,
+  // measured: return errors 1e-5 from shape 0.09 on at N = 20). Further knots (free_knots > 2)
+  // spread between the two.
+  std::vector<double> at{first.kinks[0]};
+  for (int j = 1; j + 1 < options.free_knots; ++j)
+    at.push_back(first.kinks[0] + (first.kinks[1] - first.kinks[0]) * j / (options.free_knots - 1));
+  options.knot_nodes = nearest_knot_nodes(options.elements, material.length, at);
+  options.knot_nodes.push_back(options.elements - 1);
+  if (options.knot_nodes.size() >= 2 &&
+      options.knot_nodes[options.knot_nodes.size() - 2] >= options.elements - 1)
+    throw core::InputError("shooting_elements", "too few elements for the free knots");
+  const long test_elements = scene.integer("test_elements", -1);
+  options.test_elements =
+      static_cast<int>(test_elements < 0 ? 2 * options.state_size() : test_elements);
+  if (continuum)
+    options.fixed_energy = energy;
+  else
+    options.fixed_shape = shape;
+
+  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, shooting_solver(scene), options);
+  continuation::TraceSetup s;
+  s.guess = problem->subharmonic_guess(start_energy, shape);
+  if (continuum) {
+    // Towards the other grazing limit: the shape decreases from 1.
+    const double next = shape > 0.5 ? shape - 0.01 : shape + 0.01;
+    s.direction = problem->subharmonic_guess(energy, next) - s.guess;
+  } else {
+    s.direction = problem->subharmonic_guess(start_energy * 1.01, shape) - s.guess;
+  }
+  const ContactBarOrbitProblem* p = problem.get();
+  const double return_tolerance = scene.non_negative("return_tolerance");
+  if (return_tolerance > 0) {
+    // 1000 intervals: finer than any knot segment the branch keeps (a coarser check grid let
+    // spurious roots through near the shape-0 limit).
+    s.reject_point = [p, return_tolerance](const core::Vector& x) {
+      const exact_bar::ExactBarSolver oracle;
+      const ReturnError e = return_error(*p, x, oracle, 1000);
+      if (e.worst() <= return_tolerance) return std::string();
+      return fmt::format(
+          "exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
+          "return_tolerance {:g}",
+          e.displacement, e.velocity, return_tolerance);
+    };
+  }
+  s.describe_point = [mode2](const continuation::BranchPoint& point) {
+    const double exact = 2 * mode2.period(point.observable("energy"));
+    return fmt::format("T / (2 T2) - 1 = {:.2e}, shape {:.4f}",
+                       point.observable("period") / exact - 1, point.observable("shape"));
+  };
+  const bool dimension_check = scene.flag("dimension_check");
+  const double rank_threshold = scene.positive("rank_threshold");
+  s.write_extra_outputs = [p, mode2, dimension_check, rank_threshold](
+                              const std::filesystem::path& out, const continuation::Branch& b) {
+    write_subharmonic_outputs(*p, mode2, b, out, dimension_check ? rank_threshold : std::nan(""));
+  };
+  problem->set_path_rows(scene.flag("path_rows"));
+  s.problem = std::move(problem);
+  return s;
+}
+
 }  // namespace
 
 void register_plugin(continuation::PluginRegistry& registry) {
@@ -168,7 +301,7 @@ void register_plugin(continuation::PluginRegistry& registry) {
   p.name = "contact_bar";
   p.summary = "elastic bar fixed at x = 0, rigid wall at gap g0 beyond x = L (Signorini contact)";
   p.scene_keys = &trace_keys;
-  p.branches = {"mode1", "mode2"};
+  p.branches = {"mode1", "mode2", "subharmonic", "subharmonic_continuum"};
   p.setup = &setup_trace;
   p.simulate_keys = &simulate_keys;
   p.simulate = &simulate_scene;
@@ -189,6 +322,14 @@ void register_plugin(continuation::PluginRegistry& registry) {
        {scenes + "paper.ini", "--compare", "--periods", "1", "--out", "{out}/mode1_orbit"}},
       {"mode1", "trace", {scenes + "paper.ini", "--branch", "mode1", "--out", "{out}/mode1"}},
       {"mode2", "trace", {scenes + "paper.ini", "--branch", "mode2", "--out", "{out}/mode2"}},
+      {"subharmonic",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic", "--out", "{out}/subharmonic"}},
+      {"subharmonic_continuum",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1.25e-5", "--ds",
+        "0.05", "--ds_max", "0.05", "--newton_tolerance", "1e-12", "--out",
+        "{out}/subharmonic_continuum"}},
       // Other scenes, nothing but the bar changed: the closed forms must hold there too.
       {"mode1_short_bar",
        "trace",

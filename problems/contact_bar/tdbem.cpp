@@ -64,6 +64,12 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
                                          e == 0 ? 0.0 : L_, u));
     E.knots.push_back({0.0, u, 0.0, 0.5 * u, false});
     E.closed = E.end.type == bar::EndType::contact && E.normal * (u - E.wall) >= 0;
+    if (E.closed) {
+      // A state that starts on the wall (a subharmonic member at the centre of a contact
+      // phase): the force at t = 0 is the initial compressive strain, -EA n u0_x at the end.
+      const double inward_slope = e == 0 ? setup_.u0.slope(0.0, +1) : setup_.u0.slope(L_, -1);
+      E.force = std::max(0.0, -ea_ * E.normal * inward_slope);
+    }
     if (method_ == ContactMethod::event) {
       // Kinks of R_e inside (0, tau]: data knots reaching the end, and the end of the IC term.
       std::vector<double> times{tau_};

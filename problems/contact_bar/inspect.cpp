@@ -1,0 +1,108 @@
+#include "problems/contact_bar/inspect.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+
+#include "continuation/outputs.hpp"
+#include "continuation/scaled_problem.hpp"
+#include "continuation/scene_options.hpp"
+#include "core/bordered_system.hpp"
+#include "core/errors.hpp"
+#include "core/periodic_orbit.hpp"
+#include "core/scene_ini.hpp"
+
+namespace backbone::contact_bar {
+
+std::string DimensionEvidence::text() const {
+  std::string s = fmt::format("dimension {} (candidates {}, rank {} of {} unknowns)\n",
+                              report.verified_dimension, report.nullity, report.rank,
+                              report.rank + report.nullity);
+  s += fmt::format(
+      "threshold {:.3e} = max({:.1e} x sigma_max, floor), gap sigma_rank / "
+      "sigma_rank+1 = {:.3e}\n",
+      report.threshold, report.relative_threshold, report.gap);
+  s += "singular values (relative to sigma_max), smallest kept and all dropped:\n";
+  const auto n = report.singular_values.size();
+  const double top = n > 0 ? report.singular_values[0] : 1.0;
+  for (Eigen::Index i = std::max<Eigen::Index>(0, report.rank - 3); i < n; ++i)
+    s += fmt::format("  sigma_{:<3d} {:.6e}  {:.3e}  {}\n", i + 1, report.singular_values[i],
+                     report.singular_values[i] / top, i < report.rank ? "kept" : "dropped");
+  s +=
+      fmt::format("probes (step {:g} scaled units, real when drift <= {:g}):\n", step, drift_ratio);
+  for (std::size_t i = 0; i < probes.size(); ++i)
+    s += fmt::format("  direction {}: {}, residual {:.2e}, drift {:.3e}: {}\n", i + 1,
+                     probes[i].converged ? "re-corrected" : "not re-corrected", probes[i].residual,
+                     probes[i].drift, probes[i].real ? "neighbour found" : "no neighbour");
+  s += fmt::format("{:.2f} s\n", seconds);
+  return s;
+}
+
+DimensionEvidence dimension_evidence(const core::Problem& problem, const core::Vector& x,
+                                     const core::RankOptions& rank,
+                                     const core::VerifyOptions& verify) {
+  const auto start = std::chrono::steady_clock::now();
+  DimensionEvidence e;
+  e.step = verify.step;
+  e.drift_ratio = verify.drift_ratio;
+  const continuation::ScaledProblem scaled(problem);
+  const core::Vector z = scaled.to_scaled(x);
+  core::Matrix J;
+  if (scaled.jacobian(z, J) != core::EvalStatus::ok) return e;
+  e.report = core::rank_report(J, rank);
+  auto verifier = core::make_verifier(verify);
+  core::verify_null_directions(scaled, z, *verifier, verify, e.report);
+  // The distances along the final (possibly rotated) basis: the probe verify ran, repeated.
+  for (Eigen::Index i = 0; i < e.report.null_directions.cols(); ++i) {
+    const core::Vector d = e.report.null_directions.col(i);
+    const core::Vector stepped = z + verify.step * d;
+    const core::BorderedSystem on_plane(scaled, {core::BorderRow::hyperplane(d, stepped)});
+    core::Vector y = stepped;
+    verifier->solve(on_plane, y);
+    NullProbe p;
+    core::Vector f;
+    if (y.allFinite() && scaled.residual(y, f) == core::EvalStatus::ok) {
+      p.residual = f.lpNorm<Eigen::Infinity>();
+      p.converged = p.residual <= verify.residual_tolerance;
+      p.drift = (y - stepped).norm() / verify.step;
+    } else {
+      p.residual = p.drift = std::nan("");
+    }
+    p.real = e.report.direction_verified[static_cast<std::size_t>(i)];
+    e.probes.push_back(p);
+  }
+  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return e;
+}
+
+int inspect_command(const continuation::ProblemPlugin& plugin,
+                    const std::vector<std::string>& args) {
+  namespace po = boost::program_options;
+  if (args.empty()) throw core::InputError("SCENE", "a scene file is required");
+  po::options_description keys = plugin.scene_keys(), own("inspect");
+  own.add_options()("orbit", po::value<std::string>(), "DIR/orbits.csv:K")  //
+      ("branch", po::value<std::string>(), "branch of the problem (default: DIR's)");
+  keys.add(continuation::continuation_keys(keys));
+  const core::Scene scene = core::read_scene(keys, args[0], {args.begin() + 1, args.end()}, own);
+  if (!scene.has("orbit")) throw core::InputError("orbit", "needs DIR/orbits.csv:K");
+  const auto [dir, point] = continuation::parse_saved_point(scene.text("orbit"), "orbit");
+  const std::string branch = scene.has("branch")
+                                 ? scene.text("branch")
+                                 : core::read_text_value(dir / "summary.txt", "branch");
+  const continuation::RunSettings run = continuation::read_run_settings(scene);
+  continuation::TraceSetup setup = plugin.setup(scene, branch);
+  if (auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get()))
+    periodic->set_formulation(run.formulation);
+  const core::Vector x = continuation::read_unknowns(dir / "unknowns.csv", point, "orbit");
+  if (x.size() != setup.problem->num_unknowns())
+    throw core::InputError("orbit", fmt::format("the point has {} unknowns, the problem {} (same "
+                                                "grid keys as the trace?)",
+                                                x.size(), setup.problem->num_unknowns()));
+  const DimensionEvidence e =
+      dimension_evidence(*setup.problem, x, run.options.rank, run.options.verification);
+  fmt::print("{} / {} point {}: {} equations, {} unknowns\n{}", plugin.name, branch, point,
+             setup.problem->num_equations(), x.size(), e.text());
+  return e.report.verified_dimension >= 0 ? core::exit_ok : core::exit_numerical_failure;
+}
+
+}  // namespace backbone::contact_bar

@@ -1,0 +1,49 @@
+// The dimension of the solution set at one point, with its evidence: the singular values of the
+// column-scaled Jacobian, the threshold and the gap of the rank report, then every probe along
+// a candidate null direction (core/rank_report.hpp) with the distance the re-corrected point
+// kept from the stepped one. Generic over core::Problem; `backbone inspect` prints it.
+//
+//   core::RankOptions rank; rank.relative_threshold = 1e-5;
+//   const DimensionEvidence e = dimension_evidence(problem, x, rank, core::VerifyOptions{});
+//   fmt::print("{}", e.text());     // "dimension 2 (candidates 2) ..." then one line per probe
+//   int d = e.report.verified_dimension;
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "continuation/plugin.hpp"
+#include "core/problem.hpp"
+#include "core/rank_report.hpp"
+
+namespace backbone::contact_bar {
+
+struct NullProbe {
+  bool converged = false;  // the re-corrected point reached VerifyOptions::residual_tolerance
+  double residual = 0;     // ||F||_inf there
+  double drift = 0;        // |corrected - stepped| / step, scaled units (real if <= drift_ratio)
+  bool real = false;       // verified: a neighbour exists along this direction
+};
+
+struct DimensionEvidence {
+  core::RankReport report;  // on the column-scaled Jacobian (x ./ typical_scale)
+  double step = 0;          // probe step (scaled units)
+  double drift_ratio = 0;
+  std::vector<NullProbe> probes;  // one per (rotated) candidate null direction
+  double seconds = 0;
+  std::string text() const;  // the report `backbone inspect` prints
+};
+
+// Never throws on numerical failure (a failed Jacobian gives an empty report, dimension -1).
+DimensionEvidence dimension_evidence(const core::Problem& problem, const core::Vector& x,
+                                     const core::RankOptions& rank,
+                                     const core::VerifyOptions& verify);
+
+// `backbone inspect SCENE --orbit DIR/orbits.csv:K [--branch NAME] [--key value ...]` for the
+// plugin of SCENE: builds the problem with plugin.setup (the branch of DIR/summary.txt unless
+// --branch), reads point K of DIR/unknowns.csv, prints the evidence. The scene must give the
+// trace's grid keys (DIR/scene.ini does). Returns the exit code; InputError for bad input.
+int inspect_command(const continuation::ProblemPlugin& plugin,
+                    const std::vector<std::string>& args);
+
+}  // namespace backbone::contact_bar
