@@ -117,6 +117,11 @@ void spacetime_figure(const fs::path& out, int mode, const FigureScene& scene,
 
 std::optional<TracedOrbit> load_traced_orbit(const fs::path& branch_dir, double target_energy,
                                              double length) {
+  return load_traced_orbit_point(branch_dir, -1, target_energy, length);
+}
+
+std::optional<TracedOrbit> load_traced_orbit_point(const fs::path& branch_dir, int wanted,
+                                                   double target_energy, double length) {
   if (!fs::exists(branch_dir / "branch.csv") || !fs::exists(branch_dir / "orbits.csv"))
     return std::nullopt;
   const Table branch = Table::read_csv(branch_dir / "branch.csv");
@@ -130,8 +135,11 @@ std::optional<TracedOrbit> load_traced_orbit(const fs::path& branch_dir, double 
   const double target = target_energy > 0 ? target_energy : std::sqrt(lo * hi);
   std::size_t best = 0;
   for (std::size_t i = 0; i < energy.size(); ++i)
-    if (std::abs(std::log(energy[i] / target)) < std::abs(std::log(energy[best] / target)))
+    if (wanted >= 0
+            ? point[i] == wanted
+            : std::abs(std::log(energy[i] / target)) < std::abs(std::log(energy[best] / target)))
       best = i;
+  if (wanted >= 0 && point[best] != wanted) return std::nullopt;
   std::vector<double> xs, us;
   const auto op = orbits.column("point"), ox = orbits.column("x"), ou = orbits.column("u0");
   for (std::size_t i = 0; i < op.size(); ++i) {

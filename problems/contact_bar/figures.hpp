@@ -58,5 +58,8 @@ struct TracedOrbit {
 // `length` are clipped to it. Empty when branch.csv or orbits.csv is missing or holds no orbit.
 std::optional<TracedOrbit> load_traced_orbit(const std::filesystem::path& branch_dir,
                                              double target_energy, double length);
+// The same for point `point` of the branch (>= 0), or as above when point < 0.
+std::optional<TracedOrbit> load_traced_orbit_point(const std::filesystem::path& branch_dir,
+                                                   int point, double target_energy, double length);
 
 }  // namespace backbone::contact_bar

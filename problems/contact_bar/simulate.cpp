@@ -6,9 +6,11 @@
 #include <cmath>
 #include <limits>
 
+#include "continuation/outputs.hpp"
 #include "core/errors.hpp"
 #include "core/plot.hpp"
 #include "problems/contact_bar/bar_solvers.hpp"
+#include "problems/contact_bar/figures.hpp"
 #include "problems/contact_bar/scene.hpp"
 
 namespace backbone::contact_bar {
@@ -32,7 +34,10 @@ po::options_description simulate_keys() {
       "max_steps", po::value<long>()->default_value(default_max_steps),
       "refuse a run larger than this many time steps: t_end / dt (tdbem, fem), max(rows, 100) "
       "x min(L/c, t_end) / dt (the tdbem window, integrated per row), node-steps / 100 (fem), "
-      "1000 x t_end / (L/c) (exact: stored wave transits)");
+      "1000 x t_end / (L/c) (exact: stored wave transits)")(
+      "orbit", po::value<std::string>(),
+      "DIR/orbits.csv:K: simulate point K of a traced branch (its u0, v0 = 0) over `periods` of "
+      "its own period instead of the scene's u0, v0 and period (the scene gives the same bar)");
   keys.add(run);
   return keys;
 }
@@ -116,9 +121,26 @@ void check_run_size(const core::Scene& scene, const bar::BarSetup& setup,
 
 int simulate_scene(const core::Scene& scene, const fs::path& out) {
   // Validate everything before anything runs or is written.
-  const bar::BarSetup setup = setup_from_scene(scene);
+  bar::BarSetup setup = setup_from_scene(scene);
   const double periods = scene.positive("periods");
-  const bar::SimulationOptions options = simulation_from_scene(scene, periods);
+  bar::SimulationOptions options = simulation_from_scene(scene, periods);
+  double period = scene.positive("period");
+  if (scene.has("orbit")) {
+    // A traced orbit: its own u0 (orbits.csv holds it at its actual knots), v0 = 0, its period.
+    const auto [dir, point] = continuation::parse_saved_point(scene.text("orbit"), "orbit");
+    const auto orbit = load_traced_orbit_point(dir, point, 0, setup.material.length);
+    if (!orbit)
+      throw core::InputError("orbit", fmt::format("'{}' has no traced orbit {} (branch.csv and "
+                                                  "orbits.csv of a trace)",
+                                                  dir.string(), point));
+    setup.u0 = orbit->u0;
+    setup.v0 = bar::PiecewiseLinear::zero(setup.material.length);
+    setup.validate();
+    period = orbit->period;
+    options.t_end = periods * period;
+    fmt::print("orbit {} of {}: period {:.12g} s, energy {:.6g} J\n", point, dir.string(), period,
+               orbit->energy);
+  }
   const ContactMethod contact = contact_method_from_scene(scene);
   const std::string method = scene.choice("method", {"tdbem", "fem", "exact", "all"});
   const bool compare = scene.flag("compare") || method == "all";
@@ -151,7 +173,7 @@ int simulate_scene(const core::Scene& scene, const fs::path& out) {
   }
   const std::string title =
       fmt::format("{}: {} period(s) of {} s, dt = {} s", fs::path(scene.path()).stem().string(),
-                  periods, scene.positive("period"), options.dt);
+                  periods, period, options.dt);
   const core::PlotResult plot =
       core::render_png(out / "history.png", plot_script(curves, title), {1000, 800});
   if (!plot.ok) fmt::print(stderr, "backbone simulate: figure skipped: {}\n", plot.message);

@@ -196,4 +196,21 @@ TEST(SimulateCli, OutputFolderIsCheckedBeforeTheWork) {
   }
 }
 
+// `--orbit DIR/orbits.csv:K` simulates a traced orbit over its own period: the exact oracle
+// brings the contacting end back to where it started (the orbit is periodic to the trace's
+// tolerance, 1e-10 g0, so 1e-9 relative to the end amplitude is a safe bound), and a point the
+// branch does not have is bad input naming `orbit`.
+TEST(SimulateCli, TracedOrbitReturnsOverItsPeriod) {
+  const std::string branch = std::string(BACKBONE_SOURCE_DIR) + "/results/mode1";
+  const fs::path out = scratch("orbit");
+  const cli::Run r = simulate(paper + " --method exact --orbit " + branch + "/orbits.csv:20", out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto u = backbone::core::Table::read_csv(out / "history.csv").column("u_contact");
+  ASSERT_GE(u.size(), 2u);
+  EXPECT_NEAR(u.back() / u.front(), 1.0, 1e-9);
+  EXPECT_LT(u.front(), -1e-3);  // in contact beyond the gap: a mode-1 orbit, not the scene's u0
+  expect_bad_input(paper + " --orbit " + branch + "/orbits.csv:100000", "orbit");
+  fs::remove_all(out);
+}
+
 }  // namespace
