@@ -195,16 +195,27 @@ int repair_branch_files(const std::filesystem::path& out, const std::string& key
   return static_cast<int>(last);
 }
 
-core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key) {
-  std::vector<double> points, index, value;
+namespace {
+
+// The named number columns of a CSV file; any defect is an InputError naming `key`.
+std::vector<std::vector<double>> read_columns(const std::filesystem::path& path,
+                                              std::initializer_list<const char*> names,
+                                              const std::string& key) {
   try {
     const core::Table table = core::Table::read_csv(path);
-    points = table.column("point");
-    index = table.column("index");
-    value = table.column("value");
+    std::vector<std::vector<double>> columns;
+    for (const char* name : names) columns.push_back(table.column(name));
+    return columns;
   } catch (const core::InputError& e) {
     throw core::InputError(key, e.what());
   }
+}
+
+}  // namespace
+
+core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key) {
+  const auto columns = read_columns(path, {"point", "index", "value"}, key);
+  const std::vector<double>&points = columns[0], &index = columns[1], &value = columns[2];
   if (points.empty())
     throw core::InputError(key, fmt::format("'{}' holds no point", path.string()));
   const double wanted = point < 0 ? points.back() : point;
@@ -255,16 +266,10 @@ std::pair<std::filesystem::path, int> parse_saved_point(const std::string& text,
 RestartPoint restart_point(const std::filesystem::path& dir, int point,
                            const ContinuationOptions& options, const std::string& key) {
   RestartPoint r;
-  std::vector<double> index, step, iterations, arclength;
-  try {
-    const core::Table branch = core::Table::read_csv(dir / "branch.csv");
-    index = branch.column("point");
-    step = branch.column("step_size");
-    iterations = branch.column("newton_iterations");
-    arclength = branch.column("arclength");
-  } catch (const core::InputError& e) {
-    throw core::InputError(key, e.what());
-  }
+  const auto columns = read_columns(dir / "branch.csv",
+                                    {"point", "step_size", "newton_iterations", "arclength"}, key);
+  const std::vector<double>&index = columns[0], &step = columns[1], &iterations = columns[2],
+        &arclength = columns[3];
   if (index.empty())
     throw core::InputError(key, fmt::format("'{}' holds no point", (dir / "branch.csv").string()));
   const double wanted = point < 0 ? index.back() : point;

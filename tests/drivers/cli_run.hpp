@@ -34,8 +34,10 @@ inline fs::path scratch(const std::string& suite, const std::string& name) {
   return p;
 }
 
-inline Run run(const std::string& subcommand, const std::string& arguments, const fs::path& out) {
-  const fs::path err_file = out.string() + ".stderr";
+// stderr goes to OUT.stderr, or to err_file when given (an OUT whose sibling cannot be written).
+inline Run run(const std::string& subcommand, const std::string& arguments, const fs::path& out,
+               fs::path err_file = {}) {
+  if (err_file.empty()) err_file = out.string() + ".stderr";
   const std::string command = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone " + subcommand +
                               " " + arguments + " --out '" + out.string() + "' > /dev/null 2> '" +
                               err_file.string() + "'";

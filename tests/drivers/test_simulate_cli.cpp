@@ -156,19 +156,7 @@ TEST(SimulateCli, ByteOrderMarkInSceneIsSkipped) {
 // file.
 cli::Run run_with_out(const std::string& command, const std::string& arguments,
                       const fs::path& out) {
-  const fs::path err_file = scratch(command + ".stderr");
-  const std::string line = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone " + command + " " +
-                           arguments + " --out '" + out.string() + "' > /dev/null 2> '" +
-                           err_file.string() + "'";
-  const int status = std::system(line.c_str());
-  cli::Run r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(err_file);
-  std::stringstream text;
-  text << in.rdbuf();
-  r.err = text.str();
-  fs::remove(err_file);
-  return r;
+  return cli::run(command, arguments, out, scratch(command + ".stderr"));
 }
 
 // Item 5 (and item 2 for trace): a bad --out, an integer beyond int, a NaN limit are refused
