@@ -268,6 +268,9 @@ int run_trace(const std::vector<std::string>& args_in) {
     write_figure(out, table,
                  fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()));
     if (setup.write_extra_outputs) setup.write_extra_outputs(out, branch);
+    if (options.branch_points.detect)
+      cont::branch_point_table(branch, branch.points.front().observables)
+          .write_csv(out / "branch_points.csv");
   }
   core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",
                                                            &branch, rejected, result.switch_index));
