@@ -159,6 +159,10 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       best_value = e.tau.value;
     }
   };
+  // Every value seen, for the minimisation of |tau| (a dip, or a secant iteration whose
+  // singular triplet stopped following the reference's).
+  std::vector<std::pair<double, double>> seen;  // (s, |tau|)
+  for (const Sample& p : polyline) seen.emplace_back(p.s, std::abs(p.tau.value));
   int steps = 0;
   if (sign_change) {
     // Illinois: regula falsi with the stale end's value halved.
@@ -170,9 +174,14 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
       const Evaluation e = evaluate(polyline, s, reference);
       ++steps;
-      if (!e.ok || !e.tau.continued) break;
+      if (!e.ok) break;
       keep(e, s);
-      if (e.tau.value == 0) break;
+      seen.emplace_back(s, std::abs(e.tau.value));
+      if (!e.tau.continued) break;
+      if (e.tau.value == 0) {
+        seen.clear();
+        break;
+      }
       if (e.tau.value * fb < 0) {
         sa = sb;
         fa = fb;
@@ -182,16 +191,26 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       sb = s;
       fb = e.tau.value;
     }
-  } else {
-    // |tau| ~ |s - s*| near a simple crossing whose sign was lost: fit the V through the
-    // bracket (the steeper side's chord does not straddle the kink), golden section when the
-    // fit does not shrink the bracket.
-    double sa = polyline[0].s, sb = polyline[1].s, sc = polyline[2].s;
-    double fa = std::abs(polyline[0].tau.value), fb = std::abs(polyline[1].tau.value),
-           fc = std::abs(polyline[2].tau.value);
-    double previous_width = sc - sa;
+    if (std::abs(sb - sa) <= o.location_tolerance) seen.clear();
+  }
+  // Minimise |tau| from the smallest value seen and its neighbours: |tau| ~ |s - s*| near a
+  // simple crossing, so fit the V through the three (the steeper side's chord does not straddle
+  // the kink), golden section when the fit does not shrink the bracket. Stops when the bracket
+  // is below location_tolerance, or when six evaluations in a row did not halve the smallest
+  // value (a minimum that does not reach zero: a near miss, reported unverified).
+  std::sort(seen.begin(), seen.end());
+  std::size_t middle = 0;
+  for (std::size_t i = 1; i < seen.size(); ++i)
+    if (seen[i].second < seen[middle].second) middle = i;
+  if (middle > 0 && middle + 1 < seen.size()) {
+    double sa = seen[middle - 1].first, fa = seen[middle - 1].second;
+    double sb = seen[middle].first, fb = seen[middle].second;
+    double sc = seen[middle + 1].first, fc = seen[middle + 1].second;
+    double previous_width = sc - sa, reference_value = fb;
+    int without_progress = 0;
     bool golden = false;
-    while (steps < o.max_location_steps && sc - sa > o.location_tolerance && fb > 0) {
+    while (steps < o.max_location_steps && sc - sa > o.location_tolerance && fb > 0 &&
+           without_progress < 6) {
       double s;
       const bool right_larger = sc - sb > sb - sa;
       if (golden) {
@@ -224,6 +243,12 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       } else {
         sc = s;
         fc = f;
+      }
+      if (fb < 0.5 * reference_value) {
+        reference_value = fb;
+        without_progress = 0;
+      } else {
+        ++without_progress;
       }
       const double width = sc - sa;
       golden = width > 0.7 * previous_width;

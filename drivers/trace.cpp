@@ -248,6 +248,7 @@ int run_trace(const std::vector<std::string>& args_in) {
   };
   long rejected = 0;
   hooks.reject_point = setup.reject_point;
+  hooks.describe_branch_point = setup.describe_branch_point;
   hooks.on_attempt = [&](const cont::StepAttempt& a) {
     if (a.rejection.empty()) return;
     ++rejected;

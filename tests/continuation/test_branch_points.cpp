@@ -151,3 +151,26 @@ TEST(BranchPoints, TurnCheckShrinksSteepSteps) {
   o.branch_points.max_turn_degrees = 180;
   EXPECT_THROW(o.validate(), core::InputError);
 }
+
+// branch_points.csv: the observables, dimension, the problem's description columns, the angle.
+TEST(BranchPoints, TableHasTheDocumentedColumns) {
+  const algebraic::Transcritical problem;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  continuation::ContinuationHooks hooks;
+  int reported = 0;
+  hooks.on_branch_point = [&](const continuation::BranchPointReport&) { ++reported; };
+  hooks.describe_branch_point = [](const core::Vector& at, const core::Vector& attached) {
+    return core::Observables{{"offset", (attached - at).norm()}};
+  };
+  const Branch b = continuation::pseudo_arclength(problem, vec({0, 0}), vec({0, 1}), *newton,
+                                                  detecting(0.13, 20), hooks);
+  EXPECT_EQ(reported, 1);
+  const core::Table t = continuation::branch_point_table(b);
+  ASSERT_EQ(t.rows(), 1u);
+  EXPECT_NEAR(t.column("lambda")[0], 1.0, 1e-9);
+  EXPECT_EQ(t.column("dimension")[0], 1.0);
+  EXPECT_NEAR(t.column("tangent_angle")[0], 45.0, 1e-3);
+  // The probe steps h = 1e-3 along x and lands on x = lambda - 1: offset h sqrt(2).
+  EXPECT_NEAR(t.column("offset")[0], 1e-3 * std::sqrt(2.0), 1e-9);
+  EXPECT_EQ(t.column("verified")[0], 1.0);
+}
