@@ -1,5 +1,6 @@
 #include "continuation/branch.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace backbone::continuation {
@@ -66,6 +67,42 @@ core::Table branch_table(const Branch& branch) {
     row.push_back(p.seconds);
     row.push_back(static_cast<double>(p.jacobian_evaluations));
     row.push_back(static_cast<double>(p.residual_evaluations));
+    table.add_row(row);
+  }
+  return table;
+}
+
+core::Table branch_point_table(const Branch& branch, const core::Observables& template_point) {
+  std::vector<std::string> observables, described;
+  const auto add_name = [](std::vector<std::string>& names, const std::string& name) {
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  };
+  for (const auto& [key, value] : template_point) add_name(observables, key);
+  for (const BranchPointReport& r : branch.branch_points) {
+    for (const auto& [key, value] : r.observables) add_name(observables, key);
+    for (const auto& [key, value] : r.attached_description) add_name(described, key);
+  }
+  const auto value_of = [](const core::Observables& list, const std::string& name) {
+    for (const auto& [key, value] : list)
+      if (key == name) return value;
+    return std::numeric_limits<double>::quiet_NaN();
+  };
+  std::vector<std::string> columns = observables;
+  columns.push_back("dimension");
+  columns.insert(columns.end(), described.begin(), described.end());
+  for (const char* c : {"tangent_angle", "verified", "nullity", "after_point", "arclength",
+                        "test_value", "sign_change", "location_steps", "seconds"})
+    columns.push_back(c);
+  core::Table table(columns);
+  for (const BranchPointReport& r : branch.branch_points) {
+    std::vector<double> row;
+    for (const std::string& n : observables) row.push_back(value_of(r.observables, n));
+    row.push_back(r.attached_dimension);
+    for (const std::string& n : described) row.push_back(value_of(r.attached_description, n));
+    row.insert(row.end(),
+               {r.tangent_angle, r.verified() ? 1.0 : 0.0, static_cast<double>(r.nullity),
+                static_cast<double>(r.after_point), r.arclength, r.test_value,
+                r.sign_change ? 1.0 : 0.0, static_cast<double>(r.location_steps), r.seconds});
     table.add_row(row);
   }
   return table;

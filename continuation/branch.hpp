@@ -56,8 +56,36 @@ enum class StopReason {
 };
 const char* to_string(StopReason r);
 
+// A candidate branch point located between two points of a branch (branch_points.hpp): where
+// the test function changed sign or dipped. verified() when the rank report and its probes found
+// more directions of solutions there than the traced tangent.
+struct BranchPointReport {
+  int after_point = 0;            // located between this point of the branch and the next one
+  core::Vector x;                 // located point, problem's unknowns
+  core::Observables observables;  // problem.observables(x)
+  double arclength = 0;           // along the branch, same units as BranchPoint::arclength
+  double test_value = 0;          // signed test function at x (branch_points.hpp)
+  bool sign_change = false;       // bracketed by a sign change (else by a dip)
+  int location_steps = 0;         // corrected points spent locating it
+  int nullity = -1;               // candidate null directions of J at x (rank report)
+  // Candidate directions beyond the traced tangent along which a probe found solutions (at most
+  // options.branch_points.max_probes probed): the dimension of the attached family at this
+  // resolution; verified_dimension = 1 + attached_dimension (the traced tangent counted).
+  int attached_dimension = 0;
+  int verified_dimension = -1;
+  // Angle [degrees] between the traced tangent and the closest secant to a probed point of the
+  // attached family (90: it leaves at right angles); NaN when none was found.
+  double tangent_angle = 0;
+  core::Vector attached_point;             // that probed point (unknowns), empty when none
+  core::Observables attached_description;  // ContinuationHooks::describe_branch_point
+  double seconds = 0;                      // wall time of location and verification
+  bool verified() const { return attached_dimension > 0; }
+};
+
 struct Branch {
   std::vector<BranchPoint> points;
+  // Candidate branch points located along the branch (options.branch_points.detect), in order.
+  std::vector<BranchPointReport> branch_points;
   StopReason reason = StopReason::max_points;
   std::string message;  // human-readable: reason, the point and the numbers involved
   // True when the branch ended for a reason other than reaching its planned end
@@ -72,5 +100,14 @@ struct Branch {
 // singular value counted as zero and smallest kept, relative to the largest), residual,
 // newton_iterations, step_size, arclength, seconds, jacobian_evaluations, residual_evaluations.
 core::Table branch_table(const Branch& branch);
+
+// branch_points.csv: one row per located candidate (Branch::branch_points): its observables (the
+// names of template_point first, e.g. a point of the branch, so that an empty list still has
+// them), dimension (of the attached family, 0 when not verified), the problem's description
+// columns (ContinuationHooks::describe_branch_point, e.g. frequency_ratio), tangent_angle
+// [degrees], verified (0/1), nullity (candidate directions at the point), after_point, arclength,
+// test_value, sign_change (0/1: located as a root, else as a dip's minimum), location_steps,
+// seconds.
+core::Table branch_point_table(const Branch& branch, const core::Observables& template_point = {});
 
 }  // namespace backbone::continuation

@@ -9,7 +9,8 @@
 // (x in the problem's own unknowns): a non-empty answer (the reason) rejects it like a failed
 // correction, so ds shrinks and the step is retried (a rejected first point ends the branch). A
 // shooting residual projected on few test functions can have spurious roots; an exact
-// re-simulation of the orbit catches them.
+// re-simulation of the orbit catches them. on_branch_point and describe_branch_point serve the
+// branch-point detection (branch_points.hpp).
 //
 //   ContinuationHooks hooks;
 //   hooks.on_point = [](const BranchPoint& p) {
@@ -40,6 +41,14 @@ struct ContinuationHooks {
   std::function<void(const StepAttempt&)> on_attempt;
   std::function<bool()> cancel_requested;
   std::function<std::string(const core::Vector& x)> reject_point;
+  // With options.branch_points.detect: called once per located candidate, in order.
+  std::function<void(const BranchPointReport&)> on_branch_point;
+  // Describes a verified branch point from the located point on the branch and a point of the
+  // attached family near it (both in the problem's own unknowns), e.g. the frequency ratio of the
+  // attached family's extra content measured from a simulation: its observables go to
+  // BranchPointReport::attached_description (columns of branch_points.csv).
+  std::function<core::Observables(const core::Vector& on_branch, const core::Vector& attached)>
+      describe_branch_point;
 };
 
 }  // namespace backbone::continuation

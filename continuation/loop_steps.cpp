@@ -56,6 +56,11 @@ void LoopSteps::push(BranchPoint point) {
   if (hooks_.on_point) hooks_.on_point(branch_.points.back());
 }
 
+void LoopSteps::add_branch_point(BranchPointReport report) {
+  branch_.branch_points.push_back(std::move(report));
+  if (hooks_.on_branch_point) hooks_.on_branch_point(branch_.branch_points.back());
+}
+
 Branch LoopSteps::end(StopReason reason, std::string message) {
   branch_.reason = reason;
   branch_.message = std::move(message);

@@ -74,16 +74,23 @@ struct CorrectedStep {
   std::string last_message;
 };
 
-template <class Attempt>  // core::NewtonSummary attempt(double ds, core::Vector& y);
+// check(y), run first on a converged y, is the loop's own test (pseudo-arclength: the turn of
+// the step, options.branch_points.max_turn_degrees); a non-empty answer rejects y like
+// hooks.reject_point.
+template <class Attempt, class Check>  // core::NewtonSummary attempt(double ds, core::Vector& y);
 CorrectedStep correct_with_shrinking(double ds, int index, const ContinuationOptions& options,
                                      const ContinuationHooks& hooks, core::Vector& y,
-                                     Attempt&& attempt) {
+                                     Attempt&& attempt, Check&& check) {
   CorrectedStep r;
   r.ds = ds;
   while (true) {
     r.summary = attempt(r.ds, y);
     r.accepted = r.summary.converged() && y.allFinite();
     std::string rejection;
+    if (r.accepted) {
+      rejection = check(y);
+      r.accepted = rejection.empty();
+    }
     if (r.accepted && hooks.reject_point) {
       rejection = hooks.reject_point(y);
       r.accepted = rejection.empty();
@@ -143,9 +150,19 @@ class LoopSteps {
 
   template <class Attempt>
   CorrectedStep correct(double ds, core::Vector& y, Attempt&& attempt) {
-    return correct_with_shrinking(ds, next_index(), options_, hooks_, y,
-                                  std::forward<Attempt>(attempt));
+    return correct(ds, y, std::forward<Attempt>(attempt),
+                   [](const core::Vector&) { return std::string(); });
   }
+  template <class Attempt, class Check>
+  CorrectedStep correct(double ds, core::Vector& y, Attempt&& attempt, Check&& check) {
+    return correct_with_shrinking(ds, next_index(), options_, hooks_, y,
+                                  std::forward<Attempt>(attempt), std::forward<Check>(check));
+  }
+
+  // Arclength of the last recorded point.
+  double arclength() const { return arclength_; }
+  // Adds a located candidate to the branch and reports it (hooks.on_branch_point).
+  void add_branch_point(BranchPointReport report);
 
   // Records y, corrected from the last point x with step ds: the arclength grows by |y - x|.
   // When y leaves a bound the branch ends (false): with options.land_on_bounds, F plus the

@@ -78,6 +78,23 @@ void ContinuationOptions::validate() const {
   }
   rank.validate();
   verification.validate();
+  branch_points.validate();
+}
+
+void BranchPointOptions::validate() const {
+  if (!(max_turn_degrees >= 0 && max_turn_degrees < 180))
+    throw core::InputError("max_turn_degrees",
+                           fmt::format("must be in [0, 180) (got {})", max_turn_degrees));
+  if (!(dip_ratio > 0 && dip_ratio < 1))
+    throw core::InputError("branch_points.dip_ratio",
+                           fmt::format("must be in (0, 1) (got {})", dip_ratio));
+  require_positive("branch_points.location_tolerance", location_tolerance);
+  if (max_probes < 1)
+    throw core::InputError("branch_points.max_probes",
+                           fmt::format("must be >= 1 (got {})", max_probes));
+  if (max_location_steps < 1)
+    throw core::InputError("branch_points.max_location_steps",
+                           fmt::format("must be >= 1 (got {})", max_location_steps));
 }
 
 }  // namespace backbone::continuation

@@ -42,6 +42,24 @@ struct Bound {
   double max = std::numeric_limits<double>::infinity();
 };
 
+// Branch points (branch_points.hpp, continuation/README.md, section 'Branch points').
+struct BranchPointOptions {
+  bool detect = false;  // evaluate the test function, locate and verify candidates
+  // Passing (always on, also without detect): a pseudo-arclength correction whose secant turns
+  // by more than this from the predictor direction is refused like a failed one (ds shrinks), so
+  // the step that lands on an attached family is retried; 0 disables the check.
+  double max_turn_degrees = 20;
+  // A sampled |tau_k| below dip_ratio times both neighbours is a candidate (besides sign changes).
+  double dip_ratio = 0.5;
+  // Location ends when the bracket is shorter than this (scaled arclength) or after
+  // max_location_steps corrected points.
+  double location_tolerance = 1e-9;
+  int max_location_steps = 40;
+  // Probes of candidate attached directions at a located point (each a corrected point).
+  int max_probes = 24;
+  void validate() const;  // InputError naming branch_points.<field>
+};
+
 struct ContinuationOptions {
   Method method = Method::arclength;
   Predictor predictor = Predictor::tangent;
@@ -66,6 +84,7 @@ struct ContinuationOptions {
   bool verify = true;
   core::RankOptions rank;
   core::VerifyOptions verification;
+  BranchPointOptions branch_points;
 
   void validate() const;  // throws core::InputError naming the field
 };

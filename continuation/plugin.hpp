@@ -58,6 +58,9 @@ struct TraceSetup {
   std::function<std::string(const core::Vector& x)> reject_point;
   // Optional: words appended to each progress line (e.g. "closed-form rel err 1e-14").
   std::function<std::string(const BranchPoint& point)> describe_point;
+  // Optional: describes a verified branch point (ContinuationHooks::describe_branch_point).
+  std::function<core::Observables(const core::Vector& on_branch, const core::Vector& attached)>
+      describe_branch_point;
 };
 
 // A named job of a problem that writes into a folder: a benchmark case (`backbone bench

@@ -4,7 +4,10 @@
 
 #include <Eigen/QR>
 #include <cmath>
+#include <numbers>
+#include <optional>
 
+#include "continuation/branch_points.hpp"
 #include "continuation/loop_steps.hpp"
 #include "continuation/scaled_problem.hpp"
 #include "core/bordered_system.hpp"
@@ -18,6 +21,11 @@ core::EvalStatus curve_tangent(const core::Problem& problem, const core::Vector&
   core::Matrix J;
   core::EvalStatus s = problem.jacobian(x, J);
   if (s != core::EvalStatus::ok) return s;
+  return tangent_from_jacobian(J, orientation, relative_threshold, tangent);
+}
+
+core::EvalStatus tangent_from_jacobian(const core::Matrix& J, const core::Vector& orientation,
+                                       double relative_threshold, core::Vector& tangent) {
   const int m = static_cast<int>(J.rows());
   const int n = static_cast<int>(J.cols());
   core::Matrix bordered(m + 1, n);
@@ -59,10 +67,21 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
   core::Vector x = guess;
   if (!steps.start(system, x, "")) return steps.take();
   core::Vector tangent;
-  if (curve_tangent(problem, x, hint, threshold, tangent) != core::EvalStatus::ok)
+  core::Matrix J;
+  if (problem.jacobian(x, J) != core::EvalStatus::ok ||
+      tangent_from_jacobian(J, hint, threshold, tangent) != core::EvalStatus::ok)
     return steps.end(
         StopReason::evaluation_failed,
         fmt::format("the Jacobian could not be evaluated at point 0 ({})", steps.describe(x)));
+  std::optional<BranchPointDetector> detector;
+  if (options.branch_points.detect) {
+    detector.emplace(problem, options, hooks, corrector);
+    detector->add(0, x, tangent, J, 0.0);
+  }
+  // Passing an attached family: a correction that turns away from the predictor direction by
+  // more than max_turn_degrees landed on another family (or jumped a fold); it is refused, and
+  // ds shrinks, so the branch keeps the direction closest to the incoming one.
+  const double max_turn = options.branch_points.max_turn_degrees;
 
   double ds = options.ds;
   core::Vector previous = x;
@@ -78,11 +97,25 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
     system.set_anchor(0, x);
     system.set_direction(0, step_direction);
     core::Vector y;
-    const CorrectedStep corrected =
-        steps.correct(ds, y, [&](double ds_try, core::Vector& predicted) {
+    const CorrectedStep corrected = steps.correct(
+        ds, y,
+        [&](double ds_try, core::Vector& predicted) {
           predicted = x + ds_try * step_direction;
           system.set_value(0, ds_try);
           return corrector.solve(system, predicted);
+        },
+        [&](const core::Vector& corrected_point) {
+          if (max_turn <= 0) return std::string();
+          const core::Vector secant = corrected_point - x;
+          const double norm = secant.norm();
+          if (!(norm > 0)) return std::string();
+          const double turn = std::acos(std::clamp(secant.dot(step_direction) / norm, -1.0, 1.0)) *
+                              180 / std::numbers::pi;
+          if (turn <= max_turn) return std::string();
+          return fmt::format(
+              "the step turned by {:.1f} degrees from the predictor direction "
+              "(max_turn_degrees {:g})",
+              turn, max_turn);
         });
     ds = corrected.ds;
     if (!corrected.accepted)
@@ -94,14 +127,19 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
                       core::to_string(corrected.last_failure), corrected.last_message));
     const int iterations = corrected.summary.iterations;
     core::Vector next_tangent;
-    const core::EvalStatus tangent_status =
-        curve_tangent(problem, y, step_direction, threshold, next_tangent);
+    core::EvalStatus tangent_status = problem.jacobian(y, J);
+    if (tangent_status == core::EvalStatus::ok)
+      tangent_status = tangent_from_jacobian(J, step_direction, threshold, next_tangent);
     const bool last = index + 1 == options.max_points || tangent_status != core::EvalStatus::ok;
     if (!steps.record(x, y, step_direction, iterations, ds, last)) return steps.take();
     if (tangent_status != core::EvalStatus::ok)
       return steps.end(StopReason::evaluation_failed,
                        fmt::format("the Jacobian could not be evaluated at point {} ({}: {})",
                                    index, core::to_string(tangent_status), steps.describe(y)));
+    if (detector) {
+      detector->add(index, y, next_tangent, J, steps.arclength());
+      for (BranchPointReport& report : detector->take()) steps.add_branch_point(std::move(report));
+    }
     previous = x;
     have_previous = true;
     x = y;

@@ -41,6 +41,10 @@ core::EvalStatus curve_tangent(const core::Problem& problem, const core::Vector&
                                const core::Vector& orientation, double relative_threshold,
                                core::Vector& tangent);
 
+// The same from the Jacobian J at the point (no evaluation).
+core::EvalStatus tangent_from_jacobian(const core::Matrix& J, const core::Vector& orientation,
+                                       double relative_threshold, core::Vector& tangent);
+
 // Throws core::InputError for bad options, sizes (guess and direction must have n entries,
 // m >= n - 1) or a zero direction. Never throws on numerical failure.
 Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,

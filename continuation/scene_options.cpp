@@ -49,6 +49,12 @@ po::options_description continuation_keys(const po::options_description& problem
       "verify then keeps only the real directions)");
   add("verify", po::value<bool>()->default_value(true),
       "re-correct along candidate null directions (verified dimension)");
+  add("detect_branch_points", po::value<bool>()->default_value(false),
+      "arclength: evaluate the branch-point test function at every point, locate and verify "
+      "candidates (trace writes branch_points.csv)");
+  add("max_turn_degrees", po::value<double>()->default_value(20),
+      "arclength: refuse a correction whose step turns by more than this from the predictor "
+      "direction (it landed on another family); 0: off");
   add("newton_tolerance", po::value<double>()->default_value(1e-10), "||F||_inf to converge");
   add("newton_max_iterations", po::value<long>()->default_value(25), "Newton iterations per point");
   add("natural_parameter", po::value<std::string>()->default_value("period"),
@@ -113,6 +119,8 @@ RunSettings read_run_settings(const core::Scene& scene) {
   if (!(o.rank.relative_threshold < 1))
     throw core::InputError("rank_threshold",
                            fmt::format("must be in (0, 1) (got {})", o.rank.relative_threshold));
+  o.branch_points.detect = scene.flag("detect_branch_points");
+  o.branch_points.max_turn_degrees = scene.non_negative("max_turn_degrees");
   read_bounds(scene, o);
   o.validate();
   run.newton = scene.choice("newton", {"eigen", "kinsol"});

@@ -206,6 +206,7 @@ int run_trace(const std::vector<std::string>& args_in) {
   };
   long rejected = 0;
   hooks.reject_point = setup.reject_point;
+  hooks.describe_branch_point = setup.describe_branch_point;
   hooks.on_attempt = [&](const cont::StepAttempt& a) {
     if (a.rejection.empty()) return;
     ++rejected;
@@ -228,6 +229,9 @@ int run_trace(const std::vector<std::string>& args_in) {
                       fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()),
                       entry.units);
     if (setup.write_extra_outputs) setup.write_extra_outputs(out, branch);
+    if (options.branch_points.detect)
+      cont::branch_point_table(branch, branch.points.front().observables)
+          .write_csv(out / "branch_points.csv");
   }
   core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",
                                                            &branch, rejected, result.switch_index));

@@ -23,6 +23,7 @@
 
 #include "core/errors.hpp"
 #include "core/table.hpp"
+#include "problems/contact_bar/attached_content.hpp"
 #include "problems/contact_bar/bench.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/figures.hpp"
@@ -66,8 +67,8 @@ po::options_description trace_keys() {
       ("shooting_elements", po::value<long>()->default_value(20),
        "intervals of the u0 grid (0: the scene's elements). 20 holds modes 1 and 2 exactly "
        "(mode 2 with its free knot); at 100 mode 1 meets a continuum of other periodic orbits "
-       "at end amplitude 2 g0 and follows it (measured; no branch-point detection yet), at "
-       "~100x the cost per point")  //
+       "at end amplitude 2 g0 and steps over it (max_turn_degrees; detect_branch_points "
+       "locates it), at ~100x the cost per point")  //
       ("test_elements", po::value<long>()->default_value(-1),
        "elements of the grid the residual is sampled on (its equations): 0 = as many as "
        "unknowns (square), -1 = auto (2x the unknowns: overdetermined, consistent, no "
@@ -97,8 +98,10 @@ po::options_description trace_keys() {
       ("ds", po::value<double>()->default_value(2.0),
        "first step, dimensionless: Euclidean in u0 / gap, knot / L and T c / L")           //
       ("ds_max", po::value<double>()->default_value(2.0), "largest step (dimensionless)")  //
-      ("newton_tolerance", po::value<double>()->default_value(1e-10),
-       "||F||_inf to converge; F is in units of the gap, so this is relative to g0")  //
+      ("newton_tolerance", po::value<double>()->default_value(3e-9),
+       "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
+       "residual's round-off grows with the amplitude: measured at shooting_elements 100 on "
+       "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there)")  //
       ("return_tolerance", po::value<double>()->default_value(1e-6),
        "reject a converged point whose orbit, re-simulated over T by the exact oracle, misses "
        "u0 or v0 = 0 by more than this, relative to max|u0| (0: no check). Catches spurious "
@@ -163,6 +166,14 @@ continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string
           e.displacement, e.velocity, return_tolerance);
     };
   }
+  // Branch points: the frequency ratio of the attached orbit's extra end content, measured
+  // from exact re-simulations of both orbits (attached_content.hpp).
+  s.describe_branch_point = [p](const core::Vector& on_branch, const core::Vector& attached) {
+    const AttachedContent c =
+        attached_content(*p, on_branch, attached, exact_bar::ExactBarSolver());
+    return core::Observables{{"frequency_ratio", c.frequency_ratio},
+                             {"oscillations_per_period", c.oscillations_per_period}};
+  };
   s.describe_point = [family](const continuation::BranchPoint& point) {
     const double exact = family.frequency(point.observable("energy"));
     return fmt::format("closed-form rel err {:.2e}",

@@ -1,0 +1,92 @@
+// Branch points along a traced curve: where another family of solutions attaches to it.
+//
+// Test function. At a regular point of a curve F(x) = 0 (F: R^n -> R^m, rank n - 1) the bordered
+// matrix [J; t^T] has full column rank n; where another family attaches, J loses rank and so does
+// [J; t^T]. The test function is the smallest singular value of [J / |J_0|_F; t^T] (J_0: the
+// Jacobian at the branch's first point; scaled unknowns, so it has no units), signed by following
+// the singular vectors from point to point (analytic SVD): at a simple branch point it changes
+// sign. This also holds for a consistent overdetermined residual (least-squares shooting), where no
+// determinant exists.
+//
+// Detection, location, verification (continuation/README.md, section 'Branch points'):
+//   - a sign change between consecutive points, or a dip (|tau_k| below dip_ratio times both
+//     neighbours: a sampled minimum, whose depth depends on how close a step lands) brackets a
+//     candidate;
+//   - it is located on the branch by an Illinois secant iteration on the signed test function
+//     (sign change) or by a safeguarded V-fit (|tau| ~ |s - s*| near a simple crossing) with
+//     golden-section fall-back (dip), each evaluation a point corrected on the hyperplane
+//     orthogonal to the bracket's polyline;
+//   - the located point is verified with the rank report and the probes of
+//     core::verify_null_directions: dimension = verified dimension - 1 (the directions beyond the
+//     traced tangent), and each extra direction is probed once more to find the attached family's
+//     secant, whose angle to the traced tangent is tangent_angle.
+//
+//   BranchPointDetector detector(scaled_problem, options, hooks, corrector);
+//   detector.add(index, z, tangent, J, arclength);   // after every accepted point
+//   for (BranchPointReport& r : detector.take()) use(r.x, r.attached_dimension, r.tangent_angle);
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "continuation/branch.hpp"
+#include "continuation/callbacks.hpp"
+#include "continuation/options.hpp"
+#include "continuation/scaled_problem.hpp"
+#include "core/newton.hpp"
+#include "core/rank_report.hpp"
+
+namespace backbone::continuation {
+
+// The signed test function at one point, with the singular vectors that fix its sign.
+struct TestFunctionValue {
+  double value = 0;  // +- sigma_min([J; t^T]) / sigma_max(J)
+  core::Vector left, right;
+  bool continued = true;  // false when the vectors did not follow the reference's (sign unknown)
+};
+
+// Test function of J (m x n) and the unit tangent t: the smallest singular value of
+// [J / scale; t^T]. With a reference (the previous point's value), the singular vectors are
+// oriented like the reference's and the value is signed; without one it is positive.
+TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vector& tangent,
+                                         double scale, const TestFunctionValue* reference);
+
+class BranchPointDetector {
+ public:
+  // problem: the loop's problem in scaled unknowns; corrector: the loop's (locates points on
+  // the branch). Uses options.branch_points, options.rank, options.verification (the probes'
+  // corrector, core::make_verifier); hooks.describe_branch_point, when set, describes each
+  // verified point.
+  BranchPointDetector(const ScaledProblem& problem, const ContinuationOptions& options,
+                      const ContinuationHooks& hooks, core::Corrector& corrector);
+  ~BranchPointDetector();
+
+  // After each accepted point z (scaled), its unit tangent, its Jacobian and arclength. May
+  // locate and verify a candidate bracketed by this and the previous points.
+  void add(int index, const core::Vector& z, const core::Vector& tangent, const core::Matrix& J,
+           double arclength);
+  // Located candidates so far (in the problem's own unknowns), in order; cleared.
+  std::vector<BranchPointReport> take();
+  // Test-function value at the last added point (NaN before the first).
+  double last_value() const;
+
+ private:
+  struct Sample;
+  struct Evaluation;
+  Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref);
+  void locate(const std::vector<Sample>& polyline, bool sign_change);
+  void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent);
+
+  const ScaledProblem& problem_;
+  const ContinuationOptions& options_;
+  const ContinuationHooks& hooks_;
+  core::Corrector& corrector_;
+  std::unique_ptr<core::Corrector> verifier_;
+  std::vector<Sample> samples_;  // the last three points
+  std::vector<BranchPointReport> found_;
+  double jacobian_scale_ = 0;  // Frobenius norm of the first point's Jacobian
+};
+
+}  // namespace backbone::continuation

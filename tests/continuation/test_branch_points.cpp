@@ -1,0 +1,176 @@
+// Branch points along pseudo-arclength branches of algebraic curves whose branch points are known
+// exactly (problems/algebraic/algebraic.hpp): detection, location, verification (dimension of
+// the attached family, angle between the branches) and passing through on the traced curve.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "continuation/branch_points.hpp"
+#include "continuation/pseudo_arclength.hpp"
+#include "core/errors.hpp"
+#include "problems/algebraic/algebraic.hpp"
+
+using namespace backbone;
+using continuation::Branch;
+
+namespace {
+
+continuation::ContinuationOptions detecting(double ds, int points) {
+  continuation::ContinuationOptions o;
+  o.ds = ds;
+  o.ds_max = ds;  // a fixed step, so that no point lands on a branch point by chance
+  o.max_points = points;
+  o.rank_check_every = 0;
+  o.branch_points.detect = true;
+  return o;
+}
+
+core::Vector vec(std::initializer_list<double> values) {
+  core::Vector v(static_cast<Eigen::Index>(values.size()));
+  Eigen::Index i = 0;
+  for (double x : values) v[i++] = x;
+  return v;
+}
+
+double largest_abs(const Branch& b, int coordinate) {
+  double worst = 0;
+  for (const auto& p : b.points) worst = std::max(worst, std::abs(p.x[coordinate]));
+  return worst;
+}
+
+}  // namespace
+
+// [J/s; t^T] of the transcritical on x = 0 is diag((lambda - 1)/s, 1): the signed test function
+// is (lambda - 1)/s, up to an orientation fixed by the first point.
+TEST(BorderedTestFunction, ChangesSignAcrossASimpleBranchPoint) {
+  const algebraic::Transcritical problem;
+  core::Matrix J;
+  const core::Vector t = vec({0, 1});
+  problem.jacobian(vec({0, 0.5}), J);
+  const auto before = continuation::bordered_test_function(J, t, 1.0, nullptr);
+  problem.jacobian(vec({0, 1.25}), J);
+  const auto after = continuation::bordered_test_function(J, t, 1.0, &before);
+  EXPECT_NEAR(std::abs(before.value), 0.5, 1e-14);
+  EXPECT_NEAR(after.value, -before.value * 0.5, 1e-14);  // |0.25| with the opposite sign
+  EXPECT_TRUE(after.continued);
+}
+
+// The line x = 0 traced upwards in lambda crosses x = lambda - 1 at (0, 1): one candidate,
+// located to the location tolerance (the test function is linear in lambda, so the secant
+// iteration is exact up to round-off), with a one-dimensional attached family at 45 degrees,
+// and the branch stays on x = 0 (exactly: the corrector never leaves it).
+TEST(BranchPoints, TranscriticalLocatedVerifiedAndPassed) {
+  for (int copies : {1, 3}) {  // 3: consistent overdetermined, least-squares corrector
+    const algebraic::Transcritical problem(copies);
+    auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+    const Branch b = continuation::pseudo_arclength(problem, vec({0, 0}), vec({0, 1}), *newton,
+                                                    detecting(0.13, 20));
+    ASSERT_EQ(b.points.size(), 20u) << b.message;
+    EXPECT_LE(largest_abs(b, 0), 1e-12);
+    ASSERT_EQ(b.branch_points.size(), 1u);
+    const auto& r = b.branch_points[0];
+    EXPECT_TRUE(r.sign_change);
+    EXPECT_NEAR(r.x[1], 1.0, 1e-9);
+    EXPECT_NEAR(r.x[0], 0.0, 1e-12);
+    EXPECT_EQ(r.after_point, 7);  // lambda = 0.91 at point 7, 1.04 at point 8
+    EXPECT_EQ(r.attached_dimension, 1);
+    // Probe at h = 1e-3 from a point within 1e-9 of the exact one: the secant's angle is off by
+    // about 1e-9 / 1e-3 rad = 6e-5 degrees.
+    EXPECT_NEAR(r.tangent_angle, 45.0, 1e-3);
+    EXPECT_NEAR(r.attached_point[1] - 1.0, r.attached_point[0], 1e-9);  // on x = lambda - 1
+  }
+}
+
+// The y axis meets the unit circle at y = -1 and y = 1: two candidates at right angles (the
+// probe's secant to the circle x^2 + y^2 = 1 from (0, 1) at x = h tilts by h/2 rad).
+TEST(BranchPoints, AxisMeetsTheCircleTwice) {
+  const algebraic::AxisAndCircle problem;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  const Branch b = continuation::pseudo_arclength(problem, vec({0, -1.6}), vec({0, 1}), *newton,
+                                                  detecting(0.15, 24));
+  ASSERT_EQ(b.points.size(), 24u) << b.message;
+  EXPECT_LE(largest_abs(b, 0), 1e-12);
+  ASSERT_EQ(b.branch_points.size(), 2u);
+  EXPECT_NEAR(b.branch_points[0].x[1], -1.0, 1e-9);
+  EXPECT_NEAR(b.branch_points[1].x[1], 1.0, 1e-9);
+  for (const auto& r : b.branch_points) {
+    EXPECT_EQ(r.attached_dimension, 1);
+    EXPECT_NEAR(r.tangent_angle, 90.0, 0.05);  // h/2 rad = 0.03 degrees
+  }
+}
+
+// The z axis pierces the plane z = 1: the attached family is two-dimensional. The branch passes
+// it and stays on the axis.
+TEST(BranchPoints, AttachedPlaneHasDimensionTwo) {
+  const algebraic::AxisAndPlane problem(2);
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  const Branch b = continuation::pseudo_arclength(problem, vec({0, 0, 0.1}), vec({0, 0, 1}),
+                                                  *newton, detecting(0.17, 12));
+  ASSERT_EQ(b.points.size(), 12u) << b.message;
+  EXPECT_LE(std::max(largest_abs(b, 0), largest_abs(b, 1)), 1e-12);
+  EXPECT_GT(b.points.back().x[2], 1.5);
+  ASSERT_EQ(b.branch_points.size(), 1u);
+  EXPECT_NEAR(b.branch_points[0].x[2], 1.0, 1e-9);
+  EXPECT_EQ(b.branch_points[0].attached_dimension, 2);
+  EXPECT_NEAR(b.branch_points[0].tangent_angle, 90.0, 1e-6);
+}
+
+// Without detection nothing is reported, and a regular curve (the circle) has no candidate.
+TEST(BranchPoints, NoneOnARegularCurveOrWhenOff) {
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  const algebraic::Circle circle;
+  const Branch regular =
+      continuation::pseudo_arclength(circle, vec({1, 0}), vec({0, 1}), *newton, detecting(0.2, 40));
+  EXPECT_TRUE(regular.branch_points.empty());
+  const algebraic::Transcritical problem;
+  auto options = detecting(0.13, 20);
+  options.branch_points.detect = false;
+  const Branch off =
+      continuation::pseudo_arclength(problem, vec({0, 0}), vec({0, 1}), *newton, options);
+  EXPECT_TRUE(off.branch_points.empty());
+}
+
+// The turn check refuses a correction that leaves the predictor direction by more than
+// max_turn_degrees: on the unit circle from (1, 0) with ds = 1 the arclength row lands on (0, 1),
+// a chord 45 degrees from the tangent: refused and retried at ds = 0.5 (15 degrees).
+TEST(BranchPoints, TurnCheckShrinksSteepSteps) {
+  const algebraic::Circle circle;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  continuation::ContinuationOptions o;
+  o.ds = 1.0;
+  o.ds_max = 1.0;
+  o.max_points = 3;
+  o.rank_check_every = 0;
+  const Branch b = continuation::pseudo_arclength(circle, vec({1, 0}), vec({0, 1}), *newton, o);
+  ASSERT_EQ(b.points.size(), 3u);
+  EXPECT_DOUBLE_EQ(b.points[1].step_size, 0.5);
+  o.branch_points.max_turn_degrees = 0;  // off
+  const Branch unchecked =
+      continuation::pseudo_arclength(circle, vec({1, 0}), vec({0, 1}), *newton, o);
+  EXPECT_DOUBLE_EQ(unchecked.points[1].step_size, 1.0);
+  o.branch_points.max_turn_degrees = 180;
+  EXPECT_THROW(o.validate(), core::InputError);
+}
+
+// branch_points.csv: the observables, dimension, the problem's description columns, the angle.
+TEST(BranchPoints, TableHasTheDocumentedColumns) {
+  const algebraic::Transcritical problem;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  continuation::ContinuationHooks hooks;
+  int reported = 0;
+  hooks.on_branch_point = [&](const continuation::BranchPointReport&) { ++reported; };
+  hooks.describe_branch_point = [](const core::Vector& at, const core::Vector& attached) {
+    return core::Observables{{"offset", (attached - at).norm()}};
+  };
+  const Branch b = continuation::pseudo_arclength(problem, vec({0, 0}), vec({0, 1}), *newton,
+                                                  detecting(0.13, 20), hooks);
+  EXPECT_EQ(reported, 1);
+  const core::Table t = continuation::branch_point_table(b);
+  ASSERT_EQ(t.rows(), 1u);
+  EXPECT_NEAR(t.column("lambda")[0], 1.0, 1e-9);
+  EXPECT_EQ(t.column("dimension")[0], 1.0);
+  EXPECT_NEAR(t.column("tangent_angle")[0], 45.0, 1e-3);
+  // The probe steps h = 1e-3 along x and lands on x = lambda - 1: offset h sqrt(2).
+  EXPECT_NEAR(t.column("offset")[0], 1e-3 * std::sqrt(2.0), 1e-9);
+  EXPECT_EQ(t.column("verified")[0], 1.0);
+}
