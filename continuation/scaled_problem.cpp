@@ -34,8 +34,20 @@ core::EvalStatus ScaledProblem::compute_residual(const core::Vector& z, core::Ve
 }
 
 core::EvalStatus ScaledProblem::compute_jacobian(const core::Vector& z, core::Matrix& J) const {
+  {
+    const std::lock_guard<std::mutex> lock(cache_mutex_);
+    // Exact equality: the same point, so the base would return the same matrix.
+    if (cached_z_.size() == z.size() && cached_z_ == z) {
+      J = cached_jacobian_;
+      return core::EvalStatus::ok;
+    }
+  }
   const core::EvalStatus s = base_.jacobian(to_unknowns(z), J);
-  if (s == core::EvalStatus::ok) J = J * scale_.asDiagonal();
+  if (s != core::EvalStatus::ok) return s;
+  J = J * scale_.asDiagonal();
+  const std::lock_guard<std::mutex> lock(cache_mutex_);
+  cached_z_ = z;
+  cached_jacobian_ = J;
   return s;
 }
 

@@ -12,7 +12,9 @@
 // L2 norm of u0 over the bar, so a branch has as many points at N = 640 as at N = 40). The
 // residual itself is the base's. Both continuation loops run on this view (loop_steps.hpp:
 // in_scaled_unknowns), so natural and pseudo-arclength branches report step sizes and
-// arclength in the same units.
+// arclength in the same units. The view keeps the last Jacobian it computed: the loops ask for
+// it twice at every point (tangent, then rank report), and the second request at the same z
+// (bit for bit) is a copy, not a new finite-difference Jacobian of the base.
 //
 //   ScaledProblem scaled(problem);                 // s = typical_scale(), w = step_weights()
 //   core::Vector z = scaled.to_scaled(x);          // x ./ scale(), scale() = s ./ w
@@ -20,6 +22,7 @@
 //   core::Vector back = scaled.to_unknowns(z);     // scale() .* z
 #pragma once
 
+#include <mutex>
 #include <string>
 
 #include "core/problem.hpp"
@@ -53,12 +56,16 @@ class ScaledProblem : public core::Problem {
 
  protected:
   core::EvalStatus compute_residual(const core::Vector& z, core::Vector& r) const override;
-  // J_z = J_x diag(s ./ w): the base's Jacobian (analytic or FD with its own step rule).
+  // J_z = J_x diag(s ./ w): the base's Jacobian (analytic or FD with its own step rule), or the
+  // last one when z is the last z asked for.
   core::EvalStatus compute_jacobian(const core::Vector& z, core::Matrix& J) const override;
 
  private:
   const core::Problem& base_;
   core::Vector scale_;
+  mutable std::mutex cache_mutex_;  // compute_jacobian may be called from several threads
+  mutable core::Vector cached_z_;   // empty: nothing cached
+  mutable core::Matrix cached_jacobian_;
 };
 
 }  // namespace backbone::continuation

@@ -231,6 +231,31 @@ TEST(ContactBarOrbit, StepNormIsTheL2NormOfU0AtEveryGrid) {
   }
 }
 
+// compute_residual is safe to call concurrently (each call marches its own TdbemMarch), and
+// the columns are computed by the same operations on every thread: the default Jacobian with
+// two threads equals the one-thread Jacobian bit for bit, on the contact bar and for a point
+// in contact (the kinks and contact events of every column's march differ).
+TEST(ContactBarOrbit, JacobianWithTwoThreadsIsBitIdentical) {
+  const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
+  ContactBarOrbitProblem p(paper_setup(), event, grid(40, 40, 0, 80));
+  const Vector x = p.contact_family_guess(1, 3.0);
+  core::Matrix one, two;
+  ASSERT_EQ(core::default_jacobian_threads(), 1);
+  ASSERT_EQ(p.jacobian(x, one), core::EvalStatus::ok);
+  core::set_default_jacobian_threads(2);
+  const core::EvalStatus s = p.jacobian(x, two);
+  core::set_default_jacobian_threads(1);
+  ASSERT_EQ(s, core::EvalStatus::ok);
+  EXPECT_TRUE(one == two);
+  EXPECT_GT(one.norm(), 0);
+  try {
+    core::set_default_jacobian_threads(0);
+    FAIL() << "accepted 0 threads";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.key(), "threads");
+  }
+}
+
 TEST(ContactBarOrbit, TestElementsBelowTheUnknownsAreRejected) {
   const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
   try {
