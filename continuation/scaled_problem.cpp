@@ -11,15 +11,22 @@ namespace backbone::continuation {
 ScaledProblem::ScaledProblem(const core::Problem& base)
     : ScaledProblem(base, base.typical_scale().cwiseAbs()) {}
 
-ScaledProblem::ScaledProblem(const core::Problem& base, core::Vector scale)
-    : base_(base), scale_(std::move(scale)) {
-  if (scale_.size() != base.num_unknowns())
-    throw core::InputError("typical_scale", fmt::format("has {} entries for {} unknowns",
-                                                        scale_.size(), base.num_unknowns()));
-  for (Eigen::Index i = 0; i < scale_.size(); ++i)
-    if (!std::isfinite(scale_[i]) || !(scale_[i] > 0))
-      throw core::InputError("typical_scale",
-                             fmt::format("entry {} must be finite and > 0 (got {})", i, scale_[i]));
+namespace {
+void check_positive(const char* what, const core::Vector& v, int unknowns) {
+  if (v.size() != unknowns)
+    throw core::InputError(what, fmt::format("has {} entries for {} unknowns", v.size(), unknowns));
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i]) || !(v[i] > 0))
+      throw core::InputError(what,
+                             fmt::format("entry {} must be finite and > 0 (got {})", i, v[i]));
+}
+}  // namespace
+
+ScaledProblem::ScaledProblem(const core::Problem& base, core::Vector scale) : base_(base) {
+  check_positive("typical_scale", scale, base.num_unknowns());
+  const core::Vector weights = base.step_weights();
+  check_positive("step_weights", weights, base.num_unknowns());
+  scale_ = scale.cwiseQuotient(weights);
 }
 
 core::EvalStatus ScaledProblem::compute_residual(const core::Vector& z, core::Vector& r) const {
@@ -27,8 +34,20 @@ core::EvalStatus ScaledProblem::compute_residual(const core::Vector& z, core::Ve
 }
 
 core::EvalStatus ScaledProblem::compute_jacobian(const core::Vector& z, core::Matrix& J) const {
+  {
+    const std::lock_guard<std::mutex> lock(cache_mutex_);
+    // Exact equality: the same point, so the base would return the same matrix.
+    if (cached_z_.size() == z.size() && cached_z_ == z) {
+      J = cached_jacobian_;
+      return core::EvalStatus::ok;
+    }
+  }
   const core::EvalStatus s = base_.jacobian(to_unknowns(z), J);
-  if (s == core::EvalStatus::ok) J = J * scale_.asDiagonal();
+  if (s != core::EvalStatus::ok) return s;
+  J = J * scale_.asDiagonal();
+  const std::lock_guard<std::mutex> lock(cache_mutex_);
+  cached_z_ = z;
+  cached_jacobian_ = J;
   return s;
 }
 

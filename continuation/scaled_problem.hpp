@@ -1,21 +1,28 @@
-// A problem seen in scaled unknowns z = x ./ s, s = base.typical_scale(): G(z) = F(s .* z).
+// A problem seen in scaled unknowns z = w .* x ./ s: G(z) = F(s ./ w .* z), with
+// s = base.typical_scale() (its units) and w = base.step_weights() (its quadrature weights).
 //
 // Pseudo-arclength measures steps with a Euclidean norm, which is only meaningful when the
 // unknowns have comparable magnitudes. A contact bar with a 1e-5 m gap and a 1e-4 s period, or
 // a Duffing orbit whose period is 2 pi while its amplitude is 0.01, is not: unscaled, ds is in
 // metres plus seconds and every new scene needs hand-tuned steps. Continuing G instead makes
 // ds, ds_min, ds_max and the arclength dimensionless (in units of the typical scale), the
-// tangent a scaled direction and the rank report a report on the column-scaled Jacobian J S,
-// whose singular values no longer depend on the units. The residual itself is the base's. Both
-// continuation loops run on this view (loop_steps.hpp: in_scaled_unknowns), so natural and
-// pseudo-arclength branches report step sizes and arclength in the same units.
+// tangent a scaled direction and the rank report a report on the column-scaled Jacobian
+// J diag(s ./ w), whose singular values no longer depend on the units. The weights make |dz| a
+// norm of the field the unknowns sample rather than of the node values (the contact bar: the
+// L2 norm of u0 over the bar, so a branch has as many points at N = 640 as at N = 40). The
+// residual itself is the base's. Both continuation loops run on this view (loop_steps.hpp:
+// in_scaled_unknowns), so natural and pseudo-arclength branches report step sizes and
+// arclength in the same units. The view keeps the last Jacobian it computed: the loops ask for
+// it twice at every point (tangent, then rank report), and the second request at the same z
+// (bit for bit) is a copy, not a new finite-difference Jacobian of the base.
 //
-//   ScaledProblem scaled(problem);                 // s = problem.typical_scale()
-//   core::Vector z = scaled.to_scaled(x);          // x ./ s
+//   ScaledProblem scaled(problem);                 // s = typical_scale(), w = step_weights()
+//   core::Vector z = scaled.to_scaled(x);          // x ./ scale(), scale() = s ./ w
 //   scaled.residual(z, r);                         // = problem.residual(x, r)
-//   core::Vector back = scaled.to_unknowns(z);     // s .* z
+//   core::Vector back = scaled.to_unknowns(z);     // scale() .* z
 #pragma once
 
+#include <mutex>
 #include <string>
 
 #include "core/problem.hpp"
@@ -24,9 +31,12 @@ namespace backbone::continuation {
 
 class ScaledProblem : public core::Problem {
  public:
-  // Throws core::InputError when the base's typical scale is not finite and positive.
+  // Throws core::InputError when the base's typical scale or step weights are not finite and
+  // positive.
   explicit ScaledProblem(const core::Problem& base);
-  // Same with an explicit scale (ones: the identity view, for unscaled runs).
+  // Same with an explicit unit scale in place of typical_scale() (ones: unscaled runs, whose
+  // norm is then the base's weighted Euclidean norm of the raw unknowns). The step weights are
+  // the base's in both cases.
   ScaledProblem(const core::Problem& base, core::Vector scale);
   int num_unknowns() const override { return base_.num_unknowns(); }
   int num_equations() const override { return base_.num_equations(); }
@@ -35,20 +45,27 @@ class ScaledProblem : public core::Problem {
     return base_.observables(to_unknowns(z));
   }
   core::Vector typical_scale() const override { return core::Vector::Ones(num_unknowns()); }
+  // z is already weighted: its norm is the plain Euclidean one.
+  core::Vector step_weights() const override { return core::Vector::Ones(num_unknowns()); }
 
   core::Vector to_scaled(const core::Vector& x) const { return x.cwiseQuotient(scale_); }
   core::Vector to_unknowns(const core::Vector& z) const { return z.cwiseProduct(scale_); }
+  // s ./ w: x = scale() .* z.
   const core::Vector& scale() const { return scale_; }
   const core::Problem& base() const { return base_; }
 
  protected:
   core::EvalStatus compute_residual(const core::Vector& z, core::Vector& r) const override;
-  // J_z = J_x diag(s): the base's Jacobian (analytic or FD with its own step rule).
+  // J_z = J_x diag(s ./ w): the base's Jacobian (analytic or FD with its own step rule), or the
+  // last one when z is the last z asked for.
   core::EvalStatus compute_jacobian(const core::Vector& z, core::Matrix& J) const override;
 
  private:
   const core::Problem& base_;
   core::Vector scale_;
+  mutable std::mutex cache_mutex_;  // compute_jacobian may be called from several threads
+  mutable core::Vector cached_z_;   // empty: nothing cached
+  mutable core::Matrix cached_jacobian_;
 };
 
 }  // namespace backbone::continuation

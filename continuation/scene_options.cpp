@@ -9,6 +9,7 @@
 #include "continuation/natural.hpp"
 #include "continuation/pseudo_arclength.hpp"
 #include "core/errors.hpp"
+#include "core/finite_difference.hpp"
 
 namespace backbone::continuation {
 
@@ -60,6 +61,8 @@ po::options_description continuation_keys(const po::options_description& problem
   add("natural_parameter", po::value<std::string>()->default_value("period"),
       "natural method: the period unknown or an observable name");
   add("natural_direction", po::value<long>()->default_value(1), "natural method: +1 or -1");
+  add("threads", po::value<long>()->default_value(1),
+      "threads for the finite-difference Jacobian columns (same branch, bit for bit)");
   return keys;
 }
 
@@ -132,6 +135,7 @@ RunSettings read_run_settings(const core::Scene& scene) {
   if (direction != 1 && direction != -1)
     throw core::InputError("natural_direction", fmt::format("must be 1 or -1 (got {})", direction));
   run.natural_direction = static_cast<double>(direction);
+  run.threads = static_cast<int>(scene.integer("threads", 1, core::max_jacobian_threads));
   return run;
 }
 
@@ -139,6 +143,12 @@ SwitchingBranch run_continuation(const core::Problem& problem, const core::Vecto
                                  const core::Vector& direction, const RunSettings& settings,
                                  core::Corrector& corrector, const ContinuationHooks& hooks) {
   const ContinuationOptions& options = settings.options;
+  // The run's thread count, restored on the way out (also when a callback throws).
+  struct ThreadsForThisRun {
+    int previous = core::default_jacobian_threads();
+    explicit ThreadsForThisRun(int threads) { core::set_default_jacobian_threads(threads); }
+    ~ThreadsForThisRun() { core::set_default_jacobian_threads(previous); }
+  } threads(settings.threads);
   if (options.method == Method::arclength)
     return {pseudo_arclength(problem, guess, direction, corrector, options, hooks), -1};
   const auto* periodic = dynamic_cast<const core::PeriodicOrbitProblem*>(&problem);

@@ -2,8 +2,8 @@
 //
 // `backbone trace` reads a problem's scene keys plus these (method, predictor, newton,
 // formulation, ds, ds_min, ds_max, max_points, bounds, rank checks, Newton tolerance, natural
-// parameter); a problem that declares one of them itself owns its default (the contact bar's
-// ds is 2, dimensionless). read_run_settings validates them all before any work (InputError
+// parameter, threads); a problem that declares one of them itself owns its default (the contact
+// bar's ds is 2, dimensionless). read_run_settings validates them all before any work (InputError
 // naming the key); run_continuation dispatches to pseudo_arclength, natural or
 // natural_then_arclength.
 //
@@ -38,6 +38,7 @@ struct RunSettings {
   core::ShootingFormulation formulation = core::ShootingFormulation::half_period_velocity;
   std::string natural_parameter = "period";  // the period unknown or an observable's name
   double natural_direction = 1;              // +1 or -1
+  int threads = 1;  // finite-difference Jacobian columns (core::set_default_jacobian_threads)
 };
 
 // Throws core::InputError naming the key for any bad value.

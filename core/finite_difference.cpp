@@ -1,9 +1,14 @@
 #include "core/finite_difference.hpp"
 
+#include <fmt/format.h>
+
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <thread>
 #include <vector>
+
+#include "core/errors.hpp"
 
 namespace backbone::core {
 
@@ -14,8 +19,8 @@ EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, M
   J.resize(m, n);
   const bool central = options.scheme == FiniteDifferenceOptions::Scheme::central;
   const double eps = std::numeric_limits<double>::epsilon();
-  const double rel =
-      options.relative_step > 0 ? options.relative_step : (central ? std::cbrt(eps) : std::sqrt(eps));
+  const double rel = options.relative_step > 0 ? options.relative_step
+                                               : (central ? std::cbrt(eps) : std::sqrt(eps));
   const Vector scale = problem.typical_scale();
 
   Vector r0;
@@ -27,7 +32,8 @@ EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, M
   std::vector<EvalStatus> status(static_cast<std::size_t>(n), EvalStatus::ok);
   auto column = [&](int j) {
     Vector xp = x;
-    const double h0 = rel * std::max(std::abs(x[j]), std::abs(scale[j]) > 0 ? std::abs(scale[j]) : 1.0);
+    const double h0 =
+        rel * std::max(std::abs(x[j]), std::abs(scale[j]) > 0 ? std::abs(scale[j]) : 1.0);
     // Round the step so that x_j + h is exactly representable: the divisor is the step taken.
     volatile double shifted = x[j] + h0;
     const double h = shifted - x[j];
@@ -60,8 +66,25 @@ EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, M
   return EvalStatus::ok;
 }
 
+namespace {
+std::atomic<int> jacobian_threads{1};
+}  // namespace
+
+void set_default_jacobian_threads(int threads) {
+  if (threads < 1 || threads > max_jacobian_threads)
+    throw InputError("threads",
+                     fmt::format("must be in 1..{} (got {})", max_jacobian_threads, threads));
+  jacobian_threads = threads;
+}
+
+int default_jacobian_threads() {
+  return jacobian_threads;
+}
+
 EvalStatus Problem::compute_jacobian(const Vector& x, Matrix& J) const {
-  return finite_difference_jacobian(*this, x, J);
+  FiniteDifferenceOptions options;
+  options.threads = default_jacobian_threads();
+  return finite_difference_jacobian(*this, x, J, options);
 }
 
 }  // namespace backbone::core

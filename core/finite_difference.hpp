@@ -6,11 +6,16 @@
 // O(h) balances round-off O(eps/h)) and cbrt(machine epsilon) ~ 6e-6 for central differences
 // (truncation O(h^2)). h_j is then rounded so that x_j + h_j is exactly representable.
 // Columns are independent: with threads > 1 they are evaluated concurrently
-// (Problem::compute_residual is const and must be thread-safe).
+// (Problem::compute_residual is const and must be thread-safe); every column is computed by
+// the same operations whatever the thread count, so J is bit-identical to one thread's.
+// The default Jacobian of every Problem (Problem::compute_jacobian) uses
+// default_jacobian_threads(), a process-wide execution setting like Eigen::setNbThreads (the
+// `threads` key of a trace sets it for the run, continuation/scene_options.hpp).
 //
 //   FiniteDifferenceOptions fd; fd.scheme = FiniteDifferenceOptions::Scheme::central;
 //   Matrix J;
 //   EvalStatus s = finite_difference_jacobian(problem, x, J, fd);
+//   set_default_jacobian_threads(2);    // problem.jacobian(x, J) now uses two threads
 #pragma once
 
 #include "core/problem.hpp"
@@ -26,5 +31,11 @@ struct FiniteDifferenceOptions {
 
 EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, Matrix& J,
                                       const FiniteDifferenceOptions& options = {});
+
+// Threads of the default finite-difference Jacobian, 1 at start. Throws InputError("threads")
+// unless 1 <= threads <= max_jacobian_threads.
+constexpr int max_jacobian_threads = 256;
+void set_default_jacobian_threads(int threads);
+int default_jacobian_threads();
 
 }  // namespace backbone::core

@@ -68,6 +68,14 @@ class Problem {
   // scaled norms. Default: ones.
   virtual Vector typical_scale() const { return Vector::Ones(num_unknowns()); }
 
+  // Weights w of the continuation norm, |dx|^2 = sum_j (w_j dx_j / typical_scale_j)^2: how much
+  // each unknown counts in a step length, not its unit (so the finite-difference step rule,
+  // which uses typical_scale alone, does not see them). A problem whose unknowns sample a field
+  // on a grid returns quadrature weights (sqrt(dx / L) for nodal values), so that a step
+  // measures the change of the field, not the number of nodes, and a branch has as many
+  // points at every resolution. Finite and > 0. Default: ones (the Euclidean norm).
+  virtual Vector step_weights() const { return Vector::Ones(num_unknowns()); }
+
   const EvaluationCounters& counters() const { return counters_; }
   void reset_counters() const { counters_.reset(); }
 

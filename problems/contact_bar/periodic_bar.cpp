@@ -230,6 +230,16 @@ Vector ContactBarOrbitProblem::typical_scale() const {
   return s;
 }
 
+Vector ContactBarOrbitProblem::step_weights() const {
+  // Trapezoid rule on the reference grid: sum_i w_i^2 u0_i^2 = int_0^L u0^2 dx / L for a
+  // piecewise-linear u0 up to O(dx^2) (u0(0) = 0 has no unknown).
+  const int n = options_.elements;
+  Vector w = Vector::Ones(num_unknowns());
+  w.head(n).setConstant(std::sqrt(1.0 / n));
+  w[n - 1] = std::sqrt(0.5 / n);
+  return w;
+}
+
 EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
   const int n = options_.elements;
   const int m = options_.test_elements > 0 ? options_.test_elements : state_size();  // grid

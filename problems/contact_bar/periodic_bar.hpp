@@ -114,6 +114,10 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   core::Observables observables(const core::Vector& x) const override;
   // u_s for the u0 entries, L for a free knot, L/c for the period.
   core::Vector typical_scale() const override;
+  // sqrt(dx / L) for the u0 entries (dx = L / N; the trapezoid rule's half weight at x = L),
+  // 1 for a free knot and the period: a step is then |du0|_L2 / (u_s sqrt(L)) plus the period
+  // change in L/c, the same at every N for the same change of the orbit.
+  core::Vector step_weights() const override;
   // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
   double displacement_scale() const;
 

@@ -14,6 +14,7 @@
 
 #include "continuation/natural.hpp"
 #include "continuation/pseudo_arclength.hpp"
+#include "continuation/scaled_problem.hpp"
 #include "continuation/switching.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
@@ -517,5 +518,58 @@ TEST(Continuation, VerificationUsesTheVerifyOptionsCorrector) {
   for (std::size_t i = 0; i < 6; ++i) {
     EXPECT_EQ(verified.points[i].dimension, 1) << i;
     EXPECT_EQ(capped.points[i].dimension, 0) << i;
+  }
+}
+
+namespace {
+
+// The unit circle whose continuation norm counts both unknowns `weight` times (step_weights).
+class WeightedCircle : public core::Problem {
+ public:
+  explicit WeightedCircle(core::Vector weights) : weights_(std::move(weights)) {}
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 1; }
+  core::Vector step_weights() const override { return weights_; }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    r.resize(1);
+    r[0] = x.squaredNorm() - 1.0;
+    return core::EvalStatus::ok;
+  }
+
+ private:
+  core::Vector weights_;
+};
+
+}  // namespace
+
+// Step weights change the norm, not the problem: with weights 2 a step of 0.1 is a step of 0.05
+// with weights 1, so both runs visit the same points and the weighted arclength is twice the
+// other. Not bit for bit: the bordered residual [F; arclength row] is not scaled uniformly, so
+// the two Newton runs stop at different iterates within the tolerance |F| <= 1e-10 (distance
+// to the curve <= 5e-11 here, |grad F| = 2); measured 5e-12 after 30 steps, 1e-9 allows drift.
+TEST(PseudoArclength, StepWeightsScaleTheNormOnly) {
+  const WeightedCircle plain(vec(1, 1)), doubled(vec(2, 2));
+  const continuation::ScaledProblem view(doubled);
+  EXPECT_EQ(view.scale(), vec(0.5, 0.5));  // x = scale .* z: z = w .* x ./ s
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(30);
+  opt.ds = opt.ds_max = 0.05;
+  const Branch a = continuation::pseudo_arclength(plain, vec(1, 0), vec(0, 1), *newton, opt);
+  opt.ds = opt.ds_max = 0.1;
+  const Branch b = continuation::pseudo_arclength(doubled, vec(1, 0), vec(0, 1), *newton, opt);
+  ASSERT_EQ(a.points.size(), 30u);
+  ASSERT_EQ(b.points.size(), 30u);
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    EXPECT_NEAR((a.points[i].x - b.points[i].x).norm(), 0, 1e-9) << i;
+    EXPECT_NEAR(b.points[i].arclength, 2 * a.points[i].arclength, 2e-9) << i;
+  }
+  try {
+    const WeightedCircle bad(vec(1, 0));
+    const continuation::ScaledProblem rejected(bad);
+    FAIL() << "accepted a zero step weight";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.key(), "step_weights");
   }
 }
