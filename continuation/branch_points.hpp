@@ -56,9 +56,9 @@ TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vect
 class BranchPointDetector {
  public:
   // problem: the loop's problem in scaled unknowns; corrector: the loop's (locates points on
-  // the branch). Uses options.branch_points, options.rank, options.verification (the probes'
-  // corrector, core::make_verifier); hooks.describe_branch_point, when set, describes each
-  // verified point.
+  // the branch and corrects the probes). Uses options.branch_points, options.rank,
+  // options.verification (probe step and drift_ratio); hooks.describe_branch_point, when set,
+  // describes each verified point.
   BranchPointDetector(const ScaledProblem& problem, const ContinuationOptions& options,
                       const ContinuationHooks& hooks, core::Corrector& corrector);
   ~BranchPointDetector();
@@ -83,7 +83,6 @@ class BranchPointDetector {
   const ContinuationOptions& options_;
   const ContinuationHooks& hooks_;
   core::Corrector& corrector_;
-  std::unique_ptr<core::Corrector> verifier_;
   std::vector<Sample> samples_;  // the last three points
   std::vector<BranchPointReport> found_;
   double jacobian_scale_ = 0;  // Frobenius norm of the first point's Jacobian
