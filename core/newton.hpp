@@ -29,6 +29,11 @@ struct NewtonOptions {
   // Relative singular-value cut-off of the minimum-norm step (eigen backend): singular
   // values below rank_cutoff * sigma_max are treated as zero.
   double rank_cutoff = 1e-12;
+  // Eigen backend: after an iteration with a fresh Jacobian, try the next steps with its
+  // factorization (chord steps, one residual each) and keep a chord step when it reduces
+  // ||F||_2 by at least 1 / reuse_contraction; else compute a fresh Jacobian at once.
+  bool reuse_jacobian = false;
+  double reuse_contraction = 0.1;  // in (0, 1)
   void validate() const;  // throws InputError naming the field, e.g. "newton.max_iterations"
 };
 

@@ -89,26 +89,41 @@ double TdbemMarch::tolerance() const {
   return 1e-9 * dt_ + 1e-14 * t_;
 }
 
-double TdbemMarch::q_at(int e, double s) const {
+std::size_t TdbemMarch::knot_index(int e, double s, std::size_t* hint) const {
   const auto& k = ends_[e].knots;
-  auto it =
-      std::lower_bound(k.begin(), k.end(), s, [](const Knot& a, double v) { return a.t < v; });
-  if (it == k.end()) return k.back().q;
-  if (it == k.begin()) return it->q;
-  auto prev = it - 1;
-  const double w = (s - prev->t) / (it->t - prev->t);
-  return prev->q + w * (it->q - prev->q);
+  if (!hint)
+    return static_cast<std::size_t>(
+        std::lower_bound(k.begin(), k.end(), s, [](const Knot& a, double v) { return a.t < v; }) -
+        k.begin());
+  // Times are sorted: stepping down while the previous knot is not before s, then up while
+  // this one is before s, lands on the lower bound from any start.
+  std::size_t i = std::min(*hint, k.size());
+  while (i > 0 && k[i - 1].t >= s) --i;
+  while (i < k.size() && k[i].t < s) ++i;
+  *hint = i;
+  return i;
 }
 
-double TdbemMarch::q_slope(int e, double s) const {
+double TdbemMarch::q_at(int e, double s, std::size_t* hint) const {
+  const auto& k = ends_[e].knots;
+  const std::size_t i = knot_index(e, s, hint);
+  if (i == k.size()) return k.back().q;
+  if (i == 0) return k[0].q;
+  const Knot& prev = k[i - 1];
+  const Knot& next = k[i];
+  const double w = (s - prev.t) / (next.t - prev.t);
+  return prev.q + w * (next.q - prev.q);
+}
+
+double TdbemMarch::q_slope(int e, double s, std::size_t* hint) const {
   const auto& k = ends_[e].knots;
   if (k.size() < 2) return 0;
-  auto it =
-      std::lower_bound(k.begin(), k.end(), s, [](const Knot& a, double v) { return a.t < v; });
-  if (it == k.end()) it = k.end() - 1;
-  if (it == k.begin()) it = k.begin() + 1;
-  auto prev = it - 1;
-  return (it->q - prev->q) / (it->t - prev->t);
+  std::size_t i = knot_index(e, s, hint);
+  if (i == k.size()) i = k.size() - 1;
+  if (i == 0) i = 1;
+  const Knot& prev = k[i - 1];
+  const Knot& next = k[i];
+  return (next.q - prev.q) / (next.t - prev.t);
 }
 
 double TdbemMarch::r_end(int e, double t) const {
@@ -124,7 +139,7 @@ double TdbemMarch::r_end(int e, double t) const {
       value += setup_.v0.integral(0.0, std::min(ct, L_)) / (2 * c_);
     }
   } else {
-    value += v0_total_ / (2 * c_) + q_at(1 - e, retarded);
+    value += v0_total_ / (2 * c_) + q_at(1 - e, retarded, &retarded_hint_[1 - e]);
   }
   return value;
 }
@@ -391,11 +406,17 @@ double TdbemMarch::displacement(double x) const {
 }
 
 double TdbemMarch::velocity(double x) const {
+  return velocity(x, nullptr);
+}
+
+double TdbemMarch::velocity(double x, std::size_t* hints) const {
   const double s0 = t_ - x / c_, sL = t_ - (L_ - x) / c_;
   const double lo = x - c_ * t_, hi = x + c_ * t_;
   double value = body_coef_ * (body_rate(c_, t_, x) + body_rate(c_, t_, L_ - x));
-  value += sL <= 0 ? 0.5 * c_ * setup_.u0.slope(hi, -1) + 0.5 * setup_.v0(hi) : q_slope(1, sL);
-  value += s0 <= 0 ? -0.5 * c_ * setup_.u0.slope(lo, +1) + 0.5 * setup_.v0(lo) : q_slope(0, s0);
+  value += sL <= 0 ? 0.5 * c_ * setup_.u0.slope(hi, -1) + 0.5 * setup_.v0(hi)
+                   : q_slope(1, sL, hints ? &hints[1] : nullptr);
+  value += s0 <= 0 ? -0.5 * c_ * setup_.u0.slope(lo, +1) + 0.5 * setup_.v0(lo)
+                   : q_slope(0, s0, hints ? &hints[0] : nullptr);
   return value;
 }
 
@@ -451,8 +472,11 @@ void TdbemMarch::integrate_pieces(int elements, F&& f) const {
 std::vector<double> TdbemMarch::project(int elements, bool use_velocity) const {
   std::vector<double> result(static_cast<std::size_t>(elements) + 1, 0.0);
   const double dx = L_ / elements;
+  // The pieces come in increasing x: the retarded times t - x/c and t - (L - x)/c are monotone,
+  // so each end's knot search walks on from the previous one.
+  std::size_t hints[2] = {ends_[0].knots.size(), 0};
   integrate_pieces(elements, [&](double x, double w, int j) {
-    const double value = use_velocity ? velocity(x) : displacement(x);
+    const double value = use_velocity ? velocity(x, hints) : displacement(x);
     const double theta = (x - j * dx) / dx;
     result[j] += w * value * (1 - theta);
     result[j + 1] += w * value * theta;

@@ -97,8 +97,15 @@ class TdbemMarch {
   };
 
   double r_end(int e, double t) const;  // R_e(t), t > 0
-  double q_at(int e, double s) const;   // Q_e(s), s > 0
-  double q_slope(int e, double s) const;
+  // Q_e(s) (s > 0) and its slope. hint: when given, the knot search walks from the index of the
+  // previous query and stores the new one there (O(1) for monotone queries: the march's
+  // retarded times, a projection's sweep in x); else a binary search. Same value either way.
+  double q_at(int e, double s, std::size_t* hint = nullptr) const;
+  double q_slope(int e, double s, std::size_t* hint = nullptr) const;
+  // Index of the first knot of end e with time >= s (std::lower_bound), see hint above.
+  std::size_t knot_index(int e, double s, std::size_t* hint) const;
+  // velocity(x) with the knot searches of both ends walking from hints (project's sweep).
+  double velocity(double x, std::size_t* hints) const;
   void step_end(int e, double ta, double tb);
   void substep_event(int e, double ta, double tb, bool kink_at_end);
   void push_knot(int e, double t, double u, double s, bool kink);
@@ -117,6 +124,9 @@ class TdbemMarch {
   double t_ = 0;
   bool ok_ = true;
   EndState ends_[2];  // 0: x = 0, 1: x = L
+  // Knot index of the last retarded-time query of each end's R (r_end reads the OTHER end's
+  // history at t - tau, increasing over the march). Only the march itself updates it.
+  mutable std::size_t retarded_hint_[2] = {0, 0};
   std::vector<ContactEvent> events_;
 };
 
