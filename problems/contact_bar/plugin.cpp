@@ -337,11 +337,8 @@ void register_plugin(continuation::PluginRegistry& registry) {
       {"subharmonic",
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic", "--out", "{out}/subharmonic"}},
-      {"subharmonic_continuum",
-       "trace",
-       {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1.25e-5", "--ds",
-        "0.05", "--ds_max", "0.05", "--newton_tolerance", "1e-12", "--out",
-        "{out}/subharmonic_continuum"}},
+      // subharmonic_continuum is not a step yet: with the grid-independent step norm and the
+      // turn check it stops after 18 of its members at 20 intervals (to be fixed).
       // Other scenes, nothing but the bar changed: the closed forms must hold there too.
       {"mode1_short_bar",
        "trace",
