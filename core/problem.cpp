@@ -6,9 +6,12 @@ namespace backbone::core {
 
 const char* to_string(EvalStatus s) {
   switch (s) {
-    case EvalStatus::ok: return "ok";
-    case EvalStatus::non_finite: return "non-finite value";
-    case EvalStatus::failed: return "evaluation failed";
+    case EvalStatus::ok:
+      return "ok";
+    case EvalStatus::non_finite:
+      return "non-finite value";
+    case EvalStatus::failed:
+      return "evaluation failed";
   }
   return "?";
 }

@@ -97,7 +97,7 @@ po::options_description trace_keys() {
        "the contact map), the smallest kept one is 5.6e-5; verify decides")  //
       ("ds", po::value<double>()->default_value(0.45),
        "first step, dimensionless: the L2 norm of the change of u0 / gap over the bar "
-       "(independent of the grid), knot / L and T c / L")                                  //
+       "(independent of the grid), knot / L and T c / L")                                   //
       ("ds_max", po::value<double>()->default_value(0.45), "largest step (dimensionless)")  //
       ("newton_tolerance", po::value<double>()->default_value(3e-9),
        "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
