@@ -8,6 +8,7 @@
 #include <memory>
 #include <numbers>
 
+#include "problems/duffing/bench.hpp"
 #include "problems/duffing/duffing.hpp"
 
 namespace backbone::duffing {
@@ -37,6 +38,7 @@ void register_plugin(continuation::PluginRegistry& registry) {
   p.scene_keys = &scene_keys;
   p.branches = {"backbone"};
   p.setup = &setup_trace;
+  p.bench_cases = bench_cases();
   p.reproduce = {
       {"duffing",
        "trace",
