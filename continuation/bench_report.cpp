@@ -39,8 +39,9 @@ std::filesystem::path write_bench_report(
       text << in.rdbuf();
       report += text.str();
     } else {
-      report += fmt::format("## {}\n\n{} (no section in this folder: the case writes none, or has not run here).\n", name,
-                            summary);
+      report += fmt::format(
+          "## {}\n\n{} (no section in this folder: the case writes none, or has not run here).\n",
+          name, summary);
     }
   }
   const std::filesystem::path path = out / "BENCHMARKS.md";
