@@ -310,7 +310,7 @@ int bench_duffing_auto(const std::filesystem::path& out) {
   const core::PlotResult plot = core::render_png(
       png,
       fmt::format(
-          "set logscale xy\nset grid\nset format y '%.0e'\nset datafile missing 'nan'\n"
+          "set termoption noenhanced\nset logscale xy\nset grid\nset format y '%.0e'\nset datafile missing 'nan'\n"
           "set xlabel 'compute seconds (one thread, median of 3)'\n"
           "set ylabel 'max relative period error'\n"
           "set title 'Duffing backbone, amplitude 0.01 -> 5: work-precision'\n"
