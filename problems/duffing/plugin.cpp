@@ -42,7 +42,9 @@ void register_plugin(continuation::PluginRegistry& registry) {
   p.reproduce = {
       {"duffing",
        "trace",
-       {"problems/duffing/scenes/duffing.ini", "--branch", "backbone", "--out", "{out}/duffing"}}};
+       {"problems/duffing/scenes/duffing.ini", "--branch", "backbone", "--out", "{out}/duffing"}},
+      // Into the contact bar's bench folder: BENCHMARKS.md there gathers every case's section.
+      {"bench_duffing", "bench", {"--problem", "duffing", "--out", "{out}/bench"}}};
   registry.add(std::move(p));
 }
 
