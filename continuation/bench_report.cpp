@@ -27,8 +27,9 @@ std::filesystem::path write_bench_report(
   std::string report =
       "# Benchmarks\n\n"
       "Written by `backbone bench` (one section per case, in the order of `backbone bench "
-      "--help`; a case run alone refreshes its own section). Timings are of one thread on the "
-      "machine that ran the bench; the errors are deterministic. Figures and CSV tables are in "
+      "--help`; a case run alone refreshes its own section). Timings are of one thread (unless "
+      "`--threads K`) on the machine that ran the bench and vary by up to 3x from run to run on "
+      "shared machines; the errors are deterministic. Figures and CSV tables are in "
       "this folder.\n";
   for (const auto& [name, summary] : cases) {
     const std::filesystem::path section = bench_section_path(out, name);
