@@ -5,8 +5,10 @@
 // variable-order Adams-Moulton method (orders up to 12) with a fixed-point corrector: the
 // problems here are smooth and non-stiff, where high-order Adams needs far fewer steps than
 // BDF (order <= 5) at the tight tolerances (rtol ~ 1e-13) a period accurate to 1e-9 asks for.
-// The end time is imposed as a stop time, so the solution is never interpolated. Each
-// integrate_ode() call creates and frees its own CVODE memory, so concurrent calls are safe.
+// The end time is imposed as a stop time, so the solution is never interpolated. Each thread
+// keeps one CVODE memory and re-initialises it per call (CVodeReInit: the same integration as a
+// fresh CVodeCreate, without its allocations), so concurrent calls from different threads are
+// safe; a right-hand side must not call integrate_ode itself.
 //
 //   CvodeOptions opt; opt.relative_tolerance = 1e-13;
 //   opt.absolute_tolerance = Vector::Constant(2, 1e-16);

@@ -24,6 +24,8 @@
 //   p.residual(x, r); p.jacobian(x, J);          // 1 x 2, J analytic (variational equations)
 #pragma once
 
+#include <mutex>
+
 #include "core/periodic_orbit.hpp"
 
 namespace backbone::core {
@@ -44,6 +46,7 @@ struct ResidualScale {
 // unknowns [q0 | T] (v0 = 0), both shooting formulations of PeriodicOrbitProblem.
 class OdeOrbitProblem : public PeriodicOrbitProblem {
  public:
+  static constexpr int max_dimension_keeping_jacobian = 2;
   explicit OdeOrbitProblem(int dimension, OdeOrbitOptions options = {});
   int state_size() const override;
   int num_parameters() const final { return 0; }  // unknowns are exactly [q0 | T]
@@ -67,15 +70,33 @@ class OdeOrbitProblem : public PeriodicOrbitProblem {
   virtual ResidualScale residual_scale(const Vector& x) const;
 
  protected:
+  // For d <= max_dimension_keeping_jacobian both integrate the variational equations alongside
+  // the orbit and keep the Jacobian of the last point, so Newton's jacobian(x) after the
+  // residual(x) that accepted x costs nothing: one flow per Newton iteration instead of a flow
+  // and a flow with sensitivities (measured: 1.55x a flow at d = 1, 1.74x at d = 2, 3.9x at
+  // d = 4, where a residual is a bare flow again).
   EvalStatus compute_residual(const Vector& x, Vector& r) const override;
-  EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override;  // variational eqs
+  EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override;
+  // A subclass whose vector field or energy can change after construction (a parameter setter)
+  // calls this when it does: the kept Jacobian belongs to the old field.
+  void forget_last_shot() const;
 
  private:
+  // Residual and analytic Jacobian at x from one flow with sensitivities; remembers J at x.
+  EvalStatus shoot(const Vector& x, Vector& r, Matrix& J) const;
   // Speed scale of the orbit from rest at q0: sqrt(2 energy), floored away from zero.
   double velocity_scale(const Vector& q0) const;
 
   int dimension_;
   OdeOrbitOptions options_;
+  // The last shot: J at x for that formulation (guarded: residuals may run concurrently).
+  struct LastShot {
+    Vector x;
+    ShootingFormulation formulation = ShootingFormulation::half_period_velocity;
+    Matrix jacobian;
+  };
+  mutable std::mutex last_mutex_;
+  mutable LastShot last_;
 };
 
 }  // namespace backbone::core

@@ -1,6 +1,9 @@
-// `backbone bench [--problem NAME] [--case NAME] [--out DIR]`: the benchmarks of every problem
-// plugin (ProblemPlugin::bench_cases, continuation/plugin.hpp), not tests. Each case writes
-// its CSV tables and PNG figures into DIR (default results/bench) and prints its table.
+// `backbone bench [--problem NAME] [--case NAME] [--out DIR] [--threads K]`: the benchmarks of
+// every problem plugin (ProblemPlugin::bench_cases, continuation/plugin.hpp), not tests. Each
+// case writes its CSV tables, PNG figures and its markdown section into DIR (default
+// results/bench) and prints its table; DIR/BENCHMARKS.md is then rebuilt from the sections of
+// every case (continuation/bench_report.hpp). --threads K sets the finite-difference Jacobian
+// threads of the cases that run continuation (core::set_default_jacobian_threads).
 //
 //   backbone bench                                  # every case of every problem
 //   backbone bench --case bouncing_bar --out /tmp/bench
@@ -11,7 +14,9 @@
 #include <filesystem>
 #include <sstream>
 
+#include "continuation/bench_report.hpp"
 #include "core/errors.hpp"
+#include "core/finite_difference.hpp"
 #include "core/scene.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/plugins.hpp"
@@ -33,13 +38,16 @@ int run_bench(const std::vector<std::string>& args) {
   keys.add_options()("problem", po::value<std::string>(), "only this problem's cases")(
       "case", po::value<std::string>(), "only this case (default: all)")(
       "out", po::value<std::string>()->default_value("results/bench"), "output directory")(
+      "threads", po::value<long>()->default_value(1), "finite-difference Jacobian threads")(
       "help", "describe the command");
   const po::variables_map vm = backbone::core::parse_options(keys, args);
   if (vm.count("help")) {
     std::ostringstream text;
     text << keys;
-    fmt::print("usage: backbone bench [--problem NAME] [--case NAME] [--out DIR]\n{}\ncases:\n",
-               text.str());
+    fmt::print(
+        "usage: backbone bench [--problem NAME] [--case NAME] [--out DIR] [--threads K]\n{}"
+        "\ncases:\n",
+        text.str());
     for (const auto& plugin : plugins().all())
       for (const auto& c : plugin.bench_cases)
         fmt::print("  {:<18} {} ({})\n", c.name, c.summary, plugin.name);
@@ -58,6 +66,9 @@ int run_bench(const std::vector<std::string>& args) {
   if (!selected.empty() && jobs.empty())
     throw core::InputError("case",
                            fmt::format("must be one of {} (got '{}')", case_names(), selected));
+  // InputError("threads") outside [1, max_jacobian_threads] (clamped first: no int overflow).
+  core::set_default_jacobian_threads(static_cast<int>(
+      std::clamp<long>(vm["threads"].as<long>(), 0, core::max_jacobian_threads + 1)));
   const std::filesystem::path out = vm["out"].as<std::string>();
   int status = core::exit_ok;
   for (const continuation::ProblemJob* job : jobs) {
@@ -66,6 +77,10 @@ int run_bench(const std::vector<std::string>& args) {
     fmt::print("bench {}: {:.1f} s\n\n", job->name,
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
+  std::vector<std::pair<std::string, std::string>> all_cases;
+  for (const auto& plugin : plugins().all())
+    for (const auto& c : plugin.bench_cases) all_cases.emplace_back(c.name, c.summary);
+  fmt::print("wrote {}\n", continuation::write_bench_report(out, all_cases).string());
   return status;
 }
 
@@ -73,5 +88,6 @@ int run_bench(const std::vector<std::string>& args) {
 }  // namespace backbone::drivers
 
 static const bool registered = backbone::drivers::register_command(
-    {"bench", "[--problem NAME] [--case NAME] [--out DIR]",
-     "benchmarks with known answers (CSV + PNG in results/bench)", backbone::drivers::run_bench});
+    {"bench", "[--problem NAME] [--case NAME] [--out DIR] [--threads K]",
+     "benchmarks with known answers (CSV, PNG and BENCHMARKS.md in results/bench)",
+     backbone::drivers::run_bench});

@@ -25,6 +25,7 @@
 #include "core/table.hpp"
 #include "problems/contact_bar/attached_content.hpp"
 #include "problems/contact_bar/bench.hpp"
+#include "problems/contact_bar/bench_peers.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/figures.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
@@ -323,6 +324,7 @@ void register_plugin(continuation::PluginRegistry& registry) {
              {"end_amplitude", "m"},
              {"knot", "m"}};
   p.bench_cases = bench_cases();
+  for (continuation::ProblemJob& job : peer_bench_cases()) p.bench_cases.push_back(std::move(job));
   p.figures = figure_jobs();
   const std::string scenes = "problems/contact_bar/scenes/";
   p.reproduce = {

@@ -8,6 +8,7 @@
 #include <memory>
 #include <numbers>
 
+#include "problems/duffing/bench.hpp"
 #include "problems/duffing/duffing.hpp"
 
 namespace backbone::duffing {
@@ -37,10 +38,13 @@ void register_plugin(continuation::PluginRegistry& registry) {
   p.scene_keys = &scene_keys;
   p.branches = {"backbone"};
   p.setup = &setup_trace;
+  p.bench_cases = bench_cases();
   p.reproduce = {
       {"duffing",
        "trace",
-       {"problems/duffing/scenes/duffing.ini", "--branch", "backbone", "--out", "{out}/duffing"}}};
+       {"problems/duffing/scenes/duffing.ini", "--branch", "backbone", "--out", "{out}/duffing"}},
+      // Into the contact bar's bench folder: BENCHMARKS.md there gathers every case's section.
+      {"bench_duffing", "bench", {"--problem", "duffing", "--out", "{out}/bench"}}};
   registry.add(std::move(p));
 }
 

@@ -1,7 +1,8 @@
 // The generic ODE shooting wrapper (core/ode_orbit.hpp) against exact oracles: the harmonic
 // oscillator (T = 2 pi at every amplitude, closed-form flow and Jacobian), a linear two-mass
 // chain (normal modes with periods 2 pi and 2 pi / sqrt(3), closed-form Jacobian off the orbit)
-// and a coupled nonlinear system (Jacobian against finite differences).
+// and a coupled nonlinear system (Jacobian against finite differences); the Jacobian kept from
+// the last shot and the re-used CVODE memory against fresh computations.
 //
 // Tolerances: CVODE runs at rtol 1e-13 with absolute tolerances 1e-3 below it; over the few
 // radians integrated here the global error stays below ~1e-12 of the orbit's scale, so values
@@ -13,6 +14,7 @@
 #include <iostream>
 #include <numbers>
 
+#include "core/cvode_integrator.hpp"
 #include "core/errors.hpp"
 #include "core/jacobian_check.hpp"
 #include "core/newton.hpp"
@@ -286,6 +288,64 @@ TEST(OdeOrbit, DefaultAccelerationJacobianIsColumnMajor) {
   Matrix exact(2, 2);
   exact << 0.0, 2 * q[1], q[1] + 3.0, q[0];
   EXPECT_LE((J - exact).cwiseAbs().maxCoeff(), 1e-9) << J;
+}
+
+// The Jacobian kept from the last shot (ode_orbit.hpp) is the one a fresh shot computes, bit for
+// bit, and only at that point and formulation: a stale one (wrong x, or the other formulation)
+// differs in O(1) entries off the orbit, so every EXPECT_EQ here can fail.
+TEST(OdeOrbit, KeptJacobianIsTheFreshOneAtThatPointOnly) {
+  const Vector x1 = vec({0.9, -0.4, 5.3}), x2 = vec({0.5, 0.1, 4.0});
+  const auto fresh_jacobian = [](const Vector& x, ShootingFormulation f) {
+    CoupledQuartic problem(true);
+    problem.set_formulation(f);
+    Matrix J;
+    EXPECT_EQ(problem.jacobian(x, J), EvalStatus::ok);
+    return J;
+  };
+  CoupledQuartic problem(true);
+  Vector r;
+  Matrix J;
+  ASSERT_EQ(problem.residual(x1, r), EvalStatus::ok);
+  ASSERT_EQ(problem.jacobian(x1, J), EvalStatus::ok);
+  EXPECT_EQ(J, fresh_jacobian(x1, ShootingFormulation::half_period_velocity));
+  ASSERT_EQ(problem.residual(x2, r), EvalStatus::ok);
+  ASSERT_EQ(problem.jacobian(x1, J), EvalStatus::ok);  // not the kept one (x2)
+  EXPECT_EQ(J, fresh_jacobian(x1, ShootingFormulation::half_period_velocity));
+  problem.set_formulation(ShootingFormulation::displacement_periodicity);
+  ASSERT_EQ(problem.jacobian(x1, J), EvalStatus::ok);  // same x, other formulation
+  EXPECT_EQ(J, fresh_jacobian(x1, ShootingFormulation::displacement_periodicity));
+  EXPECT_GE(
+      (J - fresh_jacobian(x1, ShootingFormulation::half_period_velocity)).cwiseAbs().maxCoeff(),
+      1e-2);  // the two formulations' Jacobians differ: the check above can fail
+}
+
+// integrate_ode re-initialises one CVODE memory per thread: a call after calls of other sizes
+// and tolerances repeats the first one bit for bit, and matches the harmonic closed form.
+TEST(CvodeIntegrator, ReusedMemoryRepeatsTheFirstIntegrationExactly) {
+  const OdeRightHandSide harmonic = [](double, const double* y, double* dy) {
+    dy[0] = y[1];
+    dy[1] = -y[0];
+  };
+  const OdeRightHandSide decay = [](double, const double* y, double* dy) {
+    for (int i = 0; i < 3; ++i) dy[i] = -y[i];
+  };
+  CvodeOptions options;
+  options.relative_tolerance = 1e-12;
+  const auto run = [&](const OdeRightHandSide& f, Vector y, double t, const CvodeOptions& o) {
+    const IntegrationResult result = integrate_ode(f, y, t, o);
+    EXPECT_TRUE(result.ok) << result.message;
+    return y;
+  };
+  const Vector first = run(harmonic, vec({1.0, 0.0}), 2.0, options);
+  CvodeOptions loose;
+  loose.relative_tolerance = 1e-6;
+  run(decay, vec({1.0, 2.0, 3.0}), 5.0, loose);  // another size: the memory is rebuilt
+  run(harmonic, vec({0.3, 0.1}), 7.0, loose);    // same size, other start and tolerance
+  const Vector again = run(harmonic, vec({1.0, 0.0}), 2.0, options);
+  EXPECT_EQ(again, first);
+  // Global error at rtol 1e-12 over 2 radians: ~1e-11 (see the header note: 1e-10).
+  EXPECT_NEAR(first[0], std::cos(2.0), close);
+  EXPECT_NEAR(first[1], -std::sin(2.0), close);
 }
 
 TEST(OdeOrbit, BadOptionsAreInputErrors) {
