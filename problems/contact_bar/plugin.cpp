@@ -28,6 +28,7 @@
 #include "problems/contact_bar/bench.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/figures.hpp"
+#include "problems/contact_bar/grazing_limits.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/simulate.hpp"
@@ -346,9 +347,25 @@ continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::
   };
   const bool dimension_check = scene.flag("dimension_check");
   const double rank_threshold = scene.positive("rank_threshold");
-  s.write_extra_outputs = [p, mode2, dimension_check, rank_threshold](
+  s.write_extra_outputs = [p, mode2, dimension_check, rank_threshold, continuum, energy](
                               const std::filesystem::path& out, const continuation::Branch& b) {
     write_subharmonic_outputs(*p, mode2, b, out, dimension_check ? rank_threshold : std::nan(""));
+    if (!continuum) return;
+    // limits.csv: both grazing limits at this energy, located by NLopt (grazing_limits.hpp)
+    // on the continuum's grid and time step.
+    GrazingLimitOptions o;
+    o.elements = p->options().elements;
+    o.steps_per_period = p->options().steps_per_period;
+    const GrazingLimits g = grazing_limits(p->setup_template(), p->solver(), energy, o);
+    grazing_limit_table(g).write_csv(out / "limits.csv");
+    for (const GrazingLimit& l : g.limits)
+      fmt::print(
+          "grazing limit {} (NLopt): {} contact phase(s), {} grazing instant(s), vanishing phase "
+          "{:.2e} s, residual {:.1e}, exact return {:.1e}, {} ({:.2f} s)\n",
+          l.name, l.structure.contact_phases, l.structure.grazing_instants, l.phase_duration,
+          l.residual, l.return_error, l.message, l.seconds);
+    fmt::print("grazing limits: shape_1 simulated by T2 = {:.9g} s vs shape_0: {:.2e} relative\n",
+               g.half_period, g.shift_distance);
   };
   problem->set_path_rows(scene.flag("path_rows"));
   s.problem = std::move(problem);
