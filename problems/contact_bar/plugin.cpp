@@ -214,7 +214,8 @@ std::shared_ptr<const bar::BarSolver> shooting_solver(const core::Scene& scene) 
 //  - ds = ds_max = 1/40 of the closed-form path length in the scaled step norm, so every
 //    energy has about 40 members (the path grows like sqrt(E) / g0 in that norm), unless the
 //    scene gives ds or ds_max;
-//  - a window on the shape from shape_end = 1e-6 L / ((1 - 3b) L) to 1: the shape-0 limit has
+//  - a window on the shape from shape_end = 1e-6 L / ((1 - 3b) L) to 1 (to 1 - shape_end when
+//    the branch goes up from a first member below 1/2): the shape-0 limit has
 //    its second kink at x = L, where the two-knot chart degenerates (the forward-difference
 //    step of the last knot, 1.5e-8 L, crosses L once L - k2 is smaller), so the branch lands
 //    on the member with L - k2 = 1e-6 L, whose contact phase at t = 0 lasts 2e-6 L / c, and
@@ -232,7 +233,7 @@ std::function<void(continuation::ContinuationOptions&)> continuum_options(
   // it leaves no landing ahead of it).
   const core::Vector scale =
       problem.typical_scale().cwiseAbs().cwiseQuotient(problem.step_weights());
-  const double last = toward < 0 ? 2 * shape_end : 1.0;
+  const double last = toward < 0 ? 2 * shape_end : 1 - 2 * shape_end;
   double length = 0;
   core::Vector previous = problem.subharmonic_guess(energy, shape).cwiseQuotient(scale);
   const int samples = 200;
@@ -249,7 +250,9 @@ std::function<void(continuation::ContinuationOptions&)> continuum_options(
     const double step = length / 40;
     if (!ds_given) options.ds = ds_max_given ? std::min(step, options.ds_max) : step;
     if (!ds_max_given) options.ds_max = std::max(step, options.ds);
-    options.bounds.push_back({"shape", shape_end, 1.0});
+    // Upwards (a first member below 1/2) the curve ends at the limit shape 1 itself, which no
+    // step crosses: the window closes just before it, and limits.csv has the limit.
+    options.bounds.push_back({"shape", shape_end, toward < 0 ? 1.0 : 1 - shape_end});
   };
 }
 
