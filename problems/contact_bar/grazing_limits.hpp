@@ -13,7 +13,9 @@
 //     two-knot chart, so the one-knot chart (start_on_wall, one free knot), started from the
 //     member at shape start_distance sampled on it (its second kink cut off: not a solution).
 // A limit that fails (no tolerance reached, or an exact return above 1e-6) is retried twice
-// from start_distance / 4, / 16.
+// from start_distance / 4, / 16. Shape 1 gets a second pass from the first one's result with a
+// 100x smaller difference step in a box of 1e-3 (the kink is located to the gradients'
+// resolution). Each pass ends with a least-squares Newton polish onto all rows.
 // The two are one orbit shifted by T2 = T / 2: shift_distance simulates the shape-1 limit by
 // T2 with the exact oracle and compares with the shape-0 limit's u0 (relative to max |u0|).
 //
