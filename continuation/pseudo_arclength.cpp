@@ -73,6 +73,7 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
     return steps.end(
         StopReason::evaluation_failed,
         fmt::format("the Jacobian could not be evaluated at point 0 ({})", steps.describe(x)));
+  if (options.start_along_direction) tangent = hint;
   std::optional<BranchPointDetector> detector;
   if (options.branch_points.detect) {
     detector.emplace(problem, options, hooks, corrector);

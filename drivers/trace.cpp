@@ -128,6 +128,10 @@ int run_trace(const std::vector<std::string>& args_in) {
   cont::TraceSetup setup = entry.setup(scene, branch_name);
   if (!setup.problem) throw core::InputError("problem", "setup returned no problem");
   const core::Problem& problem = *setup.problem;
+  if (setup.branch_options) {
+    setup.branch_options(options);
+    options.validate();
+  }
   auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get());
   if (periodic) periodic->set_formulation(run.formulation);
   core::Vector direction = setup.direction;

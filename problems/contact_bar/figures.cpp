@@ -11,9 +11,11 @@
 #include "core/scene.hpp"
 #include "core/table.hpp"
 #include "problems/contact_bar/family.hpp"
+#include "problems/contact_bar/grazing_limits.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
+#include "problems/exact_bar/exact_solution.hpp"
 
 namespace backbone::contact_bar {
 
@@ -183,7 +185,7 @@ int draw_backbones(const fs::path& out, const FigureInputs& inputs) {
   std::string plot = fmt::format(
       "set title 'Backbones of the contact bar (g_0 = {} m, c = {} m/s, L = {} m)'\n"
       "set xlabel 'frequency {{/Symbol w}} [rad/s]'\nset ylabel 'energy E [J]'\n"
-      "set logscale y\nset format y '10^{{%L}}'\nset grid\nset key outside right\n"
+      "set logscale y\nset format y '10^{{%L}}'\nset grid\nset key below maxrows 4\n"
       "set xrange [{}:{}]\n"
       "set arrow from {},graph 0 to {},graph 1 nohead lc rgb 'gray40' dt 2\n"
       "set arrow from {},graph 0 to {},graph 1 nohead lc rgb 'gray40' dt 2\n"
@@ -210,8 +212,36 @@ int draw_backbones(const fs::path& out, const FigureInputs& inputs) {
         ", {} using 'frequency':'energy' with points pt 5 ps 0.6 lc rgb "
         "'dark-green' title 'mode 2, TD-BEM shooting'",
         core::gnuplot_quote(mode2 / "branch.csv"));
+  // The subharmonic backbone (mode 2 over two periods, omega2 / 2): a band where its verified
+  // dimension is 2 (at each of its points a continuum of shapes), points where it is not.
+  const fs::path sub = out / "subharmonic";
+  if (has_branch(sub)) {
+    const Table b = Table::read_csv(sub / "branch.csv");
+    const auto w = b.column("frequency"), e = b.column("energy"), d = b.column("dimension");
+    Table band({"frequency", "energy", "frequency_2d", "frequency_other", "closed_form"});
+    int two = 0;
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      const bool is_2d = i < d.size() && d[i] == 2;
+      two += is_2d ? 1 : 0;
+      band.add_row({w[i], e[i], is_2d ? w[i] : std::nan(""), is_2d ? std::nan("") : w[i],
+                    0.5 * family2.frequency(e[i])});
+    }
+    band.write_csv(out / "backbone_subharmonic.csv");
+    plot += fmt::format(
+        ", {} using 'frequency_2d':'energy' with lines lw 14 lc rgb '#A0FF8C00' title "
+        "'subharmonic {{/Symbol w}}_2/2: 2D manifold ({} of {} points dimension 2)', {} using "
+        "'frequency':'energy' with points pt 9 ps 0.6 lc rgb 'dark-orange' title 'subharmonic, "
+        "TD-BEM shooting', {} using 'closed_form':'energy' with lines lw 1 lc rgb 'black' dt 2 "
+        "title 'subharmonic, closed form {{/Symbol w}}_2(E)/2', {} using "
+        "'frequency_other':'energy' with points pt 6 ps 1.2 lc rgb "
+        "'black' title 'subharmonic, dimension not 2'",
+        core::gnuplot_quote(out / "backbone_subharmonic.csv"), two, w.size(),
+        core::gnuplot_quote(out / "backbone_subharmonic.csv"),
+        core::gnuplot_quote(out / "backbone_subharmonic.csv"),
+        core::gnuplot_quote(out / "backbone_subharmonic.csv"));
+  }
   const fs::path png = out / "backbones.png";
-  report(core::render_png(png, plot + "\n", {1200, 700}), png);
+  report(core::render_png(png, plot + "\n", {1200, 850}), png);
   return 0;
 }
 
@@ -301,6 +331,111 @@ int write_closed_form_summary(const fs::path& out) {
   return 0;
 }
 
+// Paper Fig. 8: the contacting-end displacement u(L, t) over T = 2 T2 of the traced members of
+// OUT/subharmonic_continuum (exact solver; coloured by their shape), with the two grazing
+// limits located by NLopt (grazing_limits.hpp) drawn thick.
+int draw_subharmonic_continuum(const fs::path& out, const FigureInputs& inputs) {
+  const fs::path dir = out / "subharmonic_continuum";
+  if (!has_branch(dir) || !fs::exists(dir / "orbits.csv")) {
+    fmt::print("[figures] subharmonic_continuum skipped: no branch in {}\n", dir.string());
+    return 0;
+  }
+  const FigureScene scene = read_figure_scene(inputs);
+  bar::BarSetup s = scene.setup;
+  const double length = s.material.length, g0 = s.right.gap;
+  const Table branch = Table::read_csv(dir / "branch.csv");
+  const auto points = branch.column("point");
+  const auto shapes = branch.column("shape");
+  const int samples = 800;
+  std::string members = "t,u_L,shape\n";
+  double energy = 0, period = 0;
+  int drawn = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const auto orbit = load_traced_orbit_point(dir, static_cast<int>(points[i]), 0, length);
+    if (!orbit) continue;
+    s.u0 = orbit->u0;
+    s.v0 = bar::PiecewiseLinear::zero(length);
+    const exact_bar::ExactBarSolution sol(s, orbit->period);
+    if (!sol.ok()) continue;
+    for (int k = 0; k <= samples; ++k) {
+      const double t = orbit->period * k / samples;
+      members += fmt::format("{:.9g},{:.9g},{:.6g}\n", t, sol.u_end(exact_bar::Side::right, t),
+                             i < shapes.size() ? shapes[i] : 0.0);
+    }
+    members += "\n";
+    energy = orbit->energy, period = orbit->period;
+    ++drawn;
+  }
+  if (drawn == 0) {
+    fmt::print("[figures] subharmonic_continuum skipped: no orbit in {}\n", dir.string());
+    return 0;
+  }
+  core::write_text_atomically(out / "subharmonic_continuum_members.csv", members);
+  // The limits, by NLopt at the members' energy.
+  const GrazingLimits g = grazing_limits(s, TdbemSolver(ContactMethod::event), energy, {});
+  Table limits({"t", "u_L_shape_1", "u_L_shape_0"});
+  std::vector<exact_bar::ExactBarSolution> limit_solutions;
+  for (const GrazingLimit& l : g.limits) {
+    s.u0 = l.u0;
+    limit_solutions.emplace_back(s, l.period);
+  }
+  for (int k = 0; k <= samples; ++k) {
+    std::vector<double> row{period * k / samples};
+    for (std::size_t j = 0; j < g.limits.size(); ++j) {
+      const double t = std::min(g.limits[j].period * k / samples, limit_solutions[j].t_end());
+      row.push_back(limit_solutions[j].ok() ? limit_solutions[j].u_end(exact_bar::Side::right, t)
+                                            : std::nan(""));
+    }
+    limits.add_row(row);
+  }
+  limits.write_csv(out / "subharmonic_continuum_limits.csv");
+  const std::string plot = fmt::format(
+      "set title 'Subharmonic continuum at E = {:.3g} J: {} traced members, T = 2 T_2 = {:.6g} "
+      "s (exact re-simulation)'\n"
+      "set xlabel 't [s]'\nset ylabel 'contacting-end displacement u(L,t) [m]'\nset grid\n"
+      "set key below horizontal\nset palette defined (0 'dark-orange', 0.5 'gray60', 1 "
+      "'dark-cyan')\nset cblabel 'shape (first contact phase / total contact time)'\n"
+      "set cbrange [0:1]\nset xrange [0:{}]\nset yrange [*:{}]\n"
+      "plot {} using 't':'u_L':'shape' with lines lw 1 lc palette title 'members', "
+      "{} using 't':'u_L_shape_1' with lines lw 4 lc rgb 'blue' title 'grazing limit, shape 1 "
+      "(NLopt)', {} using 't':'u_L_shape_0' with lines lw 4 dt 2 lc rgb 'red' title 'grazing "
+      "limit, shape 0 (NLopt)', {} with lines lw 1.5 lc rgb 'black' dt 3 title 'wall u = g_0 = "
+      "{:g} m'\n",
+      energy, drawn, period, period, 1.25 * g0,
+      core::gnuplot_quote(out / "subharmonic_continuum_members.csv"),
+      core::gnuplot_quote(out / "subharmonic_continuum_limits.csv"),
+      core::gnuplot_quote(out / "subharmonic_continuum_limits.csv"), g0, g0);
+  const fs::path png = out / "subharmonic_continuum.png";
+  report(core::render_png(png, plot, {1300, 700}), png);
+  return 0;
+}
+
+// Paper Fig. 9: u(x, t) over T = 2 T2 of the grazing limit shape 1 (the first member of
+// OUT/subharmonic_continuum), TD-BEM.
+int draw_subharmonic_spacetime(const fs::path& out, const FigureInputs& inputs) {
+  const fs::path dir = out / "subharmonic_continuum";
+  const FigureScene scene = read_figure_scene(inputs);
+  const auto orbit = load_traced_orbit_point(dir, 0, 0, scene.setup.material.length);
+  if (!orbit) {
+    fmt::print("[figures] subharmonic_spacetime skipped: no orbit in {}\n", dir.string());
+    return 0;
+  }
+  const SpaceTime st = space_time(scene.setup, *orbit, scene.dt, scene.elements);
+  core::write_text_atomically(out / "subharmonic_spacetime.csv", st.text);
+  const std::string plot = fmt::format(
+      "set title 'Grazing subharmonic orbit (limit shape 1) over T = 2 T_2 (TD-BEM): E = {:.3g} "
+      "J, T = {:.6g} s, wall at g_0 = {:g} m'\n"
+      "set xlabel 'x [m]'\nset ylabel 't [s]'\nset zlabel 'u [m]' rotate parallel\n"
+      "set pm3d depthorder\nset palette rgbformulae 33,13,10\nset view 55,35\n"
+      "set key top left\nset ticslevel 0\n"
+      "splot {} using 'x':'t':'u' with pm3d title 'u(x,t)'\n",
+      orbit->energy, orbit->period, scene.setup.right.gap,
+      core::gnuplot_quote(out / "subharmonic_spacetime.csv"));
+  const fs::path png = out / "subharmonic_spacetime.png";
+  report(core::render_png(png, plot, {1100, 800}), png);
+  return 0;
+}
+
 std::vector<continuation::ProblemJob> figure_jobs(const FigureInputs& inputs) {
   return {
       {"backbones", "backbones.png: frequency-energy backbones of modes 1 and 2 (Fig. 4)",
@@ -309,6 +444,13 @@ std::vector<continuation::ProblemJob> figure_jobs(const FigureInputs& inputs) {
        [inputs](const fs::path& out) { return draw_mode1_contact(out, inputs); }},
       {"spacetime", "mode1/mode2_spacetime.png: u(x, t) over one period (Figs. 6, 7)",
        [inputs](const fs::path& out) { return draw_spacetime(out, inputs); }},
+      {"subharmonic_continuum",
+       "subharmonic_continuum.png: u(L, t) of the continuum's members and its NLopt grazing "
+       "limits (Fig. 8)",
+       [inputs](const fs::path& out) { return draw_subharmonic_continuum(out, inputs); }},
+      {"subharmonic_spacetime",
+       "subharmonic_spacetime.png: u(x, t) of a grazing subharmonic orbit over 2 T2 (Fig. 9)",
+       [inputs](const fs::path& out) { return draw_subharmonic_spacetime(out, inputs); }},
       {"closed_form_summary", "closed_form_summary.csv: acceptance numbers of every branch",
        write_closed_form_summary},
   };

@@ -9,6 +9,13 @@
 //                        force over one period of a mode-1 orbit (TD-BEM and the exact oracle)
 //   spacetime            mode1_spacetime.png, mode2_spacetime.png (Figs. 6, 7): u(x, t) over
 //                        one period (TD-BEM); mode 2 marks its node, where u0 changes sign
+//                        and, with OUT/subharmonic, the subharmonic backbone omega2 / 2 as a
+//                        band where its verified dimension is 2
+//   subharmonic_continuum  subharmonic_continuum.png (Fig. 8): u(L, t) over T = 2 T2 of the
+//                        members of OUT/subharmonic_continuum, coloured by shape, with the two
+//                        grazing limits located by NLopt (grazing_limits.hpp) drawn thick
+//   subharmonic_spacetime  subharmonic_spacetime.png (Fig. 9): u(x, t) over 2 T2 of the
+//                        grazing limit shape 1 (the continuum's first member, TD-BEM)
 //   closed_form_summary  closed_form_summary.csv: one row per traced contact-bar branch found
 //                        in OUT/*/: points, energy range, worst closed-form frequency error and
 //                        exact-oracle return errors, point seconds
@@ -37,13 +44,15 @@ struct FigureInputs {
   double energy = 0;
 };
 
-// The four jobs above; run(out) reads OUT/mode1 and OUT/mode2 and writes into OUT. backbones
+// The jobs above; run(out) reads OUT/mode1 and OUT/mode2 and writes into OUT. backbones
 // returns 1 when neither branch exists; the others skip (with a line) what is missing.
 std::vector<continuation::ProblemJob> figure_jobs(const FigureInputs& inputs = {});
 
 int draw_backbones(const std::filesystem::path& out, const FigureInputs& inputs);
 int draw_mode1_contact(const std::filesystem::path& out, const FigureInputs& inputs);
 int draw_spacetime(const std::filesystem::path& out, const FigureInputs& inputs);
+int draw_subharmonic_continuum(const std::filesystem::path& out, const FigureInputs& inputs);
+int draw_subharmonic_spacetime(const std::filesystem::path& out, const FigureInputs& inputs);
 int write_closed_form_summary(const std::filesystem::path& out);
 
 // One orbit of a traced branch: its period, energy and initial displacement (orbits.csv with

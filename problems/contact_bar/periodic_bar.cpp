@@ -232,11 +232,12 @@ Vector ContactBarOrbitProblem::typical_scale() const {
 
 Vector ContactBarOrbitProblem::step_weights() const {
   // Trapezoid rule on the reference grid: sum_i w_i^2 u0_i^2 = int_0^L u0^2 dx / L for a
-  // piecewise-linear u0 up to O(dx^2) (u0(0) = 0 has no unknown).
-  const int n = options_.elements;
+  // piecewise-linear u0 up to O(dx^2) (u0(0) = 0 has no unknown; with start_on_wall neither
+  // has u0(L) = g0, so every nodal unknown is interior and the knots follow them).
+  const int n = options_.elements, nodal = options_.nodal_unknowns();
   Vector w = Vector::Ones(num_unknowns());
-  w.head(n).setConstant(std::sqrt(1.0 / n));
-  w[n - 1] = std::sqrt(0.5 / n);
+  w.head(nodal).setConstant(std::sqrt(1.0 / n));
+  if (!options_.start_on_wall) w[n - 1] = std::sqrt(0.5 / n);
   return w;
 }
 

@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <functional>
 #include <memory>
 
 #include "core/errors.hpp"
@@ -28,6 +29,7 @@
 #include "problems/contact_bar/bench_peers.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/figures.hpp"
+#include "problems/contact_bar/grazing_limits.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/simulate.hpp"
@@ -208,6 +210,53 @@ std::shared_ptr<const bar::BarSolver> shooting_solver(const core::Scene& scene) 
   return std::make_shared<TdbemSolver>(contact_method_from_scene(scene));
 }
 
+// The continuum's own continuation settings (README.md, section 'Subharmonic continuum'):
+//  - the first step along the closed-form direction (start_along_direction);
+//  - ds = ds_max = 1/40 of the closed-form path length in the scaled step norm, so every
+//    energy has about 40 members (the path grows like sqrt(E) / g0 in that norm), unless the
+//    scene gives ds or ds_max;
+//  - a window on the shape from shape_end = 1e-6 L / ((1 - 3b) L) to 1 (to 1 - shape_end when
+//    the branch goes up from a first member below 1/2): the shape-0 limit has
+//    its second kink at x = L, where the two-knot chart degenerates (the forward-difference
+//    step of the last knot, 1.5e-8 L, crosses L once L - k2 is smaller), so the branch lands
+//    on the member with L - k2 = 1e-6 L, whose contact phase at t = 0 lasts 2e-6 L / c, and
+//    ends there with bound_reached (a complete branch; the limit itself: grazing_limits.hpp).
+std::function<void(continuation::ContinuationOptions&)> continuum_options(
+    const core::Scene& scene, const ContactBarOrbitProblem& problem, double energy, double shape,
+    double toward) {
+  const bar::Material& material = problem.setup_template().material;
+  const double g0 = problem.displacement_scale();
+  const double s = std::sqrt(2 * energy / (material.axial_stiffness() * material.length));
+  const double b = 0.25 * (1 + g0 / (s * material.length));
+  const double shape_end = 1e-6 / (1 - 3 * b);
+  // The closed-form path length from `shape` to the end, in the loop's scaled unknowns: 40
+  // steps to twice shape_end, so that no planned member falls on the bound itself (a member on
+  // it leaves no landing ahead of it).
+  const core::Vector scale =
+      problem.typical_scale().cwiseAbs().cwiseQuotient(problem.step_weights());
+  const double last = toward < 0 ? 2 * shape_end : 1 - 2 * shape_end;
+  double length = 0;
+  core::Vector previous = problem.subharmonic_guess(energy, shape).cwiseQuotient(scale);
+  const int samples = 200;
+  for (int i = 1; i <= samples; ++i) {
+    const core::Vector z = problem.subharmonic_guess(energy, shape + (last - shape) * i / samples)
+                               .cwiseQuotient(scale);
+    length += (z - previous).norm();
+    previous = z;
+  }
+  const bool ds_given = !scene.values()["ds"].defaulted();
+  const bool ds_max_given = !scene.values()["ds_max"].defaulted();
+  return [=](continuation::ContinuationOptions& options) {
+    options.start_along_direction = true;
+    const double step = length / 40;
+    if (!ds_given) options.ds = ds_max_given ? std::min(step, options.ds_max) : step;
+    if (!ds_max_given) options.ds_max = std::max(step, options.ds);
+    // Upwards (a first member below 1/2) the curve ends at the limit shape 1 itself, which no
+    // step crosses: the window closes just before it, and limits.csv has the limit.
+    options.bounds.push_back({"shape", shape_end, toward < 0 ? 1.0 : 1 - shape_end});
+  };
+}
+
 // The subharmonic branches (README.md, section 'Subharmonic continuum'): mode 2 taken over two
 // periods, T = 2 T2, started at rest at the centre of a contact phase (start_on_wall), two free
 // knots at its two kinks. The periodic orbits form a 2D manifold (energy x shape); a path on it
@@ -270,9 +319,13 @@ continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::
   continuation::TraceSetup s;
   s.guess = problem->subharmonic_guess(start_energy, shape);
   if (continuum) {
-    // Towards the other grazing limit: the shape decreases from 1.
-    const double next = shape > 0.5 ? shape - 0.01 : shape + 0.01;
-    s.direction = problem->subharmonic_guess(energy, next) - s.guess;
+    // Towards the other grazing limit: the shape decreases from 1 (increases from below 1/2).
+    // The closed-form direction of the family: the first step follows it, since the start at
+    // a grazing limit is a nonsmooth boundary point where the finite-difference tangent mixes
+    // the free and the contact side (measured: 8 to 83 degrees off the family).
+    const double toward = shape > 0.5 ? -1.0 : 1.0;
+    s.direction = problem->subharmonic_guess(energy, shape + toward * 1e-4) - s.guess;
+    s.branch_options = continuum_options(scene, *problem, energy, shape, toward);
   } else {
     s.direction = problem->subharmonic_guess(start_energy * 1.01, shape) - s.guess;
   }
@@ -298,9 +351,25 @@ continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::
   };
   const bool dimension_check = scene.flag("dimension_check");
   const double rank_threshold = scene.positive("rank_threshold");
-  s.write_extra_outputs = [p, mode2, dimension_check, rank_threshold](
+  s.write_extra_outputs = [p, mode2, dimension_check, rank_threshold, continuum, energy](
                               const std::filesystem::path& out, const continuation::Branch& b) {
     write_subharmonic_outputs(*p, mode2, b, out, dimension_check ? rank_threshold : std::nan(""));
+    if (!continuum) return;
+    // limits.csv: both grazing limits at this energy, located by NLopt (grazing_limits.hpp)
+    // on the continuum's grid and time step.
+    GrazingLimitOptions o;
+    o.elements = p->options().elements;
+    o.steps_per_period = p->options().steps_per_period;
+    const GrazingLimits g = grazing_limits(p->setup_template(), p->solver(), energy, o);
+    grazing_limit_table(g).write_csv(out / "limits.csv");
+    for (const GrazingLimit& l : g.limits)
+      fmt::print(
+          "grazing limit {} (NLopt): {} contact phase(s), {} grazing instant(s), vanishing phase "
+          "{:.2e} s, residual {:.1e}, exact return {:.1e}, {} ({:.2f} s)\n",
+          l.name, l.structure.contact_phases, l.structure.grazing_instants, l.phase_duration,
+          l.residual, l.return_error, l.message, l.seconds);
+    fmt::print("grazing limits: shape_1 simulated by T2 = {:.9g} s vs shape_0: {:.2e} relative\n",
+               g.half_period, g.shift_distance);
   };
   problem->set_path_rows(scene.flag("path_rows"));
   s.problem = std::move(problem);
@@ -339,8 +408,16 @@ void register_plugin(continuation::PluginRegistry& registry) {
       {"subharmonic",
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic", "--out", "{out}/subharmonic"}},
-      // subharmonic_continuum is not a step yet: with the grid-independent step norm and the
-      // turn check it stops after 18 of its members at 20 intervals (to be fixed).
+      // The continuum at two energies, from the grazing limit shape 1 to shape_end (about one
+      // second each; README.md, section 'Subharmonic continuum').
+      {"subharmonic_continuum",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1.25e-5", "--out",
+        "{out}/subharmonic_continuum"}},
+      {"subharmonic_continuum_1e-3",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1e-3", "--out",
+        "{out}/subharmonic_continuum_1e-3"}},
       // Other scenes, nothing but the bar changed: the closed forms must hold there too.
       {"mode1_short_bar",
        "trace",

@@ -37,9 +37,12 @@ ContactStructure contact_structure(const bar::BarSetup& setup, double period) {
     result.first_contact = phases.front().second;
   }
   result.contact_phases = static_cast<int>(phases.size());
+  // Closed during a phase; a closed interval shorter than tol is a grazing instant.
   auto closed_at = [&](double t) {
     for (const auto& c : intervals)
-      if (t >= c.t_close - tol && t <= std::min(c.t_release, period) + tol) return true;
+      if (std::min(c.t_release, period) - c.t_close > tol && t >= c.t_close - tol &&
+          t <= std::min(c.t_release, period) + tol)
+        return true;
     return false;
   };
   const int samples = 4000;

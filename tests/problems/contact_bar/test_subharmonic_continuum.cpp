@@ -1,0 +1,61 @@
+// `backbone trace ... --branch subharmonic_continuum` with the branch's own defaults
+// (problems/contact_bar/README.md, section 'Subharmonic continuum'): from the grazing limit
+// shape 1 to the bound near shape 0, exit code 0, members checked against the closed forms of
+// family.hpp (period 2 T2, energy) and the exact oracle (subharmonic_check.csv).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/table.hpp"
+#include "tests/drivers/cli_run.hpp"
+
+namespace {
+
+using backbone::core::Table;
+
+// Regression: with the grid-independent step norm and the turn check the branch stopped at
+// point 1 (the finite-difference tangent at the nonsmooth grazing limit was 43 degrees off the
+// family). Tolerances: energy and period are fixed by the energy row and the closed form to
+// round-off (measured spreads <= 1e-11), 1e-8 is the acceptance; the exact return is
+// round-off for exactly represented members (measured <= 5e-9 up to 1e-3 J), 1e-6 is
+// the branch's own return_tolerance.
+TEST(SubharmonicContinuumCli, TracesFromGrazingLimitToGrazingLimitWithItsDefaults) {
+  const std::string scene =
+      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
+  const auto out = cli::scratch("subharmonic_continuum", "e1.25e-5");
+  const cli::Run r =
+      cli::run("trace", scene + " --branch subharmonic_continuum --energy 1.25e-5", out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Table b = Table::read_csv(out / "branch.csv");
+  const Table c = Table::read_csv(out / "subharmonic_check.csv");
+  const auto energy = b.column("energy"), period = b.column("period");
+  const auto phases = b.column("contact_phases"), grazing = b.column("grazing_instants");
+  const auto shape = c.column("shape"), closed = c.column("period_closed_form");
+  const auto returns = c.column("return_error"), dimension = b.column("dimension");
+  ASSERT_GE(energy.size(), 20u) << "about 40 members by default";
+  EXPECT_NEAR(shape.front(), 1, 1e-12);
+  EXPECT_LT(shape.back(), 2e-5) << "ends at the bound shape_end = 1e-6 / (1 - 3b) = 1e-5";
+  EXPECT_EQ(phases.front(), 1);
+  EXPECT_EQ(grazing.front(), 1);
+  int two_dimensional = 0;
+  for (std::size_t i = 0; i < energy.size(); ++i) {
+    EXPECT_NEAR(energy[i] / 1.25e-5, 1, 1e-8) << i;
+    EXPECT_NEAR(period[i] / closed[i], 1, 1e-8) << i;
+    EXPECT_LT(returns[i], 1e-6) << i;
+    if (i > 0) {
+      EXPECT_EQ(phases[i], 2) << i;
+      EXPECT_EQ(grazing[i], 0) << i;
+    }
+    two_dimensional += dimension[i] == 2 ? 1 : 0;
+  }
+  // Interior members away from the shape-0 end, where the probe leaves the chart.
+  EXPECT_GE(two_dimensional, static_cast<int>(energy.size()) - 3);
+  const Table limits = Table::read_csv(out / "limits.csv");
+  ASSERT_EQ(limits.rows(), 2u);
+  for (double shift : limits.column("shift_distance")) EXPECT_LT(shift, 1e-5);
+  for (double p : limits.column("contact_phases")) EXPECT_EQ(p, 1);
+}
+
+}  // namespace
