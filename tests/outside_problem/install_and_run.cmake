@@ -1,5 +1,6 @@
 # ctest driver of the outside-project example (not part of the example itself):
 #   cmake -DBACKBONE_BINARY_DIR=<build> [-DCMAKE_CXX_COMPILER=...] [-DCMAKE_CXX_COMPILER_LAUNCHER=...]
+#         [-DCONSUMER_CXX_FLAGS=...]   (the backbone build's CMAKE_CXX_FLAGS, e.g. sanitizers)
 #         -P tests/outside_problem/install_and_run.cmake
 # 1. installs the build into <build>/outside_problem/prefix (cmake --install),
 # 2. configures this folder in a fresh <build>/outside_problem/build with CMAKE_PREFIX_PATH set
@@ -32,6 +33,9 @@ if(CMAKE_CXX_COMPILER)
 endif()
 if(CMAKE_CXX_COMPILER_LAUNCHER)
   list(APPEND configure_args -DCMAKE_CXX_COMPILER_LAUNCHER=${CMAKE_CXX_COMPILER_LAUNCHER})
+endif()
+if(CONSUMER_CXX_FLAGS)
+  list(APPEND configure_args "-DCMAKE_CXX_FLAGS=${CONSUMER_CXX_FLAGS}")
 endif()
 run_step("configure" ${CMAKE_COMMAND} ${configure_args})
 run_step("build" ${CMAKE_COMMAND} --build ${build} -j 2)
