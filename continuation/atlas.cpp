@@ -69,8 +69,13 @@ std::vector<Point2> clip(const std::vector<Point2>& polygon, const Point2& n, do
 class AtlasBuilder {
  public:
   AtlasBuilder(const core::Problem& problem, core::Corrector& corrector,
-               const AtlasOptions& options, const std::function<bool(const core::Vector&)>& inside)
-      : problem_(problem), corrector_(corrector), options_(options), inside_(inside) {
+               const AtlasOptions& options, const std::function<bool(const core::Vector&)>& inside,
+               const std::function<bool(const core::Vector&)>& accept)
+      : problem_(problem),
+        corrector_(corrector),
+        options_(options),
+        inside_(inside),
+        accept_(accept) {
     if (options.scale_unknowns)
       scaled_ = std::make_unique<ScaledProblem>(problem);
     else
@@ -166,67 +171,112 @@ class AtlasBuilder {
 
   bool inside(const Chart& c) const { return !inside_ || inside_(c.x); }
 
-  // Corrects from chart i along direction dir at distance h; accepted only when close to the
+  enum class Outcome { accepted, not_converged, too_far };
+
+  // Corrects from chart i along direction dir at distance h: accepted when close to the
   // prediction and not turned too much.
-  std::optional<Chart> attempt(int i, const Point2& dir, double h, double radius) {
+  Outcome attempt(int i, const Point2& dir, double h, double radius, std::optional<Chart>& out) {
     const Chart& from = atlas_.charts[static_cast<std::size_t>(i)];
-    std::optional<Chart> c = correct(from.z, from.tangent, h * dir, radius);
+    out = correct(from.z, from.tangent, h * dir, radius);
+    if (out && accept_ && !accept_(out->x)) {
+      ++atlas_.rejected;
+      out.reset();
+    }
+    if (!out) {
+      ++atlas_.failed_corrections;
+      return Outcome::not_converged;
+    }
     const double max_angle = options_.max_angle_degrees * std::numbers::pi / 180;
-    if (c &&
-        ((c->z - (from.z + from.tangent * (h * dir))).norm() <= options_.max_distance_ratio * h &&
-         plane_angle(c->tangent, from.tangent) <= max_angle))
-      return c;
+    if ((out->z - (from.z + from.tangent * (h * dir))).norm() <= options_.max_distance_ratio * h &&
+        plane_angle(out->tangent, from.tangent) <= max_angle)
+      return Outcome::accepted;
     ++atlas_.failed_corrections;
-    return std::nullopt;
+    out.reset();
+    return Outcome::too_far;
   }
 
-  // One new chart from chart i towards its open vertex; false when the direction was closed
-  // instead.
+  void close(int i, const Point2& dir) {
+    atlas_.charts[static_cast<std::size_t>(i)].closed.push_back(dir);
+  }
+
+  // One new chart from chart i towards its open vertex. A correction too far from its
+  // prediction (or turned too much) halves the chart's radius (Henderson's rule; its polygon
+  // and its neighbours' are rebuilt). One that does not converge or leaves the bounds marks the
+  // end of the manifold in that direction: the step is bisected to the last good point, a
+  // boundary chart when it is at least boundary_fraction * R away, else the direction closes.
+  // Returns true when a chart was added.
   bool expand(int i, const Point2& vertex) {
     const Point2 dir = vertex.normalized();
-    double h = atlas_.charts[static_cast<std::size_t>(i)].radius;
+    const double h = atlas_.charts[static_cast<std::size_t>(i)].radius;
+    const double radius = std::min(options_.radius, 2 * h);
     std::optional<Chart> c;
-    while (!(c = attempt(i, dir, h, h))) {
-      h /= 2;
-      if (h < options_.radius_min) {
+    const Outcome outcome = attempt(i, dir, h, radius, c);
+    if (outcome == Outcome::too_far) {
+      if (h / 2 < options_.radius_min) {
         ++atlas_.closed_by_failure;
-        atlas_.charts[static_cast<std::size_t>(i)].closed.push_back(dir);
-        return false;
+        close(i, dir);
+      } else {
+        shrink(i, h / 2);
+      }
+      return false;
+    }
+    if (outcome == Outcome::accepted && inside(*c)) {
+      add_chart(std::move(*c));
+      return true;
+    }
+    double h_in = 0, h_out = h;
+    std::optional<Chart> last_inside;
+    for (int k = 0; k < options_.bisection_steps; ++k) {
+      const double mid = (h_in + h_out) / 2;
+      std::optional<Chart> m;
+      if (attempt(i, dir, mid, radius, m) == Outcome::accepted && inside(*m)) {
+        h_in = mid;
+        last_inside = std::move(m);
+      } else {
+        h_out = mid;
       }
     }
-    if (!inside(*c)) {
-      // Bisect the step back to the bound: the last inside point, if far enough, is a chart.
-      double h_in = 0, h_out = h;
-      std::optional<Chart> last_inside;
-      for (int k = 0; k < options_.bisection_steps; ++k) {
-        const double mid = (h_in + h_out) / 2;
-        std::optional<Chart> m = attempt(i, dir, mid, h);
-        if (m && inside(*m)) {
-          h_in = mid;
-          last_inside = std::move(m);
-        } else {
-          h_out = mid;
-        }
-      }
-      if (!last_inside || h_in < options_.boundary_fraction * h) {
-        atlas_.charts[static_cast<std::size_t>(i)].closed.push_back(dir);
-        return false;
-      }
-      c = std::move(last_inside);
-      c->on_boundary = true;
+    if (!last_inside || h_in < options_.boundary_fraction * h) {
+      close(i, dir);
+      return false;
     }
-    add_chart(std::move(*c));
+    last_inside->on_boundary = true;
+    add_chart(std::move(*last_inside));
     return true;
+  }
+
+  // Chart i with a smaller radius: its polygon and those of its neighbours start again from
+  // their regular polygons, clipped by the neighbours that still overlap.
+  void shrink(int i, double radius) {
+    Chart& c = atlas_.charts[static_cast<std::size_t>(i)];
+    c.radius = radius;
+    rebuild(i);
+    for (int j : c.neighbours) rebuild(j);
+  }
+
+  void rebuild(int i) {
+    Chart& c = atlas_.charts[static_cast<std::size_t>(i)];
+    c.polygon = regular_polygon(c.radius);
+    for (int j : c.neighbours) {
+      const Chart& other = atlas_.charts[static_cast<std::size_t>(j)];
+      if ((other.z - c.z).norm() < other.radius + c.radius) cut(c, other);
+    }
+  }
+
+  std::vector<Point2> regular_polygon(double radius) const {
+    const int k = options_.polygon_vertices;
+    const double corner = radius / std::cos(std::numbers::pi / k);
+    std::vector<Point2> p;
+    for (int j = 0; j < k; ++j) {
+      const double angle = 2 * std::numbers::pi * j / k;
+      p.emplace_back(corner * std::cos(angle), corner * std::sin(angle));
+    }
+    return p;
   }
 
   // Polygon of a new chart, clipped with every chart whose disk overlaps (and they with it).
   void add_chart(Chart c) {
-    const int k = options_.polygon_vertices;
-    const double corner = c.radius / std::cos(std::numbers::pi / k);
-    for (int j = 0; j < k; ++j) {
-      const double angle = 2 * std::numbers::pi * j / k;
-      c.polygon.emplace_back(corner * std::cos(angle), corner * std::sin(angle));
-    }
+    c.polygon = regular_polygon(c.radius);
     const int index = static_cast<int>(atlas_.charts.size());
     for (int j = 0; j < index; ++j) {
       Chart& other = atlas_.charts[static_cast<std::size_t>(j)];
@@ -250,6 +300,7 @@ class AtlasBuilder {
   core::Corrector& corrector_;
   const AtlasOptions& options_;
   const std::function<bool(const core::Vector&)>& inside_;
+  const std::function<bool(const core::Vector&)>& accept_;
   std::unique_ptr<ScaledProblem> scaled_;
   Atlas atlas_;
 };
@@ -259,14 +310,15 @@ class AtlasBuilder {
 Atlas cover_manifold(const core::Problem& problem, const core::Vector& guess,
                      core::Corrector& corrector, const AtlasOptions& options,
                      const std::function<bool(const core::Vector& x)>& inside,
-                     const std::function<void(const Atlas& atlas, int chart)>& on_chart) {
+                     const std::function<void(const Atlas& atlas, int chart)>& on_chart,
+                     const std::function<bool(const core::Vector& x)>& accept) {
   options.validate();
   if (guess.size() != problem.num_unknowns())
     throw core::InputError("guess", fmt::format("must have {} entries (got {})",
                                                 problem.num_unknowns(), guess.size()));
   if (problem.num_unknowns() < 3)
     throw core::InputError("problem", "a 2D manifold needs at least 3 unknowns");
-  AtlasBuilder builder(problem, corrector, options, inside);
+  AtlasBuilder builder(problem, corrector, options, inside, accept);
   return builder.run(guess, on_chart);
 }
 

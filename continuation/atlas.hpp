@@ -72,17 +72,21 @@ struct Atlas {
   int corrections = 0;         // bordered solves, bisections included
   int failed_corrections = 0;  // not converged, too far or turned too much
   int closed_by_failure = 0;   // directions given up at radius_min
+  int rejected = 0;            // converged corrections refused by accept(x)
   double seconds = 0;
 };
 
 // inside(x): the problem's bounds (x in its own unknowns); an empty function means no bounds.
-// on_chart: called after each accepted chart (index). Throws InputError for bad options, a guess
+// on_chart: called after each accepted chart (index). accept(x): an independent check of a
+// converged correction (e.g. the contact bar's exact-oracle return); false counts as a failed
+// correction (Atlas::rejected). Throws InputError for bad options, a guess
 // of the wrong size or a problem whose solution set cannot be 2D (n - rank(J) < 2 at the guess is
 // not checked: the chart basis is the two smallest singular directions).
 Atlas cover_manifold(const core::Problem& problem, const core::Vector& guess,
                      core::Corrector& corrector, const AtlasOptions& options,
                      const std::function<bool(const core::Vector& x)>& inside = {},
-                     const std::function<void(const Atlas& atlas, int chart)>& on_chart = {});
+                     const std::function<void(const Atlas& atlas, int chart)>& on_chart = {},
+                     const std::function<bool(const core::Vector& x)>& accept = {});
 
 // Orthonormal basis (n x 2) of the two right singular vectors of J with the smallest singular
 // values: the tangent plane of a 2D solution manifold.
