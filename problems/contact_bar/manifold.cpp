@@ -21,7 +21,7 @@ namespace po = boost::program_options;
 po::options_description manifold_keys() {
   po::options_description keys("subharmonic_manifold (an atlas of the 2D manifold)");
   keys.add_options()  //
-      ("chart_radius", po::value<double>()->default_value(0.1),
+      ("chart_radius", po::value<double>()->default_value(0.3),
        "subharmonic_manifold: chart radius in the scaled unknowns (continuation/README.md, "
        "section 'Covering a 2D manifold')")  //
       ("shape_margin", po::value<double>()->default_value(1e-3),
