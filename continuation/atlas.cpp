@@ -113,6 +113,7 @@ class AtlasBuilder {
         continue;
       }
       if (static_cast<int>(atlas_.charts.size()) >= options_.max_charts) {
+        find_adjacent();
         atlas_.message = fmt::format("max_charts ({}) reached", options_.max_charts);
         atlas_.seconds = elapsed();
         return atlas_;
@@ -120,6 +121,7 @@ class AtlasBuilder {
       if (expand(static_cast<int>(i), *vertex) && on_chart)
         on_chart(atlas_, static_cast<int>(atlas_.charts.size()) - 1);
     }
+    find_adjacent();
     atlas_.complete = true;
     atlas_.message = fmt::format("complete: {} charts, no open vertex", atlas_.charts.size());
     atlas_.seconds = elapsed();
@@ -287,6 +289,23 @@ class AtlasBuilder {
       other.neighbours.push_back(index);
     }
     atlas_.charts.push_back(std::move(c));
+  }
+
+  // A neighbour is adjacent when two vertices of the polygon lie on its half-plane's line.
+  void find_adjacent() {
+    for (Chart& a : atlas_.charts) {
+      a.adjacent.clear();
+      for (int j : a.neighbours) {
+        const Chart& b = atlas_.charts[static_cast<std::size_t>(j)];
+        const Point2 s = a.tangent.transpose() * (b.z - a.z);
+        const double c = (a.radius * a.radius - b.radius * b.radius + s.squaredNorm()) / 2;
+        const double tolerance = 1e-9 * std::max(s.norm() * a.radius, 1e-300);
+        const auto on_line =
+            std::count_if(a.polygon.begin(), a.polygon.end(),
+                          [&](const Point2& v) { return std::abs(s.dot(v) - c) <= tolerance; });
+        if (on_line >= 2) a.adjacent.push_back(j);
+      }
+    }
   }
 
   // Henderson's half-plane of neighbour b in a's tangent coordinates.

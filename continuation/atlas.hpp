@@ -54,8 +54,11 @@ struct Chart {
   core::Vector z;        // centre, the scaled unknowns the atlas works in
   core::Matrix tangent;  // n x 2, orthonormal (scaled)
   double radius = 0;
-  bool on_boundary = false;  // centred on a bisected bound
-  std::vector<int> neighbours;
+  bool on_boundary = false;     // centred on a bisected bound
+  std::vector<int> neighbours;  // charts whose disks overlap this one's (mutual)
+  // Neighbours whose half-plane bounds an edge of this chart's final polygon: the cells that
+  // touch (a Delaunay-like subset of neighbours, what a figure draws).
+  std::vector<int> adjacent;
   core::Observables observables;
   double residual = 0;  // ||F||_inf of the problem at x
   int newton_iterations = 0;

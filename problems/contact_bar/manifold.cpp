@@ -103,16 +103,20 @@ ManifoldRun cover_subharmonic_manifold(const ContactBarOrbitProblem& problem,
 }
 
 core::Table manifold_table(const ManifoldRun& run) {
-  core::Table t({"point", "chart", "energy", "period", "shape", "neighbours", "radius",
+  core::Table t({"point", "chart", "energy", "period", "shape", "neighbours", "adjacent", "radius",
                  "on_boundary", "residual", "return_error", "period_error"});
   for (std::size_t i = 0; i < run.atlas.charts.size(); ++i) {
     const continuation::Chart& c = run.atlas.charts[i];
-    std::string neighbours;
-    for (int j : c.neighbours) neighbours += (neighbours.empty() ? "" : ";") + std::to_string(j);
+    auto joined = [](const std::vector<int>& indices) {
+      std::string text;
+      for (int j : indices) text += (text.empty() ? "" : ";") + std::to_string(j);
+      return text;
+    };
+    const std::string neighbours = joined(c.neighbours), adjacent = joined(c.adjacent);
     const double e = observable(c.observables, "energy");
     const double period = observable(c.observables, "period");
     t.add_cells({static_cast<double>(i), static_cast<double>(i), e, period,
-                 observable(c.observables, "shape"), neighbours, c.radius,
+                 observable(c.observables, "shape"), neighbours, adjacent, c.radius,
                  c.on_boundary ? 1.0 : 0.0, c.residual, run.return_errors[i],
                  run.period_errors[i]});
   }
@@ -131,7 +135,7 @@ void write_manifold_figure(const std::filesystem::path& out, const ManifoldRun& 
   for (std::size_t i = 0; i < cs.size(); ++i) {
     (cs[i].on_boundary ? rim : charts) +=
         fmt::format("{:.9g} {:.9g}\n", shape(cs[i]), energy(cs[i]));
-    for (int j : cs[i].neighbours) {
+    for (int j : cs[i].adjacent) {
       if (j < static_cast<int>(i)) continue;
       const auto& b = cs[static_cast<std::size_t>(j)];
       edges += fmt::format("{:.9g} {:.9g}\n{:.9g} {:.9g}\n\n", shape(cs[i]), energy(cs[i]),
@@ -144,15 +148,16 @@ void write_manifold_figure(const std::filesystem::path& out, const ManifoldRun& 
           "set datafile separator whitespace\nset key noautotitle\nset logscale y\nset format y "
           "'10^{{%L}}'\nset xlabel 'shape (first contact phase / "
           "total contact time)'\nset ylabel 'energy [J]'\nset xrange [-0.02:1.02]\n"
-          "set yrange [{:g}:{:g}]\nset key outside top center horizontal\n"
-          "set title 'subharmonic manifold near {{/Symbol w}}_2/2: {} charts{}'\n"
+          "set yrange [{:g}:{:g}]\nset key below horizontal maxcols 3 samplen 2\nset bmargin 6\n"
+          "set title 'subharmonic orbits near {{/Symbol w}}_2/2: atlas of {} charts{} (period 2 "
+          "T_2 "
+          "at every point)'\n"
           "set arrow from 0,graph 0 to 0,graph 1 nohead dt 2 lc rgb 'gray40'\n"
           "set arrow from 1,graph 0 to 1,graph 1 nohead dt 2 lc rgb 'gray40'\n"
-          "plot $edges using 1:2 with lines lc rgb '#b8c8e0' lw 0.8 title 'neighbours (overlapping "
-          "disks)', "
+          "plot $edges using 1:2 with lines lc rgb '#8fa8cc' lw 1 title 'adjacent charts', "
           "$charts using 1:2 with points pt 7 ps 0.6 lc rgb '#1f4e9a' title 'chart centres', "
-          "$rim using 1:2 with points pt 7 ps 0.7 lc rgb '#c0392b' title 'charts placed by "
-          "bisection (bounds, refused corrections)'\n",
+          "$rim using 1:2 with points pt 7 ps 0.7 lc rgb '#c0392b' title 'bisected (bounds, "
+          "refused corrections)'\n",
           energy_min / 1.15, energy_max * 1.15, cs.size(),
           run.atlas.complete ? "" : " (incomplete)");
   const core::PlotResult r = core::render_png(out / "manifold.png", script, {1100, 800});

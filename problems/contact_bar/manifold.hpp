@@ -53,10 +53,11 @@ ManifoldRun cover_subharmonic_manifold(const ContactBarOrbitProblem& problem,
                                        const core::Vector& seed,
                                        const continuation::AtlasOptions& options, double energy_min,
                                        double energy_max, double shape_margin,
-                                       const core::NewtonOptions& newton);
+                                       const core::NewtonOptions& newton, double return_tolerance);
 
 // manifold.csv: point, chart, energy, period, shape, neighbours (chart indices joined by ';'),
-// radius, on_boundary, residual, return_error, period_error.
+// adjacent (the neighbours whose polygons share an edge: what the figure draws), radius,
+// on_boundary, residual, return_error, period_error.
 core::Table manifold_table(const ManifoldRun& run);
 
 // Turns the continuum's trace setup into the manifold's: one traced point (the seed), then the

@@ -69,6 +69,11 @@ TEST(Atlas, CoversABandOfTheSphereWithoutHoles) {
       const auto& back = atlas.charts[static_cast<std::size_t>(j)].neighbours;
       EXPECT_NE(std::find(back.begin(), back.end(), static_cast<int>(i)), back.end());
     }
+    // Adjacent charts (polygons sharing an edge) are neighbours; an interior cell of a closed
+    // polygon tiling has at least three.
+    for (int j : c.adjacent)
+      EXPECT_NE(std::find(c.neighbours.begin(), c.neighbours.end(), j), c.neighbours.end());
+    if (!c.on_boundary) EXPECT_GE(c.adjacent.size(), 3u) << "chart " << i;
     boundary += c.on_boundary;
   }
   // No holes: every point of the band is within R of a centre (a chart's disk covers it). The
