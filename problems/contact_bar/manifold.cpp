@@ -109,7 +109,10 @@ core::Table manifold_table(const ManifoldRun& run) {
     const continuation::Chart& c = run.atlas.charts[i];
     auto joined = [](const std::vector<int>& indices) {
       std::string text;
-      for (int j : indices) text += (text.empty() ? "" : ";") + std::to_string(j);
+      for (int j : indices) {
+        if (!text.empty()) text += ';';
+        text += std::to_string(j);
+      }
       return text;
     };
     const std::string neighbours = joined(c.neighbours), adjacent = joined(c.adjacent);

@@ -73,7 +73,9 @@ TEST(Atlas, CoversABandOfTheSphereWithoutHoles) {
     // polygon tiling has at least three.
     for (int j : c.adjacent)
       EXPECT_NE(std::find(c.neighbours.begin(), c.neighbours.end(), j), c.neighbours.end());
-    if (!c.on_boundary) EXPECT_GE(c.adjacent.size(), 3u) << "chart " << i;
+    if (!c.on_boundary) {
+      EXPECT_GE(c.adjacent.size(), 3u) << "chart " << i;
+    }
     boundary += c.on_boundary;
   }
   // No holes: every point of the band is within R of a centre (a chart's disk covers it). The
