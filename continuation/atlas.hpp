@@ -54,7 +54,8 @@ struct Chart {
   core::Vector z;        // centre, the scaled unknowns the atlas works in
   core::Matrix tangent;  // n x 2, orthonormal (scaled)
   double radius = 0;
-  bool on_boundary = false;     // centred on a bisected bound
+  // Placed by bisection: at a bound, or where corrections stop converging or are refused.
+  bool on_boundary = false;
   std::vector<int> neighbours;  // charts whose disks overlap this one's (mutual)
   // Neighbours whose half-plane bounds an edge of this chart's final polygon: the cells that
   // touch (a Delaunay-like subset of neighbours, what a figure draws).

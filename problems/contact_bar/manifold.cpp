@@ -197,7 +197,8 @@ void add_manifold_outputs(const core::Scene& scene, continuation::TraceSetup& se
     manifold_table(run).write_csv(out / "manifold.csv");
     write_manifold_figure(out, run, e1, e2);
     fmt::print(
-        "manifold: {} charts ({} on the bounds), energy {:.3e} .. {:.3e} J, {} corrections ({} "
+        "manifold: {} charts ({} placed by bisection), energy {:.3e} .. {:.3e} J, {} corrections "
+        "({} "
         "failed, {} rejected by the exact return, {} directions closed by failure), {:.1f} s; "
         "worst exact return {:.1e}, worst "
         "period vs 2 T2 {:.1e}; largest gap {:.2f} chart radii (2000 closed-form members); {}\n",
