@@ -30,6 +30,7 @@
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/figures.hpp"
 #include "problems/contact_bar/grazing_limits.hpp"
+#include "problems/contact_bar/manifold.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/simulate.hpp"
@@ -112,6 +113,7 @@ po::options_description trace_keys() {
        "roots of the projected residual");
   keys.add(shooting);
   keys.add(subharmonic_keys());
+  keys.add(manifold_keys());
   return keys;
 }
 
@@ -267,14 +269,17 @@ continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::
   if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
     throw core::InputError("right_end",
                            "the subharmonic branches need right_end = contact and gap > 0");
-  const bool continuum = branch == "subharmonic_continuum";
+  // The manifold's seed is a member of the continuum at sqrt(energy_min energy_max) (manifold.hpp).
+  const bool manifold = branch == "subharmonic_manifold";
+  const bool continuum = branch == "subharmonic_continuum" || manifold;
   const bar::Material& material = setup.material;
   const double g0 = setup.right.gap;
   const ContactFamily mode2(material, g0, 2);
   double energy = scene.non_negative("energy");
   if (energy == 0) energy = 0.5 * material.axial_stiffness() * 25 * g0 * g0 / material.length;
+  if (manifold) energy = manifold_seed_energy(scene);
   const double shape_key = scene.number("shape");
-  const double shape = shape_key >= 0 ? shape_key : (continuum ? 1.0 : 0.3);
+  const double shape = shape_key >= 0 ? shape_key : (continuum && !manifold ? 1.0 : 0.3);
   if (!(shape > 0 && shape <= 1))
     throw core::InputError("shape", fmt::format("must be in (0, 1] (got {})", shape));
   // The backbone starts near the mode-2 grazing energy (end amplitude (1 + start_offset) g0).
@@ -372,6 +377,7 @@ continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::
                g.half_period, g.shift_distance);
   };
   problem->set_path_rows(scene.flag("path_rows"));
+  if (manifold) add_manifold_outputs(scene, s, *problem);
   s.problem = std::move(problem);
   return s;
 }
@@ -383,7 +389,7 @@ void register_plugin(continuation::PluginRegistry& registry) {
   p.name = "contact_bar";
   p.summary = "elastic bar fixed at x = 0, rigid wall at gap g0 beyond x = L (Signorini contact)";
   p.scene_keys = &trace_keys;
-  p.branches = {"mode1", "mode2", "subharmonic", "subharmonic_continuum"};
+  p.branches = {"mode1", "mode2", "subharmonic", "subharmonic_continuum", "subharmonic_manifold"};
   p.setup = &setup_trace;
   p.simulate_keys = &simulate_keys;
   p.simulate = &simulate_scene;
