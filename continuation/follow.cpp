@@ -99,6 +99,9 @@ std::vector<FollowedBranch> follow_branch_points(
   std::vector<FollowedBranch> followed;
   ContinuationOptions o = options;
   o.max_points = run.max_points;
+  // The verified rank report (one probe per candidate direction, up to 19 at the contact bar's
+  // T = 3.6 point at 100 intervals) cost 30-50 s per followed point there: every 10th point.
+  if (o.rank_check_every > 0) o.rank_check_every = std::max(o.rank_check_every, 10);
   const auto* periodic = dynamic_cast<const core::PeriodicOrbitProblem*>(&problem);
   for (std::size_t i = 0; i < branch.branch_points.size(); ++i) {
     const int k = static_cast<int>(i) + 1;
