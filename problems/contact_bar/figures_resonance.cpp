@@ -6,11 +6,82 @@
 #include <string>
 
 #include "core/plot.hpp"
+#include "core/scene.hpp"
 #include "core/table.hpp"
+#include "problems/contact_bar/figures.hpp"
+#include "problems/contact_bar/scene.hpp"
+#include "problems/exact_bar/exact_bar_solver.hpp"
 
 namespace backbone::contact_bar {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<fs::path> followed_branches(const fs::path& mode1) {
+  std::vector<fs::path> attached;
+  if (!fs::exists(mode1)) return attached;
+  for (const auto& entry : fs::directory_iterator(mode1))
+    if (entry.path().filename().string().rfind("branch_point_", 0) == 0 &&
+        fs::exists(entry.path() / "branch.csv"))
+      attached.push_back(entry.path());
+  std::sort(attached.begin(), attached.end());
+  return attached;
+}
+
+}  // namespace
+
+int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
+  const std::vector<fs::path> attached = followed_branches(out / "mode1");
+  if (attached.empty()) {
+    fmt::print("[figures] resonant_end skipped: no followed branch in {} (trace --follow)\n",
+               (out / "mode1").string());
+    return 0;
+  }
+  const core::Scene scene = core::read_scene(scene_keys(), scene_path.string(), {},
+                                             boost::program_options::options_description());
+  bar::BarSetup s = setup_from_scene(scene);
+  const double L = s.material.length, c = s.material.wave_speed(), g0 = s.right.gap;
+  std::string plot =
+      "set grid\nset xlabel 't / T'\nset ylabel 'u(L,t) [m]'\nset key outside right\n";
+  std::string curves;
+  for (const fs::path& dir : attached) {
+    // The highest-energy orbit of the followed branch, and mode 1 at its period: the closed form
+    // u0 = eps x with T = (3 L + g0 / |eps|) / c (README.md, 'Mode 1').
+    const auto orbit = load_traced_orbit(dir, 1e300, L);
+    if (!orbit) continue;
+    const double eps = -g0 / (c * orbit->period - 3 * L);
+    bar::SimulationOptions o;
+    o.t_end = orbit->period;
+    o.dt = orbit->period / 4000;
+    o.history_samples = 4001;
+    o.energy = false;
+    const std::string k = dir.filename().string().substr(13);  // "branch_point_K" -> K
+    for (const bool resonant : {true, false}) {
+      s.u0 = resonant ? orbit->u0 : bar::PiecewiseLinear({0.0, L}, {0.0, eps * L});
+      s.v0 = bar::PiecewiseLinear::zero(L);
+      const fs::path csv =
+          out / fmt::format("resonant_end_{}_{}.csv", k, resonant ? "attached" : "mode1");
+      exact_bar::ExactBarSolver().simulate(s, o).to_table().write_csv(csv);
+      curves += fmt::format(
+          "{}{} using (column('t')/{}):'u_contact' with lines lw {} title '{}'",
+          curves.empty() ? "plot " : ", ", core::gnuplot_quote(csv), orbit->period,
+          resonant ? 1.5 : 3,
+          resonant ? fmt::format("attached at branch point {} (E = {:.3g} J)", k, orbit->energy)
+                   : fmt::format("mode 1 at T = {:.6g} s", orbit->period));
+    }
+  }
+  if (curves.empty()) return 0;
+  plot += "set title 'Contacting-end displacement over one period, exact oracle (Fig. 11)'\n" +
+          curves + "\n";
+  const fs::path png = out / "resonant_end.png";
+  const core::PlotResult r = core::render_png(png, plot, {1200, 700});
+  if (r.ok)
+    fmt::print("[figures] wrote {}\n", png.string());
+  else
+    fmt::print(stderr, "[figures] {}\n", r.message);
+  return 0;
+}
 
 int draw_attached_branches(const fs::path& out) {
   const fs::path mode1 = out / "mode1";
@@ -18,12 +89,7 @@ int draw_attached_branches(const fs::path& out) {
     fmt::print("[figures] attached_branches skipped: no {}\n", (mode1 / "branch.csv").string());
     return 0;
   }
-  std::vector<fs::path> attached;
-  for (const auto& entry : fs::directory_iterator(mode1))
-    if (entry.path().filename().string().rfind("branch_point_", 0) == 0 &&
-        fs::exists(entry.path() / "branch.csv"))
-      attached.push_back(entry.path());
-  std::sort(attached.begin(), attached.end());
+  const std::vector<fs::path> attached = followed_branches(mode1);
   if (attached.empty()) {
     fmt::print("[figures] attached_branches skipped: no followed branch in {} (trace --follow)\n",
                mode1.string());
@@ -61,7 +127,13 @@ int draw_attached_branches(const fs::path& out) {
 std::vector<continuation::ProblemJob> resonance_figure_jobs() {
   return {{"attached_branches",
            "attached_branches.png: mode 1 with its followed attached branches (Fig. 4 d)",
-           draw_attached_branches}};
+           draw_attached_branches},
+          {"resonant_end",
+           "resonant_end.png: contacting end of an attached orbit beside mode 1 at its period "
+           "(Fig. 11)",
+           [](const fs::path& out) {
+             return draw_resonant_end(out, "problems/contact_bar/scenes/paper.ini");
+           }}};
 }
 
 }  // namespace backbone::contact_bar

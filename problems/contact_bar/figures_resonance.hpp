@@ -4,8 +4,11 @@
 //   attached_branches  attached_branches.png (paper Fig. 4, label d): frequency-energy plot of
 //                      mode 1 with every followed attached branch (vertical: they leave at
 //                      constant frequency) and the branch points of branch_points.csv
-// Not drawn yet: the space-time surface of an internally resonant orbit (Fig. 10) and its
-// contacting-end displacement beside mode 1's (Fig. 11).
+//   resonant_end       resonant_end.png (Fig. 11): the contacting-end displacement over one
+//                      period of the highest-energy orbit of each followed branch beside mode 1's
+//                      closed-form orbit at the same period, both by the exact oracle (CSV
+//                      beside it); the scene is the paper's
+// Not drawn yet: the space-time surface of an internally resonant orbit (Fig. 10).
 //
 //   for (const continuation::ProblemJob& job : contact_bar::resonance_figure_jobs())
 //     status = std::max(status, job.run("results"));  // after trace --out results/mode1 --follow
@@ -23,5 +26,6 @@ std::vector<continuation::ProblemJob> resonance_figure_jobs();
 
 // 0 when drawn or skipped with a line (no OUT/mode1, or no followed branch in it).
 int draw_attached_branches(const std::filesystem::path& out);
+int draw_resonant_end(const std::filesystem::path& out, const std::filesystem::path& scene);
 
 }  // namespace backbone::contact_bar
