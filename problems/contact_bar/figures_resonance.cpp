@@ -83,6 +83,59 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
   return 0;
 }
 
+int draw_resonant_spacetime(const fs::path& out, const fs::path& scene_path) {
+  const std::vector<fs::path> attached = followed_branches(out / "mode1");
+  if (attached.empty()) {
+    fmt::print("[figures] resonant_spacetime skipped: no followed branch in {} (trace --follow)\n",
+               (out / "mode1").string());
+    return 0;
+  }
+  const core::Scene scene = core::read_scene(scene_keys(), scene_path.string(), {},
+                                             boost::program_options::options_description());
+  bar::BarSetup s = setup_from_scene(scene);
+  // The highest-energy orbit of the first followed branch: u(x, t) at 121 instants of one
+  // period on 200 intervals, exact oracle.
+  const auto orbit = load_traced_orbit(attached.front(), 1e300, s.material.length);
+  if (!orbit) return 0;
+  s.u0 = orbit->u0;
+  s.v0 = bar::PiecewiseLinear::zero(s.material.length);
+  bar::SnapshotRequest request;
+  request.elements = 200;
+  std::string text = "t,x,u\n";
+  const exact_bar::ExactBarSolver oracle;
+  for (int k = 0; k <= 120; ++k) {
+    const double t = orbit->period * k / 120;
+    const bar::FieldSnapshot f = oracle.snapshot(s, t, request);
+    if (!f.ok) {
+      fmt::print(stderr, "[figures] resonant_spacetime: exact oracle failed at t = {}: {}\n", t,
+                 f.message);
+      return 1;
+    }
+    for (std::size_t i = 0; i < f.x.size(); ++i)
+      text += fmt::format("{:.9g},{:.9g},{:.9g}\n", t, f.x[i], f.u[i]);
+    text += "\n";  // gnuplot grid block separator
+  }
+  const fs::path csv = out / "resonant_spacetime.csv";
+  core::write_text_atomically(csv, text);
+  const std::string plot = fmt::format(
+      "set title 'Internally resonant orbit (branch point {}) over one period (exact oracle): E = "
+      "{:.3g} J, "
+      "T = {:.6g} s'\n"
+      "set xlabel 'x [m]'\nset ylabel 't [s]'\nset zlabel 'u [m]' rotate parallel\n"
+      "set pm3d depthorder\nset palette rgbformulae 33,13,10\nset view 55,35\n"
+      "set key top left\nset ticslevel 0\n"
+      "splot {} using 'x':'t':'u' with pm3d title 'u(x,t)'\n",
+      attached.front().filename().string().substr(13), orbit->energy, orbit->period,
+      core::gnuplot_quote(csv));
+  const fs::path png = out / "resonant_spacetime.png";
+  const core::PlotResult r = core::render_png(png, plot, {1100, 800});
+  if (r.ok)
+    fmt::print("[figures] wrote {}\n", png.string());
+  else
+    fmt::print(stderr, "[figures] {}\n", r.message);
+  return 0;
+}
+
 int draw_attached_branches(const fs::path& out) {
   const fs::path mode1 = out / "mode1";
   if (!fs::exists(mode1 / "branch.csv")) {
@@ -128,6 +181,11 @@ std::vector<continuation::ProblemJob> resonance_figure_jobs() {
   return {{"attached_branches",
            "attached_branches.png: mode 1 with its followed attached branches (Fig. 4 d)",
            draw_attached_branches},
+          {"resonant_spacetime",
+           "resonant_spacetime.png: u(x, t) over one period of an attached orbit (Fig. 10)",
+           [](const fs::path& out) {
+             return draw_resonant_spacetime(out, "problems/contact_bar/scenes/paper.ini");
+           }},
           {"resonant_end",
            "resonant_end.png: contacting end of an attached orbit beside mode 1 at its period "
            "(Fig. 11)",

@@ -8,7 +8,8 @@
 //                      period of the highest-energy orbit of each followed branch beside mode 1's
 //                      closed-form orbit at the same period, both by the exact oracle (CSV
 //                      beside it); the scene is the paper's
-// Not drawn yet: the space-time surface of an internally resonant orbit (Fig. 10).
+//   resonant_spacetime resonant_spacetime.png (Fig. 10): u(x, t) over one period of the
+//                      highest-energy orbit of the first followed branch (exact oracle)
 //
 //   for (const continuation::ProblemJob& job : contact_bar::resonance_figure_jobs())
 //     status = std::max(status, job.run("results"));  // after trace --out results/mode1 --follow
@@ -26,6 +27,7 @@ std::vector<continuation::ProblemJob> resonance_figure_jobs();
 
 // 0 when drawn or skipped with a line (no OUT/mode1, or no followed branch in it).
 int draw_attached_branches(const std::filesystem::path& out);
+int draw_resonant_spacetime(const std::filesystem::path& out, const std::filesystem::path& scene);
 int draw_resonant_end(const std::filesystem::path& out, const std::filesystem::path& scene);
 
 }  // namespace backbone::contact_bar
