@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -80,7 +81,8 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
 // exact oracle within return_tolerance = 1e-6 (trace's per-point check; closed_form_check.csv
 // re-measures it on another grid: measured 4.9e-9 worst).
 TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
-  const fs::path out = cli::scratch("branch_points_cli", "follow");
+  const fs::path root = cli::scratch("branch_points_cli", "follow"), out = root / "mode1";
+  fs::create_directories(root);
   const cli::Run r = cli::run("trace", detecting + " --follow all --follow_max_points 30", out);
   ASSERT_EQ(r.code, 0) << r.err;
   const Table t = Table::read_csv(out / "branch_points.csv");
@@ -102,5 +104,28 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   const auto verified = t.column("verified");
   for (std::size_t i = 0; i < verified.size(); ++i)
     if (verified[i] == 0) EXPECT_FALSE(fs::exists(out / ("branch_point_" + std::to_string(i + 1))));
-  fs::remove_all(out);
+
+  // The figures of the followed branch (figures_resonance.hpp). Fig. 11's mode-1 orbit at the
+  // attached orbit's period is the closed form: u(L, 0) = eps L = -5e-3 (T = 3.2 to 1e-9, so
+  // 1e-8 relative) and contact at u(L) = g0 = 1e-3 (the exact oracle: round-off). The attached
+  // orbit is mode 1 plus low-magnitude content: differs by more than 1e-6 and less than g0
+  // (measured 1.0e-4 at E = 2.08e-5).
+  // From the source folder: the figure jobs read the paper scene by its repository path.
+  const std::string figures = "cd '" + std::string(BACKBONE_SOURCE_DIR) + "' && '" +
+                              std::string(BACKBONE_BINARY_DIR) + "/bin/backbone' figures --out '" +
+                              root.string() + "' > /dev/null 2>&1";
+  ASSERT_EQ(std::system(figures.c_str()), 0);
+  const std::string k = std::to_string(row + 1);
+  const Table mode1 = Table::read_csv(root / ("resonant_end_" + k + "_mode1.csv"));
+  const Table resonant = Table::read_csv(root / ("resonant_end_" + k + "_attached.csv"));
+  const auto u1 = mode1.column("u_contact"), ur = resonant.column("u_contact");
+  ASSERT_EQ(u1.size(), ur.size());
+  EXPECT_NEAR(u1.front() / -5e-3, 1.0, 1e-8);
+  EXPECT_NEAR(*std::max_element(u1.begin(), u1.end()), 1e-3, 1e-12);
+  double content = 0;
+  for (std::size_t i = 0; i < u1.size(); ++i) content = std::max(content, std::abs(ur[i] - u1[i]));
+  EXPECT_GT(content, 1e-6);
+  EXPECT_LT(content, 1e-3);
+  EXPECT_TRUE(fs::exists(root / "resonant_spacetime.csv"));
+  fs::remove_all(root);
 }
