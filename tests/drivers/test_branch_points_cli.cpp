@@ -39,6 +39,14 @@ int verified_row_near(const Table& t, double period) {
   return best;
 }
 
+TEST(BranchPointsCli, BadFollowExitsTwoAndWritesNothing) {
+  for (const char* bad : {"0", "-2", "some", "1.5"})
+    cli::expect_bad_input("trace", paper + " --branch mode1 --follow " + bad, "follow",
+                          "branch_points_cli");
+  cli::expect_bad_input("trace", paper + " --branch mode1 --follow all --follow_max_points 0",
+                        "follow_max_points", "branch_points_cli");
+}
+
 // The exact branch point: mode 1 of the paper scene (E = rho = L = A = 1, g0 = 1e-3) has
 // u0 = eps x and T = 3 + g0 / |eps| (problems/contact_bar/README.md, 'Mode 1'); at T = 3.2,
 // |eps| = 5e-3, E = eps^2 / 2 = 1.25e-5 and end amplitude 5e-3. Location: 1e-6 relative, the
