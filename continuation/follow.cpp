@@ -111,7 +111,10 @@ std::vector<FollowedBranch> follow_branch_points(
     const std::filesystem::path dir = out / fmt::format("branch_point_{}", k);
     std::filesystem::remove_all(dir);
     FollowedBranch f;
-    {
+    if (!report.verified()) {  // only its summary.txt, no empty branch files
+      std::filesystem::create_directories(dir);
+      f = follow_attached(problem, report, run.observable, corrector, o, hooks);
+    } else {
       BranchWriter writer(dir, periodic);
       ContinuationHooks h = hooks;
       h.on_point = [&](const BranchPoint& p) { writer.append(p); };

@@ -82,7 +82,8 @@ FollowedBranch follow_attached(const core::Problem& problem, const BranchPointRe
 // branch.branch_points followed by follow_attached with max_points = max_points and the rank
 // report at every 10th point at most (plus the first and last), each into
 // out/branch_point_K/ (BranchWriter files, branch.png, then extra(dir, followed branch) when
-// set). periodic: the problem when it is a periodic-orbit problem (orbits.csv), else nullptr.
+// set; an unverified K-th gets only summary.txt saying why). periodic: the problem when it is a
+// periodic-orbit problem (orbits.csv), else nullptr.
 struct FollowRun {
   FollowSelection selection;
   int max_points = 30;

@@ -80,6 +80,20 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   fs::remove_all(out);
 }
 
+// --follow K names a row of branch_points.csv; an unverified row is not followed: its folder
+// holds only summary.txt, which says so (row 1 at 40 intervals: the unverified dip at T = 3.33).
+TEST(BranchPointsCli, UnverifiedRowIsNotFollowed) {
+  const fs::path out = cli::scratch("branch_points_cli", "unverified");
+  ASSERT_EQ(cli::run("trace", detecting + " --follow 1", out).code, 0);
+  const Table t = Table::read_csv(out / "branch_points.csv");
+  ASSERT_GE(t.rows(), 1u);
+  ASSERT_EQ(t.column("verified")[0], 0);
+  EXPECT_TRUE(fs::exists(out / "branch_point_1" / "summary.txt"));
+  EXPECT_FALSE(fs::exists(out / "branch_point_1" / "branch.csv"));
+  EXPECT_FALSE(fs::exists(out / "branch_point_2"));  // --follow 1 follows row 1 only
+  fs::remove_all(out);
+}
+
 }  // namespace
 
 // --follow all: the family attached at T = 3.2 is traced into branch_point_K/ (K: its row). It
@@ -111,7 +125,9 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   // Unverified rows are not followed.
   const auto verified = t.column("verified");
   for (std::size_t i = 0; i < verified.size(); ++i)
-    if (verified[i] == 0) EXPECT_FALSE(fs::exists(out / ("branch_point_" + std::to_string(i + 1))));
+    if (verified[i] == 0) {
+      EXPECT_FALSE(fs::exists(out / ("branch_point_" + std::to_string(i + 1))));
+    }
 
   // The figures of the followed branch (figures_resonance.hpp). Fig. 11's mode-1 orbit at the
   // attached orbit's period is the closed form: u(L, 0) = eps L = -5e-3 (T = 3.2 to 1e-9, so
