@@ -49,35 +49,38 @@ FollowSelection parse_follow(const std::string& text) {
 
 std::optional<AttachedStart> attached_start(const core::Problem& problem,
                                             const BranchPointReport& report,
-                                            const std::string& observable) {
-  if (report.x.size() == 0) return std::nullopt;
+                                            const std::string& observable, int rank) {
+  if (report.x.size() == 0 || rank < 0) return std::nullopt;
   const ScaledProblem scaled(problem);
   const core::Vector zx = scaled.to_scaled(report.x);
   const double fx = observable_of(problem.observables(report.x), observable);
-  std::optional<AttachedStart> best;
+  std::vector<AttachedStart> starts;
   for (std::size_t i = 0; i < report.attached_points.size(); ++i) {
     const core::Vector& y = report.attached_points[i];
     const double distance = (scaled.to_scaled(y) - zx).norm();
     const double change = observable_of(problem.observables(y), observable) - fx;
     if (!(distance > 0) || !std::isfinite(change)) continue;
-    const double growth = std::abs(change) / distance;
-    if (best && growth <= best->growth) continue;
     const double sign = change < 0 ? -1.0 : 1.0;
-    best = AttachedStart{report.x + sign * (y - report.x), sign * (y - report.x),
-                         static_cast<int>(i), growth};
+    starts.push_back({report.x + sign * (y - report.x), sign * (y - report.x), static_cast<int>(i),
+                      std::abs(change) / distance});
   }
-  return best;
+  std::stable_sort(
+      starts.begin(), starts.end(),
+      [](const AttachedStart& a, const AttachedStart& b) { return a.growth > b.growth; });
+  if (rank >= static_cast<int>(starts.size())) return std::nullopt;
+  return starts[static_cast<std::size_t>(rank)];
 }
 
 FollowedBranch follow_attached(const core::Problem& problem, const BranchPointReport& report,
                                const std::string& observable, core::Corrector& corrector,
-                               const ContinuationOptions& options, const ContinuationHooks& hooks) {
+                               const ContinuationOptions& options, const ContinuationHooks& hooks,
+                               int start_rank) {
   FollowedBranch f;
   if (!report.verified()) {
     f.message = "not verified (no attached direction found by the probes): not followed";
     return f;
   }
-  f.start = attached_start(problem, report, observable);
+  f.start = attached_start(problem, report, observable, start_rank);
   if (!f.start) {
     f.message = fmt::format("no probed point with a finite {}: not followed", observable);
     return f;
@@ -115,12 +118,19 @@ std::vector<FollowedBranch> follow_branch_points(
       std::filesystem::create_directories(dir);
       f = follow_attached(problem, report, run.observable, corrector, o, hooks);
     } else {
-      BranchWriter writer(dir, periodic);
-      ContinuationHooks h = hooks;
-      h.on_point = [&](const BranchPoint& p) { writer.append(p); };
-      h.on_branch_point = nullptr;
-      h.on_attempt = nullptr;
-      f = follow_attached(problem, report, run.observable, corrector, o, h);
+      // A start whose branch ends early is retried from the next fastest probe (the files are
+      // rewritten: they hold the last attempt).
+      for (int attempt = 0; attempt < std::max(1, run.start_attempts); ++attempt) {
+        if (attempt > 0 && !attached_start(problem, report, run.observable, attempt)) break;
+        BranchWriter writer(dir, periodic);
+        ContinuationHooks h = hooks;
+        h.on_point = [&](const BranchPoint& p) { writer.append(p); };
+        h.on_branch_point = nullptr;
+        h.on_attempt = nullptr;
+        f = follow_attached(problem, report, run.observable, corrector, o, h, attempt);
+        f.attempts = attempt + 1;
+        if (!f.branch.ended_early() || (h.cancel_requested && h.cancel_requested())) break;
+      }
     }
     f.branch_point = k;
     if (!f.branch.points.empty()) {
@@ -131,9 +141,10 @@ std::vector<FollowedBranch> follow_branch_points(
     }
     core::write_text_atomically(
         dir / "summary.txt",
-        fmt::format("branch_point {}\npoints {}\nstart_probe {}\nstop_reason {}\nmessage {}\n", k,
-                    f.branch.points.size(), f.start ? f.start->probe : -1,
-                    f.branch.points.empty() ? "-" : to_string(f.branch.reason), f.message));
+        fmt::format(
+            "branch_point {}\npoints {}\nstart_probe {}\nattempts {}\nstop_reason {}\nmessage {}\n",
+            k, f.branch.points.size(), f.start ? f.start->probe : -1, f.attempts,
+            f.branch.points.empty() ? "-" : to_string(f.branch.reason), f.message));
     followed.push_back(std::move(f));
   }
   return followed;

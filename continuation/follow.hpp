@@ -57,17 +57,19 @@ struct AttachedStart {
   int probe = -1;     // index in BranchPointReport::attached_points
   double growth = 0;  // |f(y) - f(x)| / |y - x| (scaled distance) of that probe
 };
-// Distances in the loop's scaled unknowns (scaled_problem.hpp). Empty when the report has no
-// probed point, or the observable is NaN at all of them.
+// Distances in the loop's scaled unknowns (scaled_problem.hpp). rank 0: the probe along which
+// the observable changes fastest, 1 the next one, ... Empty when the report has no such probe
+// (none probed, or the observable NaN at them).
 std::optional<AttachedStart> attached_start(const core::Problem& problem,
                                             const BranchPointReport& report,
-                                            const std::string& observable);
+                                            const std::string& observable, int rank = 0);
 
 struct FollowedBranch {
   int branch_point = 0;  // K, 1-based (row of branch_points.csv)
   std::optional<AttachedStart> start;
   Branch branch;        // empty points when it could not start
   std::string message;  // why it did not start, else the branch's own message
+  int attempts = 1;     // starts tried (follow_branch_points retries a branch that ended early)
 };
 
 // Pseudo-arclength (detection off) from attached_start(report) with `options` (bounds, step
@@ -76,18 +78,21 @@ struct FollowedBranch {
 FollowedBranch follow_attached(const core::Problem& problem, const BranchPointReport& report,
                                const std::string& observable, core::Corrector& corrector,
                                const ContinuationOptions& options,
-                               const ContinuationHooks& hooks = {});
+                               const ContinuationHooks& hooks = {}, int start_rank = 0);
 
 // What `backbone trace --follow` does after the traced branch: every selected point of
 // branch.branch_points followed by follow_attached with max_points = max_points and the rank
 // report at every 10th point at most (plus the first and last), each into
 // out/branch_point_K/ (BranchWriter files, branch.png, then extra(dir, followed branch) when
-// set; an unverified K-th gets only summary.txt saying why). periodic: the problem when it is a
+// set; an unverified K-th gets only summary.txt saying why). A followed branch that ends early
+// (e.g. at the step floor) is retried from the next fastest probe, at most start_attempts starts
+// in all; the files hold the last attempt. periodic: the problem when it is a
 // periodic-orbit problem (orbits.csv), else nullptr.
 struct FollowRun {
   FollowSelection selection;
   int max_points = 30;
   std::string observable = "energy";
+  int start_attempts = 3;
 };
 std::vector<FollowedBranch> follow_branch_points(
     const core::Problem& problem, const Branch& branch, const FollowRun& run,

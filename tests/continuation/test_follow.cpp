@@ -126,6 +126,13 @@ TEST(Follow, TwoDimensionalAttachedFamilyStaysInThePlane) {
   ASSERT_GE(f.branch.points.size(), 5u) << f.message;
   EXPECT_EQ(f.branch.reason, continuation::StopReason::bound_reached) << f.message;
   for (const auto& p : f.branch.points) EXPECT_LE(std::abs(p.x[2] - 1), 1e-7);
+  // The starts by rank: the first changes x fastest, a third does not exist (two probes).
+  const auto first = continuation::attached_start(problem, traced.branch_points[0], "x", 0);
+  const auto second = continuation::attached_start(problem, traced.branch_points[0], "x", 1);
+  ASSERT_TRUE(first && second);
+  EXPECT_GE(first->growth, second->growth);
+  EXPECT_NE(first->probe, second->probe);
+  EXPECT_FALSE(continuation::attached_start(problem, traced.branch_points[0], "x", 2));
   EXPECT_NEAR(f.branch.points.back().x[0], 1.0, 1e-9);
 }
 
