@@ -76,7 +76,10 @@ struct BranchPointReport {
   // Angle [degrees] between the traced tangent and the closest secant to a probed point of the
   // attached family (90: it leaves at right angles); NaN when none was found.
   double tangent_angle = 0;
-  core::Vector attached_point;             // that probed point (unknowns), empty when none
+  core::Vector attached_point;  // that probed point (unknowns), empty when none
+  // Every probed point found on the attached family (unknowns), in the order of the probed
+  // directions; attached_point is one of them (continuation/follow.hpp switches onto one).
+  std::vector<core::Vector> attached_points;
   core::Observables attached_description;  // ContinuationHooks::describe_branch_point
   double seconds = 0;                      // wall time of location and verification
   bool verified() const { return attached_dimension > 0; }

@@ -312,6 +312,7 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
     const core::NewtonSummary s = corrector_.solve(on_plane, y);
     if (!s.converged() || !y.allFinite() || (y - z).norm() > h / v.drift_ratio) continue;
     ++attached;
+    report.attached_points.push_back(problem_.to_unknowns(y));
     const core::Vector secant = y - z;
     const double cosine = std::min(1.0, std::abs(secant.dot(t)) / secant.norm());
     const double angle = std::acos(cosine) * 180 / std::numbers::pi;

@@ -53,6 +53,12 @@ po::options_description continuation_keys(const po::options_description& problem
   add("detect_branch_points", po::value<bool>()->default_value(false),
       "arclength: evaluate the branch-point test function at every point, locate and verify "
       "candidates (trace writes branch_points.csv)");
+  add("follow", po::value<std::string>()->default_value("none"),
+      "arclength: none, all or K: switch onto the family attached at every verified (or the K-th, "
+      "1-based row of branch_points.csv) branch point and trace it towards growing energy into "
+      "DIR/branch_point_K/ (implies detect_branch_points)");
+  add("follow_max_points", po::value<long>()->default_value(30),
+      "points of each followed branch (with the energy bound)");
   add("max_turn_degrees", po::value<double>()->default_value(20),
       "arclength: refuse a correction whose step turns by more than this from the predictor "
       "direction (it landed on another family); 0: off");
@@ -122,7 +128,10 @@ RunSettings read_run_settings(const core::Scene& scene) {
   if (!(o.rank.relative_threshold < 1))
     throw core::InputError("rank_threshold",
                            fmt::format("must be in (0, 1) (got {})", o.rank.relative_threshold));
-  o.branch_points.detect = scene.flag("detect_branch_points");
+  run.follow.selection = parse_follow(scene.text("follow"));
+  run.follow.max_points = static_cast<int>(scene.integer("follow_max_points", 1));
+  o.branch_points.detect = scene.flag("detect_branch_points") ||
+                           run.follow.selection.kind != FollowSelection::Kind::none;
   o.branch_points.max_turn_degrees = scene.non_negative("max_turn_degrees");
   read_bounds(scene, o);
   o.validate();

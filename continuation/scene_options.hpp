@@ -19,6 +19,7 @@
 #include <memory>
 #include <string>
 
+#include "continuation/follow.hpp"
 #include "continuation/options.hpp"
 #include "continuation/switching.hpp"
 #include "core/newton.hpp"
@@ -38,7 +39,8 @@ struct RunSettings {
   core::ShootingFormulation formulation = core::ShootingFormulation::half_period_velocity;
   std::string natural_parameter = "period";  // the period unknown or an observable's name
   double natural_direction = 1;              // +1 or -1
-  int threads = 1;  // finite-difference Jacobian columns (core::set_default_jacobian_threads)
+  int threads = 1;   // finite-difference Jacobian columns (core::set_default_jacobian_threads)
+  FollowRun follow;  // keys follow, follow_max_points (follow.hpp); follow implies detection
 };
 
 // Throws core::InputError naming the key for any bad value.

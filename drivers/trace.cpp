@@ -236,6 +236,10 @@ int run_trace(const std::vector<std::string>& args_in) {
     if (options.branch_points.detect)
       cont::branch_point_table(branch, branch.points.front().observables)
           .write_csv(out / "branch_points.csv");
+    for (const auto& f :
+         cont::follow_branch_points(problem, branch, run.follow, *corrector, options, hooks, out,
+                                    setup.write_extra_outputs, entry.units))
+      fmt::print("  followed {}\n", cont::follow_line(f));
   }
   core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",
                                                            &branch, rejected, result.switch_index));

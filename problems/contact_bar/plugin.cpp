@@ -29,6 +29,7 @@
 #include "problems/contact_bar/bench_peers.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/figures.hpp"
+#include "problems/contact_bar/figures_resonance.hpp"
 #include "problems/contact_bar/grazing_limits.hpp"
 #include "problems/contact_bar/manifold.hpp"
 #include "problems/contact_bar/periodic_bar.hpp"
@@ -401,6 +402,7 @@ void register_plugin(continuation::PluginRegistry& registry) {
   p.bench_cases = bench_cases();
   for (continuation::ProblemJob& job : peer_bench_cases()) p.bench_cases.push_back(std::move(job));
   p.figures = figure_jobs();
+  for (continuation::ProblemJob& job : resonance_figure_jobs()) p.figures.push_back(std::move(job));
   const std::string scenes = "problems/contact_bar/scenes/";
   p.reproduce = {
       {"bouncing_bar",
