@@ -421,6 +421,33 @@ double TdbemMarch::velocity(double x, std::size_t* hints) const {
   return value;
 }
 
+// velocity(x, hints) and strain(x, hints) in one pass: the same expressions, one knot search
+// per end instead of two.
+void TdbemMarch::velocity_and_strain(double x, std::size_t* hints, double& v, double& ux) const {
+  const double s0 = t_ - x / c_, sL = t_ - (L_ - x) / c_;
+  const double lo = x - c_ * t_, hi = x + c_ * t_;
+  v = body_coef_ * (body_rate(c_, t_, x) + body_rate(c_, t_, L_ - x));
+  ux = body_coef_ * (body_slope(c_, t_, x) - body_slope(c_, t_, L_ - x));
+  if (sL <= 0) {
+    const double us = setup_.u0.slope(hi, -1), vs = setup_.v0(hi);
+    v += 0.5 * c_ * us + 0.5 * vs;
+    ux += 0.5 * us + vs / (2 * c_);
+  } else {
+    const double q = q_slope(1, sL, &hints[1]);
+    v += q;
+    ux += q / c_;
+  }
+  if (s0 <= 0) {
+    const double us = setup_.u0.slope(lo, +1), vs = setup_.v0(lo);
+    v += -0.5 * c_ * us + 0.5 * vs;
+    ux += 0.5 * us - vs / (2 * c_);
+  } else {
+    const double q = q_slope(0, s0, &hints[0]);
+    v += q;
+    ux += -q / c_;
+  }
+}
+
 double TdbemMarch::strain(double x) const {
   return strain(x, nullptr);
 }
@@ -436,27 +463,35 @@ double TdbemMarch::strain(double x, std::size_t* hints) const {
   return value;
 }
 
-// Every x where the field (a quadratic in x at most) changes form at the current time.
+// Every x where the field (a quadratic in x at most) changes form at the current time. The
+// knots of each end arrive in monotone order (end 0 from x = 0, end 1 from x = L), so the two
+// window sequences are merged with the few other points rather than sorted (O(window)).
 std::vector<double> TdbemMarch::breakpoints(int elements) const {
-  std::vector<double> pts;
+  const auto inside = [&](double p) { return p >= 0 && p <= L_; };
+  std::vector<double> other;
   const double ct = c_ * t_;
-  for (int i = 0; i <= elements; ++i) pts.push_back(L_ * i / elements);
+  for (int i = 0; i <= elements; ++i) other.push_back(L_ * i / elements);
   for (const auto* f : {&setup_.u0, &setup_.v0})
     for (double k : f->knots()) {
-      pts.push_back(k - ct);
-      pts.push_back(k + ct);
+      if (inside(k - ct)) other.push_back(k - ct);
+      if (inside(k + ct)) other.push_back(k + ct);
     }
-  pts.push_back(ct);
-  pts.push_back(L_ - ct);
-  for (const auto& k : ends_[0].knots) pts.push_back(c_ * (t_ - k.t));
-  for (const auto& k : ends_[1].knots) pts.push_back(L_ - c_ * (t_ - k.t));
-  std::vector<double> inside;
-  inside.reserve(pts.size());
-  for (double p : pts)
-    if (p >= 0 && p <= L_) inside.push_back(p);
-  std::sort(inside.begin(), inside.end());
-  inside.erase(std::unique(inside.begin(), inside.end()), inside.end());
-  return inside;
+  if (inside(ct)) other.push_back(ct);
+  if (inside(L_ - ct)) other.push_back(L_ - ct);
+  std::sort(other.begin(), other.end());
+  std::vector<double> from0, from1;  // both increasing in x
+  from0.reserve(ends_[0].knots.size());
+  from1.reserve(ends_[1].knots.size());
+  for (auto k = ends_[0].knots.rbegin(); k != ends_[0].knots.rend(); ++k)
+    if (const double p = c_ * (t_ - k->t); inside(p)) from0.push_back(p);
+  for (const auto& k : ends_[1].knots)
+    if (const double p = L_ - c_ * (t_ - k.t); inside(p)) from1.push_back(p);
+  std::vector<double> ends(from0.size() + from1.size());
+  std::merge(from0.begin(), from0.end(), from1.begin(), from1.end(), ends.begin());
+  std::vector<double> pts(ends.size() + other.size());
+  std::merge(ends.begin(), ends.end(), other.begin(), other.end(), pts.begin());
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  return pts;
 }
 
 // Calls f(x, weight, element) at the two Gauss points of every piece: exact for cubics in x.
@@ -503,7 +538,8 @@ double TdbemMarch::energy() const {
   double total = 0;
   std::size_t hints[2] = {ends_[0].knots.size(), 0};  // pieces come in increasing x
   integrate_pieces(1, [&](double x, double w, int) {
-    const double v = velocity(x, hints), ux = strain(x, hints);
+    double v, ux;
+    velocity_and_strain(x, hints, v, ux);
     total += w * (0.5 * m.density * m.area * v * v + 0.5 * ea_ * ux * ux);
     if (setup_.body_force != 0) total -= w * setup_.body_force * m.area * displacement(x);
   });

@@ -107,6 +107,7 @@ class TdbemMarch {
   // velocity(x) with the knot searches of both ends walking from hints (project's sweep).
   double velocity(double x, std::size_t* hints) const;
   double strain(double x, std::size_t* hints) const;
+  void velocity_and_strain(double x, std::size_t* hints, double& v, double& ux) const;
   void step_end(int e, double ta, double tb);
   void substep_event(int e, double ta, double tb, bool kink_at_end);
   void push_knot(int e, double t, double u, double s, bool kink);
