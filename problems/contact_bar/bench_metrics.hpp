@@ -54,8 +54,8 @@ inline constexpr ForceWindow tdbem_force_window{1, 0};
 inline constexpr ForceWindow fem_force_window{0.5, 0.5};
 
 // Mean of f over [a, b] (a clipped to 0), f smooth between the jumps listed in `breaks`:
-// Simpson on each piece, with one-sided values at the cuts, so exact for f piecewise cubic.
-// b <= a: f(max(b, 0)).
+// three-point Gauss on each piece (f is never evaluated at a cut), so exact for f piecewise
+// quintic, also when a jump sits on a window end far from t = 0. b <= a: f(max(b, 0)).
 double mean_between_breaks(const std::function<double(double)>& f, double a, double b,
                            const std::vector<double>& breaks);
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "core/errors.hpp"
@@ -420,37 +421,77 @@ double TdbemMarch::velocity(double x, std::size_t* hints) const {
   return value;
 }
 
+// velocity(x, hints) and strain(x, hints) in one pass: the same expressions, one knot search
+// per end instead of two.
+void TdbemMarch::velocity_and_strain(double x, std::size_t* hints, double& v, double& ux) const {
+  const double s0 = t_ - x / c_, sL = t_ - (L_ - x) / c_;
+  const double lo = x - c_ * t_, hi = x + c_ * t_;
+  v = body_coef_ * (body_rate(c_, t_, x) + body_rate(c_, t_, L_ - x));
+  ux = body_coef_ * (body_slope(c_, t_, x) - body_slope(c_, t_, L_ - x));
+  if (sL <= 0) {
+    const double us = setup_.u0.slope(hi, -1), vs = setup_.v0(hi);
+    v += 0.5 * c_ * us + 0.5 * vs;
+    ux += 0.5 * us + vs / (2 * c_);
+  } else {
+    const double q = q_slope(1, sL, &hints[1]);
+    v += q;
+    ux += q / c_;
+  }
+  if (s0 <= 0) {
+    const double us = setup_.u0.slope(lo, +1), vs = setup_.v0(lo);
+    v += -0.5 * c_ * us + 0.5 * vs;
+    ux += 0.5 * us - vs / (2 * c_);
+  } else {
+    const double q = q_slope(0, s0, &hints[0]);
+    v += q;
+    ux += -q / c_;
+  }
+}
+
 double TdbemMarch::strain(double x) const {
+  return strain(x, nullptr);
+}
+
+double TdbemMarch::strain(double x, std::size_t* hints) const {
   const double s0 = t_ - x / c_, sL = t_ - (L_ - x) / c_;
   const double lo = x - c_ * t_, hi = x + c_ * t_;
   double value = body_coef_ * (body_slope(c_, t_, x) - body_slope(c_, t_, L_ - x));
-  value += sL <= 0 ? 0.5 * setup_.u0.slope(hi, -1) + setup_.v0(hi) / (2 * c_) : q_slope(1, sL) / c_;
-  value +=
-      s0 <= 0 ? 0.5 * setup_.u0.slope(lo, +1) - setup_.v0(lo) / (2 * c_) : -q_slope(0, s0) / c_;
+  value += sL <= 0 ? 0.5 * setup_.u0.slope(hi, -1) + setup_.v0(hi) / (2 * c_)
+                   : q_slope(1, sL, hints ? &hints[1] : nullptr) / c_;
+  value += s0 <= 0 ? 0.5 * setup_.u0.slope(lo, +1) - setup_.v0(lo) / (2 * c_)
+                   : -q_slope(0, s0, hints ? &hints[0] : nullptr) / c_;
   return value;
 }
 
-// Every x where the field (a quadratic in x at most) changes form at the current time.
+// Every x where the field (a quadratic in x at most) changes form at the current time. The
+// knots of each end arrive in monotone order (end 0 from x = 0, end 1 from x = L), so the two
+// window sequences are merged with the few other points rather than sorted (O(window)).
 std::vector<double> TdbemMarch::breakpoints(int elements) const {
-  std::vector<double> pts;
+  const auto inside = [&](double p) { return p >= 0 && p <= L_; };
+  std::vector<double> other;
   const double ct = c_ * t_;
-  for (int i = 0; i <= elements; ++i) pts.push_back(L_ * i / elements);
+  for (int i = 0; i <= elements; ++i) other.push_back(L_ * i / elements);
   for (const auto* f : {&setup_.u0, &setup_.v0})
     for (double k : f->knots()) {
-      pts.push_back(k - ct);
-      pts.push_back(k + ct);
+      if (inside(k - ct)) other.push_back(k - ct);
+      if (inside(k + ct)) other.push_back(k + ct);
     }
-  pts.push_back(ct);
-  pts.push_back(L_ - ct);
-  for (const auto& k : ends_[0].knots) pts.push_back(c_ * (t_ - k.t));
-  for (const auto& k : ends_[1].knots) pts.push_back(L_ - c_ * (t_ - k.t));
-  std::vector<double> inside;
-  inside.reserve(pts.size());
-  for (double p : pts)
-    if (p >= 0 && p <= L_) inside.push_back(p);
-  std::sort(inside.begin(), inside.end());
-  inside.erase(std::unique(inside.begin(), inside.end()), inside.end());
-  return inside;
+  if (inside(ct)) other.push_back(ct);
+  if (inside(L_ - ct)) other.push_back(L_ - ct);
+  std::sort(other.begin(), other.end());
+  std::vector<double> from0, from1;  // both increasing in x
+  from0.reserve(ends_[0].knots.size());
+  from1.reserve(ends_[1].knots.size());
+  for (auto k = ends_[0].knots.rbegin(); k != ends_[0].knots.rend(); ++k)
+    if (const double p = c_ * (t_ - k->t); inside(p)) from0.push_back(p);
+  for (const auto& k : ends_[1].knots)
+    if (const double p = L_ - c_ * (t_ - k.t); inside(p)) from1.push_back(p);
+  std::vector<double> ends(from0.size() + from1.size());
+  std::merge(from0.begin(), from0.end(), from1.begin(), from1.end(), ends.begin());
+  std::vector<double> pts(ends.size() + other.size());
+  std::merge(ends.begin(), ends.end(), other.begin(), other.end(), pts.begin());
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  return pts;
 }
 
 // Calls f(x, weight, element) at the two Gauss points of every piece: exact for cubics in x.
@@ -493,12 +534,68 @@ std::vector<double> TdbemMarch::projected_velocity(int elements) const {
 
 double TdbemMarch::energy() const {
   const auto& m = setup_.material;
+  if (setup_.body_force == 0 && t_ > tau_) return window_energy();
   double total = 0;
+  std::size_t hints[2] = {ends_[0].knots.size(), 0};  // pieces come in increasing x
   integrate_pieces(1, [&](double x, double w, int) {
-    const double v = velocity(x), ux = strain(x);
+    double v, ux;
+    velocity_and_strain(x, hints, v, ux);
     total += w * (0.5 * m.density * m.area * v * v + 0.5 * ea_ * ux * ux);
     if (setup_.body_force != 0) total -= w * setup_.body_force * m.area * displacement(x);
   });
+  return total;
+}
+
+// Without a body force and once t > tau (no initial-data term left), v = Q_L' + Q_0' and
+// u_x = (Q_L' - Q_0') / c are constant between the x where a knot of either end's window
+// arrives: x = c (t - t_k) from x = 0, x = L - c (t - t_k) from x = L, each monotone in the knot
+// index. One merge of the two sequences gives every piece in order, each with its two slopes:
+// O(window) per call, no sort and no search. The value is the general path's (same pieces,
+// same slopes; a constant integrand, so Gauss points add nothing) up to summation order.
+double TdbemMarch::window_energy() const {
+  const auto& m = setup_.material;
+  const auto& k0 = ends_[0].knots;
+  const auto& k1 = ends_[1].knots;
+  const auto slope = [](const Knot& a, const Knot& b) { return (b.q - a.q) / (b.t - a.t); };
+  const double inf = std::numeric_limits<double>::infinity();
+  // End 0, interval (knot j - 1, knot j) covers x in [c (t - t_j), c (t - t_{j-1})]: walking up
+  // in x walks j down from the newest knot. End 1, interval (j - 1, j) covers [L - c (t -
+  // t_{j-1}), L - c (t - t_j)]: j walks up from the oldest. The oldest interval of end 0 and the
+  // newest of end 1 extend to the far end (the window holds a knot at or before t - tau; beyond
+  // it the slope is that of the last interval). Deque iterators: indexing costs more.
+  auto hi0 = std::prev(k0.end()), hi1 = std::next(k1.begin());  // knot j of each end
+  const auto lowest0 = std::next(k0.begin()), highest1 = std::prev(k1.end());
+  const auto end0_upper = [&] { return hi0 != lowest0 ? c_ * (t_ - std::prev(hi0)->t) : inf; };
+  const auto end1_upper = [&] { return hi1 != highest1 ? L_ - c_ * (t_ - hi1->t) : inf; };
+  while (end0_upper() <= 0) --hi0;
+  while (end1_upper() <= 0) ++hi1;
+  const double half_rho_a = 0.5 * m.density * m.area, half_ea_c2 = 0.5 * ea_ / (c_ * c_);
+  // Neumaier's compensated sum: the pieces are many (2 tau / dt) and all positive.
+  double total = 0, compensation = 0, x = 0;
+  double upper0 = end0_upper(), upper1 = end1_upper();
+  double a = slope(*std::prev(hi0), *hi0), b = slope(*std::prev(hi1), *hi1);
+  while (x < L_) {  // each pass ends at L or moves an index: at most the window's size passes
+    const double next = std::min({upper0, upper1, L_});
+    if (next - x > 1e-15 * L_) {
+      const double v = a + b, c_ux = b - a;
+      const double term = (next - x) * (half_rho_a * v * v + half_ea_c2 * c_ux * c_ux);
+      const double sum = total + term;
+      compensation += total >= term ? (total - sum) + term : (term - sum) + total;
+      total = sum;
+    }
+    x = next;
+    if (upper0 <= next) {
+      --hi0;
+      upper0 = end0_upper();
+      a = slope(*std::prev(hi0), *hi0);
+    }
+    if (upper1 <= next) {
+      ++hi1;
+      upper1 = end1_upper();
+      b = slope(*std::prev(hi1), *hi1);
+    }
+  }
+  total += compensation;
   return total;
 }
 

@@ -106,6 +106,8 @@ class TdbemMarch {
   std::size_t knot_index(int e, double s, std::size_t* hint) const;
   // velocity(x) with the knot searches of both ends walking from hints (project's sweep).
   double velocity(double x, std::size_t* hints) const;
+  double strain(double x, std::size_t* hints) const;
+  void velocity_and_strain(double x, std::size_t* hints, double& v, double& ux) const;
   void step_end(int e, double ta, double tb);
   void substep_event(int e, double ta, double tb, bool kink_at_end);
   void push_knot(int e, double t, double u, double s, bool kink);
@@ -116,6 +118,7 @@ class TdbemMarch {
   template <class F>
   void integrate_pieces(int elements, F&& f) const;
   std::vector<double> project(int elements, bool velocity) const;
+  double window_energy() const;  // energy() without body force once t > tau, O(window)
   double tolerance() const;
 
   bar::BarSetup setup_;

@@ -59,12 +59,24 @@ TEST(BenchMetrics, MeanBetweenBreaksIsExactForPiecewiseCubics) {
   // t^3 below 1, 5 + t^2 from 1 on: mean over [0.5, 2] by hand.
   const auto f = [](double t) { return t < 1 ? t * t * t : 5 + t * t; };
   const double exact = ((1 - std::pow(0.5, 4)) / 4 + 5 + (8 - 1) / 3.0) / 1.5;
-  // Simpson is exact on each cubic piece; the one-sided samples at the cut sit 1e-12 of a
-  // piece inside it, which moves the result by ~1e-12 relative.
-  EXPECT_NEAR(mean_between_breaks(f, 0.5, 2.0, {1.0}), exact, 1e-10 * exact);
+  // Three-point Gauss is exact on each cubic piece: only round-off (a few ulps) remains.
+  EXPECT_NEAR(mean_between_breaks(f, 0.5, 2.0, {1.0}), exact, 1e-14 * exact);
   // The window is clipped at t = 0; an empty window is the value at its end.
-  EXPECT_NEAR(mean_between_breaks(f, -1.0, 1.0, {1.0}), 0.25, 1e-12);
+  EXPECT_NEAR(mean_between_breaks(f, -1.0, 1.0, {1.0}), 0.25, 1e-14);
   EXPECT_DOUBLE_EQ(mean_between_breaks(f, 2.0, 2.0, {1.0}), 9.0);
+}
+
+// A narrow window that ends on a jump far from t = 0 (the step of dt = 1e-4 ending at the mode-1
+// onset 1.1, results/bench/mode1_convergence): the mean is that of the side inside the window,
+// 0 here, exactly. The former Simpson rule sampled f at r - 1e-12 w, which rounds back to r when
+// w = 1e-4 and r = 1.1, and returned f / 6.
+TEST(BenchMetrics, MeanBetweenBreaksTakesTheInsideOfANarrowWindowAtAJump) {
+  const double onset = 1.1;
+  const auto f = [&](double t) { return t >= onset ? 0.01 : 0.0; };
+  for (double dt : {1e-2, 1e-4, 1e-6, 1e-9}) {
+    EXPECT_EQ(mean_between_breaks(f, onset - dt, onset, {onset}), 0.0) << dt;
+    EXPECT_NEAR(mean_between_breaks(f, onset, onset + dt, {onset}), 0.01, 1e-15) << dt;
+  }
 }
 
 // The exact mean of a force `level` on [onset, release) over [a, b], by interval overlap.
