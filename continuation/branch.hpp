@@ -14,6 +14,7 @@
 //   t.write_csv(out / "branch.csv");
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,6 +25,8 @@
 #include "core/types.hpp"
 
 namespace backbone::continuation {
+
+struct LoopState;  // restart.hpp
 
 struct BranchPoint {
   int index = 0;                  // 0 for the corrected starting guess
@@ -40,6 +43,9 @@ struct BranchPoint {
   long jacobian_evaluations = 0;
   long residual_evaluations = 0;
   std::optional<core::RankReport> rank;  // when the rank was checked at this point
+  // The loop's state after this point (restart.hpp), what a restart from it needs to continue
+  // bit for bit; null when the loop could not go on from it (e.g. a point landed on a bound).
+  std::shared_ptr<const LoopState> state;
 
   // Value of a named observable; NaN when the problem does not report it.
   double observable(const std::string& name) const;

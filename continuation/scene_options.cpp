@@ -141,7 +141,8 @@ RunSettings read_run_settings(const core::Scene& scene) {
 
 SwitchingBranch run_continuation(const core::Problem& problem, const core::Vector& guess,
                                  const core::Vector& direction, const RunSettings& settings,
-                                 core::Corrector& corrector, const ContinuationHooks& hooks) {
+                                 core::Corrector& corrector, const ContinuationHooks& hooks,
+                                 const RestartPoint* restart) {
   const ContinuationOptions& options = settings.options;
   // The run's thread count, restored on the way out (also when a callback throws).
   struct ThreadsForThisRun {
@@ -149,8 +150,14 @@ SwitchingBranch run_continuation(const core::Problem& problem, const core::Vecto
     explicit ThreadsForThisRun(int threads) { core::set_default_jacobian_threads(threads); }
     ~ThreadsForThisRun() { core::set_default_jacobian_threads(previous); }
   } threads(settings.threads);
+  const LoopState* from = restart ? restart->state.get() : nullptr;
+  const bool record = restart && restart->record_saved_point;
+  const BranchStart start =
+      restart ? BranchStart{restart->index, restart->arclength, -1} : BranchStart{};
   if (options.method == Method::arclength)
-    return {pseudo_arclength(problem, guess, direction, corrector, options, hooks), -1};
+    return {from ? pseudo_arclength(problem, *from, record, corrector, options, hooks)
+                 : pseudo_arclength(problem, guess, direction, corrector, options, hooks, start),
+            -1};
   const auto* periodic = dynamic_cast<const core::PeriodicOrbitProblem*>(&problem);
   const NaturalParameter parameter =
       (periodic && settings.natural_parameter == "period")
@@ -158,8 +165,11 @@ SwitchingBranch run_continuation(const core::Problem& problem, const core::Vecto
                                          settings.natural_direction)
           : NaturalParameter::of_observable(settings.natural_parameter, settings.natural_direction);
   if (options.method == Method::natural)
-    return {natural(problem, guess, parameter, corrector, options, hooks), -1};
-  return natural_then_arclength(problem, guess, parameter, corrector, options, hooks);
+    return {from ? natural(problem, *from, record, parameter, corrector, options, hooks)
+                 : natural(problem, guess, parameter, corrector, options, hooks, start),
+            -1};
+  return from ? natural_then_arclength(problem, *from, record, parameter, corrector, options, hooks)
+              : natural_then_arclength(problem, guess, parameter, corrector, options, hooks, start);
 }
 
 }  // namespace backbone::continuation
