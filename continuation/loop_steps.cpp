@@ -66,6 +66,7 @@ void LoopSteps::attach(BranchPoint& point, std::shared_ptr<LoopState> state) con
 
 void LoopSteps::report_first(std::shared_ptr<LoopState> state) {
   BranchPoint& first = branch_.points.back();
+  if (state && state->tangent.size() > 0) recorder_.recheck_dimension(first, state->tangent);
   attach(first, std::move(state));
   if (hooks_.on_point) hooks_.on_point(first);
 }
@@ -85,7 +86,12 @@ void LoopSteps::resume(const LoopState& state, bool record) {
     return;
   }
   recorder_.begin();
-  BranchPoint point = recorder_.finish(state.z, state.index, 0, 0.0, state.arclength, true);
+  const core::Vector direction =
+      state.tangent.size() > 0
+          ? state.tangent
+          : (state.previous.size() > 0 ? core::Vector(state.z - state.previous) : core::Vector());
+  BranchPoint point =
+      recorder_.finish(state.z, state.index, 0, 0.0, state.arclength, true, direction);
   point.state = std::make_shared<LoopState>(state);
   push(std::move(point));
 }
@@ -152,8 +158,11 @@ bool LoopSteps::record(const core::Vector& x, const core::Vector& y, const core:
                        std::shared_ptr<LoopState> state) {
   const double arclength_at_x = arclength_;
   arclength_ += (y - x).norm();
+  // The curve's direction at y for a dimension re-check: the tangent when the loop has it.
+  const core::Vector direction =
+      state && state->tangent.size() == y.size() ? state->tangent : core::Vector(y - x);
   BranchPoint point =
-      recorder_.finish(y, next_index(), newton_iterations, ds, arclength_, force_rank);
+      recorder_.finish(y, next_index(), newton_iterations, ds, arclength_, force_rank, direction);
   double bound_value = 0;
   if (const Bound* bound = recorder_.violated_bound(point, bound_value)) {
     land_on_bound(*bound, bound_value, x, y, forward, ds, arclength_at_x);
@@ -191,7 +200,8 @@ void LoopSteps::land_on_bound(const Bound& bound, double value, const core::Vect
   }
   if (!landed) return;
   const double chord = (z - x).norm();
-  push(recorder_.finish(z, index, s.iterations, chord, arclength_at_x + chord, true));
+  push(recorder_.finish(z, index, s.iterations, chord, arclength_at_x + chord, true,
+                        core::Vector(z - x)));
   branch_.message = fmt::format("{} reached its bound {:.6g} (point {} lies on it)",
                                 bound.observable, value, index);
 }

@@ -176,17 +176,19 @@ int run_trace(const std::vector<std::string>& args_in) {
                      : "");
 
   // Output: the resolved scene first (it reproduces the run), then every point as it comes.
-  std::size_t points_in_files = 0;  // the whole branch, a resumed run's saved points included
+  std::size_t points_in_files = 0;      // the whole branch, a resumed run's saved points included
+  long dimension_flags[3] = {0, 0, 0};  // points per DimensionFlag (branch.hpp)
   const auto summary = [&](const std::string& status, const cont::Branch* branch, long rejected,
                            int switch_index) {
     return fmt::format(
         "problem {}\nbranch {}\nstatus {}\nequations {}\nunknowns {}\nexpected_dimension {}\n"
         "method {}\nnewton {}\nformulation {}\npoints {}\nrejected_corrections {}\n"
-        "switch_index {}\nstop_reason {}\nmessage {}\n",
+        "switch_index {}\nstop_reason {}\nmessage {}\ndimension_rechecked {}\n"
+        "dimension_unconfirmed {}\n",
         entry.name, branch_name, status, m, n, expected_dimension, cont::to_string(options.method),
         corrector->name(), periodic ? core::to_string(run.formulation) : "-", points_in_files,
         rejected, switch_index, branch ? cont::to_string(branch->reason) : "-",
-        branch ? branch->message : "-");
+        branch ? branch->message : "-", dimension_flags[1], dimension_flags[2]);
   };
   cont::BranchWriter writer(out, periodic, restart.has_value() && !resume.empty());
   if (resume.empty())
@@ -204,6 +206,9 @@ int run_trace(const std::vector<std::string>& args_in) {
     if (restart && !resume.empty() && p_in.index == restart->index) return;  // in the files
     const cont::BranchPoint& p = p_in;
     writer.append(p);
+    if (p.dimension_flag != cont::DimensionFlag::as_verified)
+      fmt::print(stderr, "backbone trace: point {}: {}\n", p.index, cont::dimension_warning(p));
+    dimension_flags[static_cast<int>(p.dimension_flag)] += 1;
     progress.finish();  // the point's line replaces the progress line, which follows it
     fmt::print("  {}{}\n", cont::point_line(p),
                setup.describe_point ? "  " + setup.describe_point(p) : "");

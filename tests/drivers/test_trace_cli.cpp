@@ -196,4 +196,35 @@ TEST(TraceCli, StartFromASavedPointReproducesTheRestOfTheBranch) {
   fs::remove_all(back);
 }
 
+// A point of a traced curve has dimension >= 1. At end amplitudes that are whole multiples of
+// g0 (T = 3 + 1/k: the contact events fall on the time grid) the candidate null space is several
+// directions wide; at 80 intervals and 10 g0 the rank verification once gave 0 of 4 candidates,
+// its probes stalling at residual 1.4e-9 above its own tolerance 1e-9 while the branch runs
+// through the point at newton_tolerance 3e-9. Every point must now report dimension >= 1, and a
+// point whose verification still gave 0 is re-checked along the tangent and said on stderr
+// and in summary.txt (dimension_flag, continuation/README.md).
+TEST(TraceCli, DimensionOnTheCurveIsNeverZero) {
+  const fs::path out = cli::scratch("trace_cli", "grid_coincidence");
+  const cli::Run r = cli::run(
+      "trace", paper + " --branch mode1 --shooting_elements 80 --start_offset 9 --max_points 2",
+      out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto t = backbone::core::Table::read_csv(out / "branch.csv");
+  const auto dimension = t.column("dimension"), flag = t.column("dimension_flag");
+  const auto amplitude = t.column("end_amplitude");
+  ASSERT_EQ(t.rows(), 2u);
+  EXPECT_NEAR(amplitude[0], 10 * 1e-3, 1e-15);  // exactly 10 g0, up to round-off
+  EXPECT_GE(t.column("nullity")[0], 2);         // the coincidence is there
+  long flagged = 0;
+  for (std::size_t i = 0; i < t.rows(); ++i) {
+    EXPECT_GE(dimension[i], 1) << "point " << i;
+    EXPECT_NE(flag[i], 2) << "point " << i;
+    flagged += flag[i] != 0;
+  }
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), flagged) << r.err;
+  EXPECT_NE(file_text(out / "summary.txt").find("dimension_rechecked " + std::to_string(flagged)),
+            std::string::npos);
+  fs::remove_all(out);
+}
+
 }  // namespace
