@@ -55,6 +55,11 @@ TEST(TraceCli, BadInputExitsTwoAndWritesNothing) {
   expect_bad_input(paper + " --steps_per_period 41", "steps_per_period");
   expect_bad_input(paper + " --return_tolerance -1", "return_tolerance");
   expect_bad_input(paper + " --right_end free", "right_end");
+  // The size of a residual is bounded before any work (it used to run for ever): 1e7 steps per
+  // period at 20 intervals, a million intervals at 40 steps, both above max_residual_work 1e7.
+  expect_bad_input(paper + " --steps_per_period 10000000", "steps_per_period");
+  expect_bad_input(paper + " --shooting_elements 1000000", "shooting_elements");
+  expect_bad_input(paper + " --branch subharmonic --steps_per_period 10000000", "steps_per_period");
   // KINSOL is square-only; the default residual is oversampled (test_elements = -1).
   expect_bad_input(paper + " --newton kinsol", "newton");
 }
