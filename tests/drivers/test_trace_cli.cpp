@@ -201,6 +201,24 @@ TEST(TraceCli, StartFromASavedPointReproducesTheRestOfTheBranch) {
   fs::remove_all(back);
 }
 
+// The paper's residual u0 - u(T) is degenerate on mode 1 (a double root: its period column
+// vanishes, problems/contact_bar/README.md). Its corrections once left the family for T = 4
+// orbits after point 0 (closed-form error up to 0.13) and the trace exited 0. The turn check
+// (max_turn_degrees) refuses those steps; the branch must end there honestly: exit 1 with the
+// reason on stderr, and every point it wrote on the closed form (1e-8, as above).
+TEST(TraceCli, PaperFormulationDoesNotLeaveTheFamily) {
+  const fs::path out = cli::scratch("trace_cli", "paper_formulation");
+  const cli::Run r = cli::run("trace", paper + " --branch mode1 --formulation paper", out);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("ended before its bound"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("turned by"), std::string::npos) << r.err;
+  const auto errors =
+      backbone::core::Table::read_csv(out / "closed_form_check.csv").column("relative_error");
+  ASSERT_FALSE(errors.empty());
+  for (double e : errors) EXPECT_LE(e, 1e-8);
+  fs::remove_all(out);
+}
+
 // A point of a traced curve has dimension >= 1. At end amplitudes that are whole multiples of
 // g0 (T = 3 + 1/k: the contact events fall on the time grid) the candidate null space is several
 // directions wide; at 80 intervals and 10 g0 the rank verification once gave 0 of 4 candidates,
