@@ -1,5 +1,7 @@
 #include "continuation/branch.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <limits>
 
@@ -31,21 +33,42 @@ const char* to_string(StopReason r) {
   return "?";
 }
 
+std::string dimension_warning(const BranchPoint& p) {
+  const int candidates = p.rank ? p.rank->nullity : -1;
+  switch (p.dimension_flag) {
+    case DimensionFlag::as_verified:
+      return {};
+    case DimensionFlag::rechecked:
+      return fmt::format(
+          "verified dimension 0 of {} candidates contradicts the curve; re-checked "
+          "along its tangent: dimension {} (dimension_flag 1)",
+          candidates, p.dimension);
+    case DimensionFlag::unconfirmed:
+      return fmt::format(
+          "verified dimension {} of {} candidates contradicts the curve, and a "
+          "probe along its tangent failed too (dimension_flag 2: not to be "
+          "trusted)",
+          p.dimension, candidates);
+  }
+  return {};
+}
+
 core::Table branch_table(const Branch& branch) {
   std::vector<std::string> names;
   if (!branch.points.empty())
     for (const auto& [key, value] : branch.points.front().observables) names.push_back(key);
   std::vector<std::string> columns{"point"};
   columns.insert(columns.end(), names.begin(), names.end());
-  for (const char* c :
-       {"dimension", "nullity", "sigma_zero", "sigma_kept", "residual", "newton_iterations",
-        "step_size", "arclength", "seconds", "jacobian_evaluations", "residual_evaluations"})
+  for (const char* c : {"dimension", "dimension_flag", "nullity", "sigma_zero", "sigma_kept",
+                        "residual", "newton_iterations", "step_size", "arclength", "seconds",
+                        "jacobian_evaluations", "residual_evaluations"})
     columns.push_back(c);
   core::Table table(columns);
   for (const BranchPoint& p : branch.points) {
     std::vector<double> row{static_cast<double>(p.index)};
     for (const std::string& n : names) row.push_back(p.observable(n));
     row.push_back(p.dimension);
+    row.push_back(static_cast<double>(p.dimension_flag));
     row.push_back(p.rank ? p.rank->nullity : -1);
     // sigma_zero: largest singular value counted as zero, sigma_kept: smallest one kept, both
     // relative to the largest (NaN when there is none or the rank was not checked): how far

@@ -14,6 +14,7 @@
 //   t.write_csv(out / "branch.csv");
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,12 +26,29 @@
 
 namespace backbone::continuation {
 
+struct LoopState;  // restart.hpp
+
+// How a point's dimension was settled. Every point of a continuation curve has dimension >= 1
+// (the curve passes through it), so a verified dimension of 0 contradicts the branch: the
+// candidate probes failed (at an exact coincidence of the contact bar's time grid the candidate
+// null space is several dimensions wide and none of its SVD directions re-corrects within the
+// drift bound). It is then re-checked along the direction the continuation knows, the curve's
+// tangent (or chord).
+enum class DimensionFlag {
+  as_verified = 0,  // the rank report's verified dimension, consistent with the curve
+  rechecked = 1,    // below 1, re-checked: the tangent probe found the curve, dimension = 1 +
+                    // the candidate directions orthogonal to it that verify
+  unconfirmed = 2,  // below 1 and the tangent probe failed too: dimension as verified (0), not
+                    // to be trusted
+};
+
 struct BranchPoint {
   int index = 0;                  // 0 for the corrected starting guess
   core::Vector x;                 // corrected solution, layout of the problem
   core::Observables observables;  // problem.observables(x)
   int dimension = -1;             // verified manifold dimension (-1: rank not checked here)
-  double residual = 0;            // ||F(x)||_inf of the problem (not of the augmented system)
+  DimensionFlag dimension_flag = DimensionFlag::as_verified;
+  double residual = 0;  // ||F(x)||_inf of the problem (not of the augmented system)
   int newton_iterations = 0;
   double step_size = 0;  // ds used to reach this point (0 for the first point)
   // Sum of the chords between consecutive points, Euclidean in the scaled unknowns
@@ -40,6 +58,9 @@ struct BranchPoint {
   long jacobian_evaluations = 0;
   long residual_evaluations = 0;
   std::optional<core::RankReport> rank;  // when the rank was checked at this point
+  // The loop's state after this point (restart.hpp), what a restart from it needs to continue
+  // bit for bit; null when the loop could not go on from it (e.g. a point landed on a bound).
+  std::shared_ptr<const LoopState> state;
 
   // Value of a named observable; NaN when the problem does not report it.
   double observable(const std::string& name) const;
@@ -55,6 +76,10 @@ enum class StopReason {
   cancelled,          // ContinuationHooks::cancel_requested returned true
 };
 const char* to_string(StopReason r);
+
+// One line for a point whose dimension_flag is not as_verified (empty otherwise): what the
+// verification gave and what the re-check along the curve found.
+std::string dimension_warning(const BranchPoint& point);
 
 // A candidate branch point located between two points of a branch (branch_points.hpp): where
 // the test function changed sign or dipped. verified() when the rank report and its probes found
@@ -99,9 +124,11 @@ struct Branch {
 };
 
 // Columns: point, then every observable by name (in the order of the first point), then
-// dimension, nullity (candidate, -1 when unchecked), sigma_zero and sigma_kept (largest
-// singular value counted as zero and smallest kept, relative to the largest), residual,
-// newton_iterations, step_size, arclength, seconds, jacobian_evaluations, residual_evaluations.
+// dimension, dimension_flag (DimensionFlag: 0 as verified, 1 re-checked along the tangent, 2
+// below the curve's 1 and unconfirmed), nullity (candidate, -1 when unchecked), sigma_zero and
+// sigma_kept (largest singular value counted as zero and smallest kept, relative to the largest),
+// residual, newton_iterations, step_size, arclength, seconds, jacobian_evaluations,
+// residual_evaluations.
 core::Table branch_table(const Branch& branch);
 
 // branch_points.csv: one row per located candidate (Branch::branch_points): its observables (the

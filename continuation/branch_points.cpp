@@ -39,13 +39,6 @@ TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vect
   return result;
 }
 
-struct BranchPointDetector::Sample {
-  int index = 0;
-  core::Vector z, tangent;
-  TestFunctionValue tau;
-  double s = 0;  // arclength
-};
-
 struct BranchPointDetector::Evaluation {
   bool ok = false;
   core::Vector z, tangent;
@@ -61,6 +54,11 @@ BranchPointDetector::~BranchPointDetector() = default;
 
 double BranchPointDetector::last_value() const {
   return samples_.empty() ? std::numeric_limits<double>::quiet_NaN() : samples_.back().tau.value;
+}
+
+void BranchPointDetector::restore(std::vector<TestFunctionSample> samples, double jacobian_scale) {
+  samples_ = std::move(samples);
+  jacobian_scale_ = jacobian_scale;
 }
 
 std::vector<BranchPointReport> BranchPointDetector::take() {

@@ -47,6 +47,15 @@ struct TestFunctionValue {
   bool continued = true;  // false when the vectors did not follow the reference's (sign unknown)
 };
 
+// One point of the branch as the detector keeps it (the last three): its index, scaled point,
+// unit tangent, test-function value and arclength. Part of a loop's restart state (restart.hpp).
+struct TestFunctionSample {
+  int index = 0;
+  core::Vector z, tangent;
+  TestFunctionValue tau;
+  double s = 0;  // arclength
+};
+
 // Test function of J (m x n) and the unit tangent t: the smallest singular value of
 // [J / scale; t^T]. With a reference (the previous point's value), the singular vectors are
 // oriented like the reference's and the value is signed; without one it is positive.
@@ -71,9 +80,14 @@ class BranchPointDetector {
   std::vector<BranchPointReport> take();
   // Test-function value at the last added point (NaN before the first).
   double last_value() const;
+  // What add() remembers between points, for a restart that must continue bit for bit: the
+  // samples kept and the Jacobian scale (0 before the first point). restore() puts them back.
+  const std::vector<TestFunctionSample>& samples() const { return samples_; }
+  double jacobian_scale() const { return jacobian_scale_; }
+  void restore(std::vector<TestFunctionSample> samples, double jacobian_scale);
 
  private:
-  struct Sample;
+  using Sample = TestFunctionSample;
   struct Evaluation;
   Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref);
   void locate(const std::vector<Sample>& polyline, bool sign_change);

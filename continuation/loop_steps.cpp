@@ -36,12 +36,16 @@ void check_sizes(const core::Problem& problem, const core::Vector& guess,
 }
 
 LoopSteps::LoopSteps(const ScaledProblem& problem, core::Corrector& corrector,
-                     const ContinuationOptions& options, const ContinuationHooks& hooks)
+                     const ContinuationOptions& options, const ContinuationHooks& hooks,
+                     const BranchStart& start)
     : problem_(problem),
       corrector_(corrector),
       options_(options),
       hooks_(hooks),
-      recorder_(problem, options, &problem.base()) {}
+      recorder_(problem, options, &problem.base()),
+      first_index_(start.index),
+      arclength_(start.arclength),
+      switch_index_(start.switch_index) {}
 
 std::string LoopSteps::describe(const core::Vector& z) const {
   return describe_point(problem_.to_unknowns(z));
@@ -49,6 +53,47 @@ std::string LoopSteps::describe(const core::Vector& z) const {
 
 std::string LoopSteps::rejection_of(const core::Vector& z) const {
   return hooks_.reject_point ? hooks_.reject_point(z) : std::string();
+}
+
+void LoopSteps::attach(BranchPoint& point, std::shared_ptr<LoopState> state) const {
+  if (!state) return;
+  state->index = point.index;
+  state->arclength = point.arclength;
+  state->scale = problem_.scale();
+  state->switch_index = switch_index_;
+  point.state = std::move(state);
+}
+
+void LoopSteps::report_first(std::shared_ptr<LoopState> state) {
+  BranchPoint& first = branch_.points.back();
+  if (state && state->tangent.size() > 0) recorder_.recheck_dimension(first, state->tangent);
+  attach(first, std::move(state));
+  if (hooks_.on_point) hooks_.on_point(first);
+}
+
+void LoopSteps::resume(const LoopState& state, bool record) {
+  const std::string mismatch = state.z.size() != problem_.num_unknowns()
+                                   ? std::string("another number of unknowns")
+                                   : (state.scale != problem_.scale() ? "another scale" : "");
+  if (!mismatch.empty())
+    throw core::InputError(
+        "state", fmt::format("the saved loop state of point {} has {}", state.index, mismatch));
+  first_index_ = state.index;
+  arclength_ = state.arclength;
+  switch_index_ = state.switch_index;
+  if (!record) {
+    ++first_index_;
+    return;
+  }
+  recorder_.begin();
+  const core::Vector direction =
+      state.tangent.size() > 0
+          ? state.tangent
+          : (state.previous.size() > 0 ? core::Vector(state.z - state.previous) : core::Vector());
+  BranchPoint point =
+      recorder_.finish(state.z, state.index, 0, 0.0, state.arclength, true, direction);
+  point.state = std::make_shared<LoopState>(state);
+  push(std::move(point));
 }
 
 void LoopSteps::push(BranchPoint point) {
@@ -89,19 +134,19 @@ bool LoopSteps::start(const core::Problem& system, core::Vector& z, const std::s
                     describe(z), rejection);
     return false;
   }
-  push(recorder_.finish(z, 0, s.iterations, 0.0, 0.0, true));
+  branch_.points.push_back(recorder_.finish(z, first_index_, s.iterations, 0.0, arclength_, true));
   return true;
 }
 
 bool LoopSteps::begin_step() {
   if (next_index() >= options_.max_points) {
     branch_.reason = StopReason::max_points;
-    branch_.message = fmt::format("{} points computed", branch_.points.size());
+    branch_.message = fmt::format("{} points computed", next_index());
     return false;
   }
   if (hooks_.cancel_requested && hooks_.cancel_requested()) {
     branch_.reason = StopReason::cancelled;
-    branch_.message = fmt::format("cancelled after {} points", branch_.points.size());
+    branch_.message = fmt::format("cancelled after {} points", next_index());
     return false;
   }
   recorder_.begin();
@@ -109,16 +154,21 @@ bool LoopSteps::begin_step() {
 }
 
 bool LoopSteps::record(const core::Vector& x, const core::Vector& y, const core::Vector& forward,
-                       int newton_iterations, double ds, bool force_rank) {
+                       int newton_iterations, double ds, bool force_rank,
+                       std::shared_ptr<LoopState> state) {
   const double arclength_at_x = arclength_;
   arclength_ += (y - x).norm();
+  // The curve's direction at y for a dimension re-check: the tangent when the loop has it.
+  const core::Vector direction =
+      state && state->tangent.size() == y.size() ? state->tangent : core::Vector(y - x);
   BranchPoint point =
-      recorder_.finish(y, next_index(), newton_iterations, ds, arclength_, force_rank);
+      recorder_.finish(y, next_index(), newton_iterations, ds, arclength_, force_rank, direction);
   double bound_value = 0;
   if (const Bound* bound = recorder_.violated_bound(point, bound_value)) {
     land_on_bound(*bound, bound_value, x, y, forward, ds, arclength_at_x);
     return false;
   }
+  attach(point, std::move(state));
   push(std::move(point));
   return true;
 }
@@ -150,7 +200,8 @@ void LoopSteps::land_on_bound(const Bound& bound, double value, const core::Vect
   }
   if (!landed) return;
   const double chord = (z - x).norm();
-  push(recorder_.finish(z, index, s.iterations, chord, arclength_at_x + chord, true));
+  push(recorder_.finish(z, index, s.iterations, chord, arclength_at_x + chord, true,
+                        core::Vector(z - x)));
   branch_.message = fmt::format("{} reached its bound {:.6g} (point {} lies on it)",
                                 bound.observable, value, index);
 }

@@ -9,9 +9,12 @@
 //   - LoopSteps::start corrects the first point and asks hooks.reject_point about it;
 //   - LoopSteps::correct is the predict-correct step with the shrinking rule and the rejection
 //     hook (correct_with_shrinking);
-//   - LoopSteps::record adds the chord |y - x| in z to the arclength, records the point, and
+//   - LoopSteps::record adds the chord |y - x| in z to the arclength, records the point with the
+//     loop's state after it (restart.hpp: what the next step needs, saved for a restart), and
 //     when it crossed a bound lands on the bound (F plus the row observable - bound value,
-//     corrected from the crossing point, then from the last point inside) and ends the branch.
+//     corrected from the crossing point, then from the last point inside) and ends the branch;
+//   - LoopSteps::resume takes a saved LoopState up instead of start: the loop then continues
+//     from the state's point as the run that saved it would have.
 //
 //   return in_scaled_unknowns(problem, options, hooks, [&](const ScaledProblem& scaled,
 //                                                          const ContinuationHooks& inner) {
@@ -22,7 +25,8 @@
 //       core::Vector y;
 //       const CorrectedStep c = steps.correct(ds, y, attempt);   // attempt(ds, y) -> summary
 //       if (!c.accepted) return steps.end(StopReason::step_floor, "...");
-//       if (!steps.record(x, y, forward, c.summary.iterations, c.ds, false)) return steps.take();
+//       if (!steps.record(x, y, forward, c.summary.iterations, c.ds, false, state_after(y)))
+//         return steps.take();
 //       x = y;
 //     }
 //     return steps.take();
@@ -37,6 +41,7 @@
 #include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
 #include "continuation/point_recorder.hpp"
+#include "continuation/restart.hpp"
 #include "continuation/scaled_problem.hpp"
 #include "core/newton.hpp"
 #include "core/problem.hpp"
@@ -51,6 +56,14 @@ std::string describe_point(const core::Vector& x);
 // method in the message).
 void check_sizes(const core::Problem& problem, const core::Vector& guess,
                  const core::Vector& direction, const char* what);
+
+// The unit scale of the loops' ScaledProblem: typical_scale() with options.scale_unknowns, else
+// ones.
+inline core::Vector loop_unit_scale(const core::Problem& problem,
+                                    const ContinuationOptions& options) {
+  return options.scale_unknowns ? core::Vector(problem.typical_scale().cwiseAbs())
+                                : core::Vector::Ones(problem.num_unknowns());
+}
 
 // Step-size rule of both loops: grow after a fast correction, shrink after a slow one, within
 // [ds_min, ds_max].
@@ -111,10 +124,7 @@ CorrectedStep correct_with_shrinking(double ds, int index, const ContinuationOpt
 template <class Loop>
 Branch in_scaled_unknowns(const core::Problem& problem, const ContinuationOptions& options,
                           const ContinuationHooks& hooks, Loop&& loop) {
-  const int n = problem.num_unknowns();
-  const ScaledProblem scaled(problem, options.scale_unknowns
-                                          ? core::Vector(problem.typical_scale().cwiseAbs())
-                                          : core::Vector::Ones(n));
+  const ScaledProblem scaled(problem, loop_unit_scale(problem, options));
   ContinuationHooks inner = hooks;
   if (hooks.on_point)
     inner.on_point = [&](const BranchPoint& p) {
@@ -136,17 +146,28 @@ Branch in_scaled_unknowns(const core::Problem& problem, const ContinuationOption
 class LoopSteps {
  public:
   LoopSteps(const ScaledProblem& problem, core::Corrector& corrector,
-            const ContinuationOptions& options, const ContinuationHooks& hooks);
+            const ContinuationOptions& options, const ContinuationHooks& hooks,
+            const BranchStart& start = {});
 
-  // Point 0: corrects `system` (F plus the loop's row) from z in place, asks
-  // hooks.reject_point, records and reports it. False when it fails (the branch's reason and
-  // message set); `where` adds context after "the starting guess did not converge".
+  // The first point: corrects `system` (F plus the loop's row) from z in place, asks
+  // hooks.reject_point and records it (index and arclength of the BranchStart). False when it
+  // fails (the branch's reason and message set); `where` adds context after "the starting guess
+  // did not converge". The loop then reports it with report_first, with its state when it has
+  // one.
   bool start(const core::Problem& system, core::Vector& z, const std::string& where);
+  void report_first(std::shared_ptr<LoopState> state);
+
+  // In place of start: continues from a saved state (its index and arclength). record: the
+  // state's point becomes the branch's first point (recorded, not corrected: --start), else the
+  // branch begins with the next one (--resume). InputError when the state does not fit the
+  // problem (restart.hpp: state_mismatch).
+  void resume(const LoopState& state, bool record);
+  int switch_index() const { return switch_index_; }
 
   // Before each further step: false when the branch has options.max_points points or a cancel
   // was requested (reason and message set); else starts measuring the point's cost.
   bool begin_step();
-  int next_index() const { return static_cast<int>(branch_.points.size()); }
+  int next_index() const { return first_index_ + static_cast<int>(branch_.points.size()); }
 
   template <class Attempt>
   CorrectedStep correct(double ds, core::Vector& y, Attempt&& attempt) {
@@ -165,11 +186,13 @@ class LoopSteps {
   void add_branch_point(BranchPointReport report);
 
   // Records y, corrected from the last point x with step ds: the arclength grows by |y - x|.
-  // When y leaves a bound the branch ends (false): with options.land_on_bounds, F plus the
-  // bound's observable row is corrected from y, then from x, and the solution is recorded in
-  // y's place if it lies ahead of x along `forward` and hooks.reject_point accepts it.
+  // state: the loop's state after y (its index, arclength, scale and switch index are filled
+  // here), null when the loop cannot go on from y. When y leaves a bound the branch ends
+  // (false): with options.land_on_bounds, F plus the bound's observable row is corrected from y,
+  // then from x, and the solution is recorded in y's place (without a state) if it lies ahead of
+  // x along `forward` and hooks.reject_point accepts it.
   bool record(const core::Vector& x, const core::Vector& y, const core::Vector& forward,
-              int newton_iterations, double ds, bool force_rank);
+              int newton_iterations, double ds, bool force_rank, std::shared_ptr<LoopState> state);
 
   // Ends the branch: sets reason and message, returns the branch.
   Branch end(StopReason reason, std::string message);
@@ -180,6 +203,7 @@ class LoopSteps {
 
  private:
   void push(BranchPoint point);
+  void attach(BranchPoint& point, std::shared_ptr<LoopState> state) const;
   std::string rejection_of(const core::Vector& z) const;
   void land_on_bound(const Bound& bound, double value, const core::Vector& x, const core::Vector& y,
                      const core::Vector& forward, double ds, double arclength_at_x);
@@ -190,7 +214,9 @@ class LoopSteps {
   const ContinuationHooks& hooks_;
   PointRecorder recorder_;
   Branch branch_;
+  int first_index_ = 0;
   double arclength_ = 0;
+  int switch_index_ = -1;
 };
 
 }  // namespace backbone::continuation

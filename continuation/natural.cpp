@@ -49,8 +49,11 @@ namespace {
 
 // The loop proper, in the scaled unknowns z of `problem` (in_scaled_unknowns): an unknown
 // parameter is then z_index, stepped by ds (ds times its typical scale in the problem's units).
+// It starts from guess (corrected at its own parameter value) or, with `from`, continues from a
+// saved state (restart.hpp) without correcting anything.
 Branch natural_loop(const ScaledProblem& problem, const core::Vector& guess,
-                    const NaturalParameter& parameter, core::Corrector& corrector,
+                    const NaturalParameter& parameter, const LoopState* from, bool record_from,
+                    const BranchStart& start, core::Corrector& corrector,
                     const ContinuationOptions& options, const ContinuationHooks& hooks) {
   const int n = problem.num_unknowns();
   // The parameter in the problem's units, for messages.
@@ -59,17 +62,35 @@ Branch natural_loop(const ScaledProblem& problem, const core::Vector& guess,
                ? lambda * problem.scale()[parameter.index]
                : lambda;
   };
-  const double lambda0 = parameter_value(problem, parameter, guess);
-  LoopSteps steps(problem, corrector, options, hooks);
+  LoopSteps steps(problem, corrector, options, hooks, start);
+  // The row's value is the parameter's at the last point (an observable row is divided by it).
+  const double lambda0 = from ? from->lambda : parameter_value(problem, parameter, guess);
   ParameterConstraintSystem system(problem, parameter, lambda0);
-  core::Vector x = guess;
-  if (!steps.start(system, x, fmt::format(" at {} = {:.10g}", parameter.name, in_units(lambda0))))
-    return steps.take();
-
+  core::Vector x = from ? from->z : guess;
   double lambda = lambda0;
-  double ds = options.ds;
-  core::Vector previous = x;
-  double previous_step = 0;
+  double ds = from ? from->ds : options.ds;
+  core::Vector previous = from ? from->previous : x;
+  double previous_step = from ? from->previous_step : 0;
+  // The state the next step starts from, saved with each point for a restart.
+  const auto state_at = [&](const core::Vector& z, double value, const core::Vector& before,
+                            double step, double next_ds) {
+    auto state = std::make_shared<LoopState>();
+    state->method = Method::natural;
+    state->z = z;
+    state->lambda = value;
+    state->previous = before;
+    state->previous_step = step;
+    state->ds = next_ds;
+    return state;
+  };
+  if (from) {
+    steps.resume(*from, record_from);
+  } else {
+    if (!steps.start(system, x, fmt::format(" at {} = {:.10g}", parameter.name, in_units(lambda0))))
+      return steps.take();
+    previous = x;
+    steps.report_first(state_at(x, lambda, x, 0.0, ds));
+  }
   while (steps.begin_step()) {
     const int index = steps.next_index();
     // dx/dlambda for the predictor: tangent of the curve scaled so that dp = 1, or the secant.
@@ -108,24 +129,25 @@ Branch natural_loop(const ScaledProblem& problem, const core::Vector& guess,
                       steps.describe(x), core::to_string(corrected.last_failure),
                       corrected.last_message));
     const int iterations = corrected.summary.iterations;
-    if (!steps.record(x, y, y - x, iterations, ds, index + 1 == options.max_points))
+    const double next_ds = adapted_step(ds, iterations, options);
+    if (!steps.record(x, y, y - x, iterations, ds, index + 1 == options.max_points,
+                      state_at(y, lambda + step, x, step, next_ds)))
       return steps.take();
     previous = x;
     previous_step = step;
     x = y;
     lambda += step;
-    ds = adapted_step(ds, iterations, options);
+    ds = next_ds;
   }
   return steps.take();
 }
 
 }  // namespace
 
-Branch natural(const core::Problem& problem, const core::Vector& guess,
-               const NaturalParameter& parameter, core::Corrector& corrector,
-               const ContinuationOptions& options, const ContinuationHooks& hooks) {
-  options.validate();
-  check_sizes(problem, guess, core::Vector(), "natural continuation in one parameter");
+namespace {
+
+void check_parameter(const core::Problem& problem, const core::Vector& x,
+                     const NaturalParameter& parameter) {
   const int n = problem.num_unknowns();
   if (parameter.kind == NaturalParameter::Kind::unknown &&
       (parameter.index < 0 || parameter.index >= n))
@@ -134,14 +156,41 @@ Branch natural(const core::Problem& problem, const core::Vector& guess,
   if (!(parameter.direction == 1.0 || parameter.direction == -1.0))
     throw core::InputError("natural_direction",
                            fmt::format("must be +1 or -1 (got {})", parameter.direction));
-  if (!std::isfinite(parameter_value(problem, parameter, guess)))
+  if (!std::isfinite(parameter_value(problem, parameter, x)))
     throw core::InputError(
         "natural_parameter",
         fmt::format("the problem reports no finite observable '{}' at the guess", parameter.name));
-  return in_scaled_unknowns(
-      problem, options, hooks, [&](const ScaledProblem& scaled, const ContinuationHooks& inner) {
-        return natural_loop(scaled, scaled.to_scaled(guess), parameter, corrector, options, inner);
-      });
+}
+
+}  // namespace
+
+Branch natural(const core::Problem& problem, const core::Vector& guess,
+               const NaturalParameter& parameter, core::Corrector& corrector,
+               const ContinuationOptions& options, const ContinuationHooks& hooks,
+               const BranchStart& start) {
+  options.validate();
+  check_sizes(problem, guess, core::Vector(), "natural continuation in one parameter");
+  check_parameter(problem, guess, parameter);
+  return in_scaled_unknowns(problem, options, hooks,
+                            [&](const ScaledProblem& scaled, const ContinuationHooks& inner) {
+                              return natural_loop(scaled, scaled.to_scaled(guess), parameter,
+                                                  nullptr, false, start, corrector, options, inner);
+                            });
+}
+
+Branch natural(const core::Problem& problem, const LoopState& from, bool record_from,
+               const NaturalParameter& parameter, core::Corrector& corrector,
+               const ContinuationOptions& options, const ContinuationHooks& hooks) {
+  options.validate();
+  check_sizes(problem, from.z, core::Vector(), "natural continuation in one parameter");
+  check_parameter(problem, from.unknowns(), parameter);
+  if (const std::string why = state_mismatch(from, problem, options, Method::natural); !why.empty())
+    throw core::InputError("state", why);
+  return in_scaled_unknowns(problem, options, hooks,
+                            [&](const ScaledProblem& scaled, const ContinuationHooks& inner) {
+                              return natural_loop(scaled, from.z, parameter, &from, record_from, {},
+                                                  corrector, options, inner);
+                            });
 }
 
 }  // namespace backbone::continuation

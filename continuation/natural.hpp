@@ -25,6 +25,7 @@
 #include "continuation/branch.hpp"
 #include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
+#include "continuation/restart.hpp"
 #include "core/bordered_system.hpp"
 #include "core/newton.hpp"
 #include "core/problem.hpp"
@@ -67,7 +68,15 @@ class ParameterConstraintSystem : public core::BorderedSystem {
 
 // Throws core::InputError for bad options, sizes, an unknown index out of range or an
 // observable the problem does not report at the guess. Never throws on numerical failure.
+// start: index and arclength of the first point (restart.hpp).
 Branch natural(const core::Problem& problem, const core::Vector& guess,
+               const NaturalParameter& parameter, core::Corrector& corrector,
+               const ContinuationOptions& options, const ContinuationHooks& hooks = {},
+               const BranchStart& start = {});
+
+// Continues a branch from the loop state saved with one of its points (BranchPoint::state), bit
+// for bit as the run that saved it (pseudo_arclength.hpp has the same entry point).
+Branch natural(const core::Problem& problem, const LoopState& from, bool record_from,
                const NaturalParameter& parameter, core::Corrector& corrector,
                const ContinuationOptions& options, const ContinuationHooks& hooks = {});
 

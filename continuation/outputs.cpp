@@ -13,7 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "continuation/loop_steps.hpp"
+#include "continuation/restart.hpp"
 #include "core/errors.hpp"
 #include "core/plot.hpp"
 
@@ -115,6 +115,10 @@ BranchWriter::BranchWriter(std::filesystem::path out, const core::PeriodicOrbitP
   branch_ = std::make_unique<File>(out_ / "branch.csv", append);
   unknowns_ = std::make_unique<File>(out_ / "unknowns.csv", append);
   if (periodic_) orbits_ = std::make_unique<File>(out_ / "orbits.csv", append);
+  const bool state_exists = std::filesystem::exists(out_ / "state.txt");
+  state_ = std::make_unique<File>(out_ / "state.txt", append);
+  if (!append || !state_exists)
+    state_->write("point state (continuation/README.md, section 'Restart files')\n");
 }
 
 BranchWriter::~BranchWriter() = default;
@@ -129,6 +133,8 @@ void BranchWriter::append(const BranchPoint& point) {
     unknowns.add_row({static_cast<double>(point.index), static_cast<double>(i), point.x[i]});
   unknowns_->write(csv_rows(unknowns, first));
   if (periodic_) orbits_->write(csv_rows(orbit_table(*periodic_, one), first));
+  state_->write(
+      fmt::format("{} {}\n", point.index, point.state ? format_state(*point.state) : "-"));
   ++points_;
 }
 
@@ -159,9 +165,10 @@ double first_cell(const std::string& line) {
 
 int repair_branch_files(const std::filesystem::path& out, const std::string& key) {
   std::vector<std::filesystem::path> files{out / "branch.csv", out / "unknowns.csv"};
-  if (std::filesystem::exists(out / "orbits.csv")) files.push_back(out / "orbits.csv");
+  for (const char* optional : {"orbits.csv", "state.txt"})
+    if (std::filesystem::exists(out / optional)) files.push_back(out / optional);
   std::vector<std::vector<std::string>> contents;
-  // The writer writes a point to branch.csv, then unknowns.csv, then orbits.csv: the last
+  // The writer writes a point to branch.csv, unknowns.csv, orbits.csv, then state.txt: the last
   // complete point is the smallest last point over the files, one less when a file holding
   // several rows per point has only part of that point's rows.
   double last = std::numeric_limits<double>::infinity();
@@ -174,16 +181,14 @@ int repair_branch_files(const std::filesystem::path& out, const std::string& key
     return std::count_if(lines.begin() + 1, lines.end(),
                          [&](const std::string& l) { return first_cell(l) == point; });
   };
-  if (last >= 0 && contents.size() > 1) {
-    // Every point has as many rows as the first one (same unknowns, same samples).
-    const auto& u = contents[1];
-    const double first_point = first_cell(u[1]);
-    if (rows_of(u, last) != rows_of(u, first_point)) last -= 1;
-    if (contents.size() > 2) {
-      const auto& o = contents[2];
-      if (o.size() > 1 && rows_of(o, last) != rows_of(o, first_cell(o[1]))) last -= 1;
-    }
+  // Every point has as many rows in a file as the first one (same unknowns, same samples).
+  bool cut = false;
+  for (std::size_t i = 1; i < contents.size() && last >= 0; ++i) {
+    const auto& lines = contents[i];
+    if (lines.size() > 1 && rows_of(lines, last) != rows_of(lines, first_cell(lines[1])))
+      cut = true;
   }
+  if (cut) last -= 1;
   if (!(last >= 0))
     throw core::InputError(key, fmt::format("'{}' holds no complete point", out.string()));
   for (std::size_t i = 0; i < files.size(); ++i) {
@@ -244,69 +249,6 @@ core::Vector read_unknowns(const std::filesystem::path& path, int point, const s
     x[i] = v;
   }
   return x;
-}
-
-std::pair<std::filesystem::path, int> parse_saved_point(const std::string& text,
-                                                        const std::string& key) {
-  const auto colon = text.rfind(':');
-  int point = -1;
-  try {
-    std::size_t used = 0;
-    if (colon != std::string::npos) point = std::stoi(text.substr(colon + 1), &used);
-    if (colon == std::string::npos || used != text.size() - colon - 1) point = -1;
-  } catch (const std::exception&) {
-    point = -1;
-  }
-  if (point < 0) throw core::InputError(key, fmt::format("'{}' is not DIR:K with K >= 0", text));
-  std::filesystem::path dir = text.substr(0, colon);
-  if (dir.has_extension()) dir = dir.parent_path();
-  return {dir, point};
-}
-
-RestartPoint restart_point(const std::filesystem::path& dir, int point,
-                           const ContinuationOptions& options, const std::string& key) {
-  RestartPoint r;
-  const auto columns = read_columns(dir / "branch.csv",
-                                    {"point", "step_size", "newton_iterations", "arclength"}, key);
-  const std::vector<double>&index = columns[0], &step = columns[1], &iterations = columns[2],
-        &arclength = columns[3];
-  if (index.empty())
-    throw core::InputError(key, fmt::format("'{}' holds no point", (dir / "branch.csv").string()));
-  const double wanted = point < 0 ? index.back() : point;
-  const auto row = std::find(index.begin(), index.end(), wanted);
-  if (row == index.end())
-    throw core::InputError(key, fmt::format("'{}' has no point {}", (dir / "branch.csv").string(),
-                                            static_cast<int>(wanted)));
-  const std::size_t i = static_cast<std::size_t>(row - index.begin());
-  if (!(wanted >= 0 && wanted < 1e9 && iterations[i] >= 0 && iterations[i] < 1e6 &&
-        std::isfinite(step[i]) && std::isfinite(arclength[i])))
-    throw core::InputError(key, fmt::format("'{}': point {} has no valid step, iterations and "
-                                            "arclength",
-                                            (dir / "branch.csv").string(), wanted));
-  r.index = static_cast<int>(wanted);
-  r.x = read_unknowns(dir / "unknowns.csv", r.index, key);
-  r.arclength = arclength[i];
-  if (r.index > 0) {
-    r.secant = r.x - read_unknowns(dir / "unknowns.csv", r.index - 1, key);
-    r.next_step = adapted_step(step[i], static_cast<int>(iterations[i]), options);
-  }
-  return r;
-}
-
-void take_up(const RestartPoint& restart, const std::string& key, ContinuationOptions& options,
-             core::Vector& guess, core::Vector& direction) {
-  if (restart.x.size() != guess.size())
-    throw core::InputError(key, fmt::format("the saved point has {} unknowns, this scene's "
-                                            "problem {} (same grid keys?)",
-                                            restart.x.size(), guess.size()));
-  guess = restart.x;
-  if (restart.secant.size() == guess.size()) direction = restart.secant;
-  if (restart.next_step > 0)
-    options.ds = std::clamp(restart.next_step, options.ds_min, options.ds_max);
-  options.max_points -= restart.index;  // the saved point is the restart's first
-  if (options.max_points < 2)
-    throw core::InputError(
-        "max_points", fmt::format("the saved branch has {} points already", restart.index + 1));
 }
 
 }  // namespace backbone::continuation

@@ -5,8 +5,12 @@
 //   branch.csv    the columns of branch_table (branch.hpp): observables, dimension, cost
 //   orbits.csv    `point,x,u0`: the initial state of the orbit as (coordinate, value) samples
 //                 (core::PeriodicOrbitProblem::initial_state_samples), for figures
-//   unknowns.csv  `point,index,value`: the point's unknowns x in the problem's own layout, the
-//                 restart format (read_unknowns): `trace --resume DIR` and `--start DIR:K`
+//   unknowns.csv  `point,index,value`: the point's unknowns x in the problem's own layout
+//                 (read_unknowns)
+//   state.txt     `point state`: the loop's state after the point (restart.hpp, format_state;
+//                 `-` when the loop could not go on from it), what `trace --resume DIR` and
+//                 `--start DIR:K` continue from bit for bit (without it they correct the
+//                 unknowns again)
 // and flushes them, so even SIGKILL leaves readable files holding every completed point. A
 // row is written with one call, so at worst the last line is cut (read_csv refuses a short
 // row; remove it or resume, which rewrites the files).
@@ -14,7 +18,7 @@
 //   BranchWriter writer(out, periodic_or_null);
 //   hooks.on_point = [&](const BranchPoint& p) { writer.append(p); };
 //   ... continuation ...
-//   core::Vector x = read_unknowns(out / "unknowns.csv", /*point=*/-1);  // the last point
+//   core::Vector x = read_unknowns(out / "unknowns.csv", /*point=*/-1, "resume");  // the last
 #pragma once
 
 #include <cstdio>
@@ -25,6 +29,7 @@
 
 #include "continuation/branch.hpp"
 #include "continuation/options.hpp"
+#include "continuation/restart.hpp"  // parse_saved_point, restart_point: the restart format
 #include "core/periodic_orbit.hpp"
 #include "core/table.hpp"
 
@@ -62,42 +67,18 @@ class BranchWriter {
   struct File;
   std::filesystem::path out_;
   const core::PeriodicOrbitProblem* periodic_;
-  std::unique_ptr<File> branch_, orbits_, unknowns_;
+  std::unique_ptr<File> branch_, orbits_, unknowns_, state_;
   int points_ = 0;
 };
 
 // Makes the files of an interrupted run consistent: drops a line cut by the interruption and
 // every row of a point that is not complete in all of branch.csv, unknowns.csv (and orbits.csv
-// when present). Returns the last complete point; InputError naming `key` when there is none.
+// and state.txt when present). Returns the last complete point; InputError naming `key` when there
+// is none.
 int repair_branch_files(const std::filesystem::path& out, const std::string& key);
 
 // The unknowns of point `point` (-1: the last one) of an unknowns.csv. InputError naming `key`
 // when the file cannot be read or has no such point.
 core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key);
-
-// Where a restarted run takes up a saved branch (`trace --resume DIR`, `--start DIR:K`): the
-// saved point's unknowns, the secant from its predecessor (the direction the branch was going;
-// empty at point 0), the step the uninterrupted run would take next (step control of
-// adapted_step applied to the point's own step and Newton iterations; 0 at point 0: use ds),
-// and its index and arclength, so the restarted points continue the numbering.
-struct RestartPoint {
-  int index = 0;
-  core::Vector x;
-  core::Vector secant;
-  double next_step = 0;
-  double arclength = 0;
-};
-// InputError naming `key` when the folder lacks the files or the point.
-// Makes a run start from the saved point: guess = its unknowns, direction = its secant, ds =
-// the step it would have taken next (within [ds_min, ds_max]), max_points less the points
-// already saved. InputError naming `key` when the guess's size differs (another grid) or no
-// point would be left.
-void take_up(const RestartPoint& restart, const std::string& key, ContinuationOptions& options,
-             core::Vector& guess, core::Vector& direction);
-// "DIR:K" or "DIR/orbits.csv:K" (any file of DIR) -> (DIR, K); InputError naming `key`.
-std::pair<std::filesystem::path, int> parse_saved_point(const std::string& text,
-                                                        const std::string& key);
-RestartPoint restart_point(const std::filesystem::path& dir, int point,
-                           const ContinuationOptions& options, const std::string& key);
 
 }  // namespace backbone::continuation

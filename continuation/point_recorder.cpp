@@ -1,5 +1,7 @@
 #include "continuation/point_recorder.hpp"
 
+#include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -24,7 +26,7 @@ double PointRecorder::elapsed_seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-void PointRecorder::check_rank(BranchPoint& point) {
+void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_direction) {
   core::Matrix J;
   if (problem_.jacobian(point.x, J) != core::EvalStatus::ok) return;
   core::RankReport report = core::rank_report(J, options_.rank);
@@ -35,10 +37,39 @@ void PointRecorder::check_rank(BranchPoint& point) {
     point.dimension = report.nullity;
   }
   point.rank = std::move(report);
+  recheck_dimension(point, curve_direction);
+}
+
+void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& curve_direction) {
+  if (!verifier_ || !point.rank || point.rank->verified_dimension < 0 || point.dimension >= 1)
+    return;
+  point.dimension_flag = DimensionFlag::unconfirmed;
+  const double norm = curve_direction.norm();
+  if (curve_direction.size() != point.x.size() || !(norm > 0) || !std::isfinite(norm)) return;
+  core::RankReport along;
+  along.null_directions = curve_direction / norm;
+  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, along);
+  if (along.verified_dimension != 1) return;
+  // The curve is there. The rest of the candidate null space, orthogonal to it: the columns of
+  // an orthonormal basis of span(D) after the curve direction's component in it.
+  point.dimension_flag = DimensionFlag::rechecked;
+  point.dimension = 1;
+  const core::Matrix& D = point.rank->null_directions;
+  const Eigen::Index k = D.cols();
+  if (k < 2) return;
+  const core::Vector in_span = D.transpose() * along.null_directions.col(0);
+  if (!(in_span.norm() > 0)) return;
+  Eigen::HouseholderQR<core::Matrix> qr(core::Matrix(in_span / in_span.norm()));
+  const core::Matrix Q = qr.householderQ();
+  core::RankReport others;
+  others.null_directions = D * Q.rightCols(k - 1);
+  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, others);
+  point.dimension += std::max(others.verified_dimension, 0);
 }
 
 BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_iterations,
-                                  double ds, double arclength, bool force_rank) {
+                                  double ds, double arclength, bool force_rank,
+                                  const core::Vector& curve_direction) {
   BranchPoint p;
   p.index = index;
   p.x = x;
@@ -51,7 +82,7 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   p.step_size = ds;
   p.arclength = arclength;
   const bool due = options_.rank_check_every > 0 && index % options_.rank_check_every == 0;
-  if (due || (force_rank && options_.rank_check_every > 0)) check_rank(p);
+  if (due || (force_rank && options_.rank_check_every > 0)) check_rank(p, curve_direction);
   p.residual_evaluations = counted_.counters().residuals - residuals_at_start_;
   p.jacobian_evaluations = counted_.counters().jacobians - jacobians_at_start_;
   p.seconds = elapsed_seconds();

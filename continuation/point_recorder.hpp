@@ -3,13 +3,16 @@
 // PointRecorder measures the cost of a point (wall time, evaluations of the base problem since
 // begin()), evaluates its observables and residual, runs the rank report (+ verification, with
 // the corrector options.verification describes: core::make_verifier) when due, and checks the
-// bounds. Keeping this in one place makes natural and pseudo-arclength branches record exactly
-// the same columns; loop_steps.hpp drives it for both loops.
+// bounds. A verified dimension below 1 contradicts the curve the loop follows: it is re-checked
+// along the curve's direction (the tangent or chord the loop knows, branch.hpp: DimensionFlag).
+// Keeping this in one place makes natural and pseudo-arclength branches record exactly the
+// same columns; loop_steps.hpp drives it for both loops.
 //
 //   PointRecorder rec(problem, options);
 //   rec.begin();
 //   ... predict, correct ...
-//   BranchPoint p = rec.finish(x, index, newton_iterations, ds, arclength, /*last=*/false);
+//   BranchPoint p = rec.finish(x, index, newton_iterations, ds, arclength, /*last=*/false,
+//                              tangent);
 //   double value;
 //   if (const Bound* b = rec.violated_bound(p, value)) { ... }
 #pragma once
@@ -33,10 +36,15 @@ class PointRecorder {
                 const core::Problem* counted = nullptr);
   void begin();
   // Fills a BranchPoint; runs the rank report when index % rank_check_every == 0 or force_rank.
+  // curve_direction: the direction of the traced curve at x (empty: unknown), for the re-check.
   BranchPoint finish(const core::Vector& x, int index, int newton_iterations, double ds,
-                     double arclength, bool force_rank);
+                     double arclength, bool force_rank, const core::Vector& curve_direction = {});
   // Rank report (and verification) at an already recorded point.
-  void check_rank(BranchPoint& point);
+  void check_rank(BranchPoint& point, const core::Vector& curve_direction = {});
+  // With a verified dimension below 1 and a verifier: probes curve_direction; when it is real,
+  // the dimension is 1 plus the verified candidate directions orthogonal to it (flag
+  // rechecked), else the flag says unconfirmed. Nothing happens at a point of dimension >= 1.
+  void recheck_dimension(BranchPoint& point, const core::Vector& curve_direction);
   // First bound the point violates, or nullptr; `value` receives the bound value crossed.
   const Bound* violated_bound(const BranchPoint& point, double& value) const;
   double elapsed_seconds() const;

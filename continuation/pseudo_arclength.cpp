@@ -54,12 +54,15 @@ StopReason failure_reason(core::NewtonStatus s) {
 }
 
 // The loop proper, in the scaled unknowns z of `problem` (in_scaled_unknowns: the identity view
-// when options.scale_unknowns is false). Points are stored in z; the caller converts them.
+// when options.scale_unknowns is false). Points are stored in z; the caller converts them. It
+// starts from guess (corrected on the hyperplane through it orthogonal to the hint) or, with
+// `from`, continues from a saved state (restart.hpp) without correcting or re-deriving anything.
 Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
-                      const core::Vector& hint_in, core::Corrector& corrector,
+                      const core::Vector& hint_in, const LoopState* from, bool record_from,
+                      const BranchStart& start, core::Corrector& corrector,
                       const ContinuationOptions& options, const ContinuationHooks& hooks) {
-  const core::Vector hint = hint_in.normalized();
   const double threshold = options.rank.relative_threshold;
+<<<<<<< HEAD
   LoopSteps steps(problem, corrector, options, hooks);
   // One bordered system for every correction: F plus the arclength row, moved at each step.
   // The first point is the guess corrected on the hyperplane through it orthogonal to the hint.
@@ -74,24 +77,68 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
         StopReason::evaluation_failed,
         fmt::format("the Jacobian could not be evaluated at point 0 ({})", steps.describe(x)));
   if (options.start_along_direction) tangent = hint;
+=======
+  LoopSteps steps(problem, corrector, options, hooks, start);
+>>>>>>> a-resume
   std::optional<BranchPointDetector> detector;
-  if (options.branch_points.detect) {
-    detector.emplace(problem, options, hooks, corrector);
-    detector->add(0, x, tangent, J, 0.0);
+  if (options.branch_points.detect) detector.emplace(problem, options, hooks, corrector);
+  core::Vector x, tangent, previous;
+  core::Matrix J;
+  double ds = options.ds;
+  if (from) {
+    steps.resume(*from, record_from);
+    x = from->z;
+    tangent = from->tangent;
+    previous = from->previous;
+    ds = from->ds;
+    if (detector) {
+      // The detector is restored as it was before the saved point was added, then the point is
+      // added again from its Jacobian (the same bits: the same z).
+      detector->restore(from->samples, from->jacobian_scale);
+      if (problem.jacobian(x, J) != core::EvalStatus::ok)
+        return steps.end(StopReason::evaluation_failed,
+                         fmt::format("the Jacobian could not be evaluated at the saved point {} "
+                                     "({})",
+                                     from->index, steps.describe(x)));
+      detector->add(from->index, x, tangent, J, from->arclength);
+      for (BranchPointReport& report : detector->take()) steps.add_branch_point(std::move(report));
+    }
+  } else {
+    // One bordered system for every correction: F plus the arclength row, moved at each step.
+    // The first point is the guess corrected on the hyperplane through it orthogonal to the hint.
+    const core::Vector hint = hint_in.normalized();
+    core::BorderedSystem first(problem, {core::BorderRow::linear(hint, guess, 0.0, "arclength")});
+    x = guess;
+    if (!steps.start(first, x, "")) return steps.take();
+    if (problem.jacobian(x, J) != core::EvalStatus::ok ||
+        tangent_from_jacobian(J, hint, threshold, tangent) != core::EvalStatus::ok) {
+      steps.report_first(nullptr);
+      return steps.end(StopReason::evaluation_failed,
+                       fmt::format("the Jacobian could not be evaluated at point {} ({})",
+                                   start.index, steps.describe(x)));
+    }
+    auto state = std::make_shared<LoopState>();
+    state->method = Method::arclength;
+    state->z = x;
+    state->tangent = tangent;
+    state->ds = ds;
+    steps.report_first(std::move(state));
+    if (detector) {
+      detector->add(start.index, x, tangent, J, start.arclength);
+      for (BranchPointReport& report : detector->take()) steps.add_branch_point(std::move(report));
+    }
   }
+  core::BorderedSystem system(problem, {core::BorderRow::linear(tangent, x, 0.0, "arclength")});
   // Passing an attached family: a correction that turns away from the predictor direction by
   // more than max_turn_degrees landed on another family (or jumped a fold); it is refused, and
   // ds shrinks, so the branch keeps the direction closest to the incoming one.
   const double max_turn = options.branch_points.max_turn_degrees;
 
-  double ds = options.ds;
-  core::Vector previous = x;
-  bool have_previous = false;
   while (steps.begin_step()) {
     const int index = steps.next_index();
     // Predictor direction: the secant through the last two points, or the tangent.
     core::Vector step_direction = tangent;
-    if (options.predictor == Predictor::secant && have_previous) {
+    if (options.predictor == Predictor::secant && previous.size() > 0) {
       core::Vector secant = x - previous;
       if (secant.norm() > 0) step_direction = secant.normalized();
     }
@@ -132,7 +179,21 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
     if (tangent_status == core::EvalStatus::ok)
       tangent_status = tangent_from_jacobian(J, step_direction, threshold, next_tangent);
     const bool last = index + 1 == options.max_points || tangent_status != core::EvalStatus::ok;
-    if (!steps.record(x, y, step_direction, iterations, ds, last)) return steps.take();
+    // The state the next step starts from (saved with the point for a restart).
+    std::shared_ptr<LoopState> state;
+    if (tangent_status == core::EvalStatus::ok) {
+      state = std::make_shared<LoopState>();
+      state->method = Method::arclength;
+      state->z = y;
+      state->tangent = next_tangent;
+      if (options.predictor == Predictor::secant) state->previous = x;
+      state->ds = adapted_step(ds, iterations, options);
+      if (detector) {
+        state->samples = detector->samples();
+        state->jacobian_scale = detector->jacobian_scale();
+      }
+    }
+    if (!steps.record(x, y, step_direction, iterations, ds, last, state)) return steps.take();
     if (tangent_status != core::EvalStatus::ok)
       return steps.end(StopReason::evaluation_failed,
                        fmt::format("the Jacobian could not be evaluated at point {} ({}: {})",
@@ -141,11 +202,10 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
       detector->add(index, y, next_tangent, J, steps.arclength());
       for (BranchPointReport& report : detector->take()) steps.add_branch_point(std::move(report));
     }
-    previous = x;
-    have_previous = true;
+    if (options.predictor == Predictor::secant) previous = x;
     x = y;
     tangent = next_tangent;
-    ds = adapted_step(ds, iterations, options);
+    ds = state->ds;
   }
   return steps.take();
 }
@@ -154,7 +214,8 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
 
 Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
                         const core::Vector& direction, core::Corrector& corrector,
-                        const ContinuationOptions& options, const ContinuationHooks& hooks) {
+                        const ContinuationOptions& options, const ContinuationHooks& hooks,
+                        const BranchStart& start) {
   options.validate();
   check_sizes(problem, guess, direction, "pseudo-arclength follows curves");
   const int n = problem.num_unknowns();
@@ -164,9 +225,24 @@ Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
 
   return in_scaled_unknowns(
       problem, options, hooks, [&](const ScaledProblem& scaled, const ContinuationHooks& inner) {
-        return arclength_loop(scaled, scaled.to_scaled(guess), scaled.to_scaled(hint), corrector,
-                              options, inner);
+        return arclength_loop(scaled, scaled.to_scaled(guess), scaled.to_scaled(hint), nullptr,
+                              false, start, corrector, options, inner);
       });
+}
+
+Branch pseudo_arclength(const core::Problem& problem, const LoopState& from, bool record_from,
+                        core::Corrector& corrector, const ContinuationOptions& options,
+                        const ContinuationHooks& hooks) {
+  options.validate();
+  check_sizes(problem, from.z, from.tangent, "pseudo-arclength follows curves");
+  if (const std::string why = state_mismatch(from, problem, options, Method::arclength);
+      !why.empty())
+    throw core::InputError("state", why);
+  return in_scaled_unknowns(problem, options, hooks,
+                            [&](const ScaledProblem& scaled, const ContinuationHooks& inner) {
+                              return arclength_loop(scaled, from.z, from.tangent, &from,
+                                                    record_from, {}, corrector, options, inner);
+                            });
 }
 
 }  // namespace backbone::continuation

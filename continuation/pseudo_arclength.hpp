@@ -23,11 +23,13 @@
 //   guess << 0.01, 6.283;  hint << 1.0, 0.0;          // Duffing: start at A = 0.01, A grows
 //   Branch b = pseudo_arclength(duffing, guess, hint, *newton, opt, hooks);
 //   // b.points[i].x, b.points[i].dimension, b.reason, b.message
+//   Branch rest = pseudo_arclength(duffing, *b.points[20].state, false, *newton, opt);  // 21, ...
 #pragma once
 
 #include "continuation/branch.hpp"
 #include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
+#include "continuation/restart.hpp"
 #include "core/newton.hpp"
 #include "core/problem.hpp"
 
@@ -46,9 +48,20 @@ core::EvalStatus tangent_from_jacobian(const core::Matrix& J, const core::Vector
                                        double relative_threshold, core::Vector& tangent);
 
 // Throws core::InputError for bad options, sizes (guess and direction must have n entries,
-// m >= n - 1) or a zero direction. Never throws on numerical failure.
+// m >= n - 1) or a zero direction. Never throws on numerical failure. start: index and arclength
+// of the first point (restart.hpp).
 Branch pseudo_arclength(const core::Problem& problem, const core::Vector& guess,
                         const core::Vector& direction, core::Corrector& corrector,
-                        const ContinuationOptions& options, const ContinuationHooks& hooks = {});
+                        const ContinuationOptions& options, const ContinuationHooks& hooks = {},
+                        const BranchStart& start = {});
+
+// Continues a branch from the loop state saved with one of its points (BranchPoint::state,
+// restart.hpp), bit for bit as the run that saved it: nothing is corrected or re-derived.
+// record_from: the saved point is the returned branch's first point (recorded again, its rank
+// checked), else the branch begins with the next point. InputError when the state does not fit
+// (state_mismatch: size, scale, method).
+Branch pseudo_arclength(const core::Problem& problem, const LoopState& from, bool record_from,
+                        core::Corrector& corrector, const ContinuationOptions& options,
+                        const ContinuationHooks& hooks = {});
 
 }  // namespace backbone::continuation

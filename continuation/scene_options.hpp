@@ -21,6 +21,7 @@
 
 #include "continuation/follow.hpp"
 #include "continuation/options.hpp"
+#include "continuation/restart.hpp"
 #include "continuation/switching.hpp"
 #include "core/newton.hpp"
 #include "core/periodic_orbit.hpp"
@@ -49,8 +50,11 @@ RunSettings read_run_settings(const core::Scene& scene);
 // Runs settings.options.method from guess. direction: the hint of pseudo-arclength (the first
 // tangent t has t . direction > 0). For natural methods the parameter is the period unknown of
 // a PeriodicOrbitProblem when natural_parameter is "period", else the named observable.
+// restart (after take_up, restart.hpp): with its state the run continues from it bit for bit;
+// without, guess (the saved point) is corrected again and the points numbered on from it.
 SwitchingBranch run_continuation(const core::Problem& problem, const core::Vector& guess,
                                  const core::Vector& direction, const RunSettings& settings,
-                                 core::Corrector& corrector, const ContinuationHooks& hooks);
+                                 core::Corrector& corrector, const ContinuationHooks& hooks,
+                                 const RestartPoint* restart = nullptr);
 
 }  // namespace backbone::continuation

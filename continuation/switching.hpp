@@ -8,7 +8,8 @@
 // secant through its last two, for the remaining max_points. The result is one branch: indices
 // and arclength continue across the switch (both loops measure it in the same scaled units,
 // options.hpp), switch_index says where it happened (-1: natural reached its planned end), and
-// the message says both parts.
+// the message says both parts. Continued from a saved loop state (restart.hpp), it goes on with
+// the part that saved it (the state's switch_index says which).
 //
 //   NaturalParameter T = NaturalParameter::of_unknown(problem.period_index(), "period", -1.0);
 //   SwitchingBranch b = natural_then_arclength(problem, guess, T, *newton, options, hooks);
@@ -19,6 +20,7 @@
 #include "continuation/callbacks.hpp"
 #include "continuation/natural.hpp"
 #include "continuation/options.hpp"
+#include "continuation/restart.hpp"
 #include "core/newton.hpp"
 #include "core/problem.hpp"
 
@@ -33,6 +35,12 @@ struct SwitchingBranch {
 // failure.
 SwitchingBranch natural_then_arclength(const core::Problem& problem, const core::Vector& guess,
                                        const NaturalParameter& parameter,
+                                       core::Corrector& corrector,
+                                       const ContinuationOptions& options,
+                                       const ContinuationHooks& hooks = {},
+                                       const BranchStart& start = {});
+SwitchingBranch natural_then_arclength(const core::Problem& problem, const LoopState& from,
+                                       bool record_from, const NaturalParameter& parameter,
                                        core::Corrector& corrector,
                                        const ContinuationOptions& options,
                                        const ContinuationHooks& hooks = {});

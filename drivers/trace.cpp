@@ -1,6 +1,6 @@
 // `backbone trace SCENE --branch NAME [--out DIR] [--key value ...]`: follows a family of
 // solutions (a nonlinear mode) by continuation and writes DIR/branch.csv, DIR/orbits.csv,
-// DIR/branch.png and DIR/summary.txt.
+// DIR/unknowns.csv, DIR/state.txt (the restart format), DIR/branch.png and DIR/summary.txt.
 //
 // The scene's `problem` key picks a plugin (continuation/plugin.hpp); its setup builds the
 // problem and the guess. Continuation settings are scene keys too (continuation/
@@ -17,6 +17,7 @@
 
 #include "continuation/outputs.hpp"
 #include "continuation/progress.hpp"
+#include "continuation/restart.hpp"
 #include "continuation/scene_options.hpp"
 #include "core/errors.hpp"
 #include "core/output_folder.hpp"
@@ -39,7 +40,8 @@ po::options_description driver_keys() {
       ("branch", po::value<std::string>(), "branch to follow (the problem lists its branches)")  //
       ("out", po::value<std::string>(), "output directory (default out/PROBLEM_BRANCH)")         //
       ("start", po::value<std::string>(),
-       "DIR:K (or DIR/orbits.csv:K): start from point K of a traced branch (its unknowns.csv)")  //
+       "DIR:K (or DIR/orbits.csv:K): start from point K of a traced branch (its saved loop "
+       "state, state.txt: the rest of that branch bit for bit)")  //
       ("direction", po::value<long>()->default_value(1),
        "with --start: +1 continues the saved branch's way, -1 goes back")  //
       ("help", "describe the command, the problem's keys and the continuation keys");
@@ -139,19 +141,21 @@ int run_trace(const std::vector<std::string>& args_in) {
     direction = core::Vector::Unit(
         problem.num_unknowns(), periodic ? periodic->period_index() : problem.num_unknowns() - 1);
 
-  // A restart takes up a saved point: its unknowns, the way the branch went, the next step.
+  // A restart takes up a saved point: its loop state (or its unknowns, the way the branch went,
+  // the next step), and numbers on from it.
   std::optional<cont::RestartPoint> restart;
+  const std::string restart_key = resume.empty() ? "start" : "resume";
   if (!resume.empty()) {
     cont::repair_branch_files(resume, "resume");
     restart = cont::restart_point(resume, -1, options, "resume");
+    restart->record_saved_point = false;  // it is in the files
   } else if (scene.has("start")) {
     const auto [dir, point] = cont::parse_saved_point(scene.text("start"), "start");
     restart = cont::restart_point(dir, point, options, "start");
-    if (restart->secant.size() == 0) restart->secant = direction;
-    restart->secant *= static_cast<double>(start_direction);
   }
   if (restart)
-    cont::take_up(*restart, resume.empty() ? "start" : "resume", options, setup.guess, direction);
+    cont::take_up(*restart, restart_key, static_cast<int>(start_direction), problem, options,
+                  setup.guess, direction);
 
   const int n = problem.num_unknowns(), m = problem.num_equations();
   if (m != n - 1 && corrector->name() == "kinsol")
@@ -168,19 +172,27 @@ int run_trace(const std::vector<std::string>& args_in) {
              periodic ? fmt::format("formulation {}, ", core::to_string(run.formulation)) : "",
              fmt::format("ds {:g} in [{:g}, {:g}], at most {} points", options.ds, options.ds_min,
                          options.ds_max, options.max_points),
-             restart ? fmt::format(", restarting from point {}", restart->index) : "");
+             restart ? fmt::format(", restarting from point {} ({})", restart->index,
+                                   restart->state ? "its saved loop state"
+                                                  : "corrected again: " + (restart->note.empty()
+                                                                               ? "no saved state"
+                                                                               : restart->note))
+                     : "");
 
   // Output: the resolved scene first (it reproduces the run), then every point as it comes.
+  std::size_t points_in_files = 0;      // the whole branch, a resumed run's saved points included
+  long dimension_flags[3] = {0, 0, 0};  // points per DimensionFlag (branch.hpp)
   const auto summary = [&](const std::string& status, const cont::Branch* branch, long rejected,
                            int switch_index) {
     return fmt::format(
         "problem {}\nbranch {}\nstatus {}\nequations {}\nunknowns {}\nexpected_dimension {}\n"
         "method {}\nnewton {}\nformulation {}\npoints {}\nrejected_corrections {}\n"
-        "switch_index {}\nstop_reason {}\nmessage {}\n",
+        "switch_index {}\nstop_reason {}\nmessage {}\ndimension_rechecked {}\n"
+        "dimension_unconfirmed {}\n",
         entry.name, branch_name, status, m, n, expected_dimension, cont::to_string(options.method),
-        corrector->name(), periodic ? core::to_string(run.formulation) : "-",
-        branch ? branch->points.size() : 0, rejected, switch_index,
-        branch ? cont::to_string(branch->reason) : "-", branch ? branch->message : "-");
+        corrector->name(), periodic ? core::to_string(run.formulation) : "-", points_in_files,
+        rejected, switch_index, branch ? cont::to_string(branch->reason) : "-",
+        branch ? branch->message : "-", dimension_flags[1], dimension_flags[2]);
   };
   cont::BranchWriter writer(out, periodic, restart.has_value() && !resume.empty());
   if (resume.empty())
@@ -191,17 +203,16 @@ int run_trace(const std::vector<std::string>& args_in) {
   stop_signal = 0;
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
-  const int offset = restart ? restart->index : 0;
-  const double arclength_offset = restart ? restart->arclength : 0;
   cont::ProgressLine progress(options);
   cont::ContinuationHooks hooks;
   hooks.cancel_requested = [] { return stop_signal != 0; };
   hooks.on_point = [&](const cont::BranchPoint& p_in) {
-    if (restart && !resume.empty() && p_in.index == 0) return;  // already in the files
-    cont::BranchPoint p = p_in;
-    p.index += offset;
-    p.arclength += arclength_offset;
+    if (restart && !resume.empty() && p_in.index == restart->index) return;  // in the files
+    const cont::BranchPoint& p = p_in;
     writer.append(p);
+    if (p.dimension_flag != cont::DimensionFlag::as_verified)
+      fmt::print(stderr, "backbone trace: point {}: {}\n", p.index, cont::dimension_warning(p));
+    dimension_flags[static_cast<int>(p.dimension_flag)] += 1;
     progress.finish();  // the point's line replaces the progress line, which follows it
     fmt::print("  {}{}\n", cont::point_line(p),
                setup.describe_point ? "  " + setup.describe_point(p) : "");
@@ -214,21 +225,21 @@ int run_trace(const std::vector<std::string>& args_in) {
   hooks.on_attempt = [&](const cont::StepAttempt& a) {
     if (a.rejection.empty()) return;
     ++rejected;
-    fmt::print("  point {:4d}  rejected at ds {:.3g}: {}\n", a.point + offset, a.ds, a.rejection);
+    fmt::print("  point {:4d}  rejected at ds {:.3g}: {}\n", a.point, a.ds, a.rejection);
   };
 
-  cont::SwitchingBranch result =
-      cont::run_continuation(problem, setup.guess, direction, run, *corrector, hooks);
+  cont::SwitchingBranch result = cont::run_continuation(
+      problem, setup.guess, direction, run, *corrector, hooks, restart ? &*restart : nullptr);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   progress.finish();
   cont::Branch& branch = result.branch;
-  for (cont::BranchPoint& p : branch.points) p.index += offset;
   const bool complete = !branch.points.empty() && !branch.ended_early();
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
   if (!branch.points.empty()) {
     // The figure and the extra outputs show the whole branch, saved points included.
     const core::Table table = core::Table::read_csv(out / "branch.csv");
+    points_in_files = table.rows();
     cont::plot_branch(out, table,
                       fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()),
                       entry.units);

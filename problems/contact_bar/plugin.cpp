@@ -108,6 +108,10 @@ po::options_description trace_keys() {
        "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
        "residual's round-off grows with the amplitude: measured at shooting_elements 100 on "
        "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there)")  //
+      ("max_residual_work", po::value<double>()->default_value(1e7),
+       "refuse a trace whose residual costs more than this many element-steps "
+       "(shooting_elements x steps_per_period; a point evaluates the residual about 2 x "
+       "shooting_elements times): raise it to run larger traces")  //
       ("return_tolerance", po::value<double>()->default_value(1e-6),
        "reject a converged point whose orbit, re-simulated over T by the exact oracle, misses "
        "u0 or v0 = 0 by more than this, relative to max|u0| (0: no check). Catches spurious "
@@ -119,6 +123,22 @@ po::options_description trace_keys() {
 }
 
 continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch);
+
+// The run's size against max_residual_work, before anything runs (simulate's max_steps habit):
+// one residual marches about elements x steps_per_period element-steps (measured: 0.1-0.15 us
+// per step at 20 intervals, problems/contact_bar/README.md, section 'Cost').
+void check_residual_work(const core::Scene& scene, const OrbitOptions& options) {
+  const double limit = scene.positive("max_residual_work");
+  const double work = static_cast<double>(options.elements) * options.steps_per_period;
+  if (work <= limit) return;
+  const bool steps = options.steps_per_period >= options.elements;
+  throw core::InputError(
+      steps ? "steps_per_period" : "shooting_elements",
+      fmt::format("shooting_elements x steps_per_period = {} x {} = {:.4g} element-steps per "
+                  "residual > max_residual_work {:.4g}; lower {} or raise max_residual_work",
+                  options.elements, options.steps_per_period, work, limit,
+                  steps ? "steps_per_period" : "shooting_elements"));
+}
 
 continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
   if (branch.rfind("subharmonic", 0) == 0) return setup_subharmonic(scene, branch);
@@ -140,6 +160,7 @@ continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string
   options.elements =
       static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
   options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
+  check_residual_work(scene, options);
   const long knots = scene.integer("free_knots", -1);
   options.free_knots = knots < 0 ? (mode == 2 ? 1 : 0) : static_cast<int>(knots);
   const long test_elements = scene.integer("test_elements", -1);
@@ -295,6 +316,7 @@ continuation::TraceSetup setup_subharmonic(const core::Scene& scene, const std::
   options.elements =
       static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
   options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
+  check_residual_work(scene, options);
   options.start_on_wall = true;
   const long knots = scene.integer("free_knots", -1);
   options.free_knots = knots < 0 ? 2 : static_cast<int>(knots);

@@ -1,0 +1,290 @@
+#include "continuation/restart.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "continuation/loop_steps.hpp"
+#include "continuation/outputs.hpp"
+#include "core/errors.hpp"
+#include "core/table.hpp"
+
+namespace backbone::continuation {
+
+namespace {
+
+// fmt's "{}" is the shortest text that reads back to the same double (std::strtod).
+std::string number(double v) {
+  return fmt::format("{}", v);
+}
+
+std::string numbers(const core::Vector& v) {
+  std::string text;
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (i) text += ',';
+    text += number(v[i]);
+  }
+  return text;
+}
+
+class StateReader {
+ public:
+  StateReader(const std::string& line, const std::string& key, const std::string& where)
+      : key_(key), where_(where) {
+    std::istringstream in(line);
+    std::string token;
+    while (in >> token) {
+      const auto eq = token.find('=');
+      if (eq == std::string::npos || eq == 0) fail(fmt::format("'{}' is not name=value", token));
+      fields_[token.substr(0, eq)] = token.substr(eq + 1);
+    }
+  }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw core::InputError(key_, fmt::format("{}: {}", where_, what));
+  }
+  const std::string& text(const std::string& name) const {
+    const auto it = fields_.find(name);
+    if (it == fields_.end()) fail(fmt::format("the loop state has no '{}'", name));
+    return it->second;
+  }
+  double value(const std::string& name) const { return parse(text(name), name); }
+  int whole(const std::string& name) const {
+    const double v = value(name);
+    if (!(v >= -1 && v < 1e9 && v == std::floor(v)))
+      fail(fmt::format("'{}' = {} is not a whole number in [-1, 1e9)", name, v));
+    return static_cast<int>(v);
+  }
+  core::Vector vector(const std::string& name) const {
+    const std::string& t = text(name);
+    std::vector<double> values;
+    std::size_t start = 0;
+    while (start < t.size()) {
+      const auto comma = std::min(t.find(',', start), t.size());
+      values.push_back(parse(t.substr(start, comma - start), name));
+      start = comma + 1;
+    }
+    return Eigen::Map<const core::Vector>(values.data(), static_cast<Eigen::Index>(values.size()));
+  }
+
+ private:
+  double parse(const std::string& t, const std::string& name) const {
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (t.empty() || end != t.c_str() + t.size())
+      fail(fmt::format("'{}' of '{}' is not a number", t, name));
+    return v;
+  }
+  std::string key_, where_;
+  std::map<std::string, std::string> fields_;
+};
+
+}  // namespace
+
+std::string format_state(const LoopState& s) {
+  std::string line = fmt::format(
+      "method={} index={} arclength={} ds={} lambda={} previous_step={} switch_index={} "
+      "jacobian_scale={} scale={} z={} tangent={} previous={} samples={}",
+      to_string(s.method), s.index, number(s.arclength), number(s.ds), number(s.lambda),
+      number(s.previous_step), s.switch_index, number(s.jacobian_scale), numbers(s.scale),
+      numbers(s.z), numbers(s.tangent), numbers(s.previous), s.samples.size());
+  for (std::size_t k = 0; k < s.samples.size(); ++k) {
+    const TestFunctionSample& a = s.samples[k];
+    line += fmt::format(
+        " sample{0}.index={1} sample{0}.s={2} sample{0}.value={3} sample{0}.continued={4} "
+        "sample{0}.z={5} sample{0}.tangent={6} sample{0}.left={7} sample{0}.right={8}",
+        k, a.index, number(a.s), number(a.tau.value), a.tau.continued ? 1 : 0, numbers(a.z),
+        numbers(a.tangent), numbers(a.tau.left), numbers(a.tau.right));
+  }
+  return line;
+}
+
+LoopState parse_state(const std::string& line, const std::string& key, const std::string& where) {
+  const StateReader in(line, key, where);
+  LoopState s;
+  const std::string& method = in.text("method");
+  if (method != to_string(Method::arclength) && method != to_string(Method::natural))
+    in.fail(fmt::format("method '{}' is not arclength or natural", method));
+  s.method = parse_method(method);
+  s.index = in.whole("index");
+  s.arclength = in.value("arclength");
+  s.ds = in.value("ds");
+  s.lambda = in.value("lambda");
+  s.previous_step = in.value("previous_step");
+  s.switch_index = in.whole("switch_index");
+  s.jacobian_scale = in.value("jacobian_scale");
+  s.scale = in.vector("scale");
+  s.z = in.vector("z");
+  s.tangent = in.vector("tangent");
+  s.previous = in.vector("previous");
+  const int samples = in.whole("samples");
+  if (samples < 0 || samples > 3) in.fail(fmt::format("{} detector samples (at most 3)", samples));
+  for (int k = 0; k < samples; ++k) {
+    const std::string p = fmt::format("sample{}.", k);
+    TestFunctionSample a;
+    a.index = in.whole(p + "index");
+    a.s = in.value(p + "s");
+    a.tau.value = in.value(p + "value");
+    a.tau.continued = in.value(p + "continued") != 0;
+    a.z = in.vector(p + "z");
+    a.tangent = in.vector(p + "tangent");
+    a.tau.left = in.vector(p + "left");
+    a.tau.right = in.vector(p + "right");
+    s.samples.push_back(std::move(a));
+  }
+  const Eigen::Index n = s.z.size();
+  const bool sizes_agree =
+      n > 0 && s.scale.size() == n && (s.tangent.size() == n || s.tangent.size() == 0) &&
+      (s.previous.size() == n || s.previous.size() == 0) &&
+      std::all_of(s.samples.begin(), s.samples.end(), [&](const TestFunctionSample& a) {
+        return a.z.size() == n && a.tangent.size() == n && a.tau.right.size() == n;
+      });
+  if (!sizes_agree) in.fail(fmt::format("the vectors of the loop state differ in size"));
+  if (s.method == Method::arclength && s.tangent.size() == 0)
+    in.fail("an arclength state needs its tangent");
+  if (!(s.ds > 0) || !s.z.allFinite() || !s.scale.allFinite())
+    in.fail("the loop state has no finite point, scale and positive step");
+  return s;
+}
+
+std::pair<std::filesystem::path, int> parse_saved_point(const std::string& text,
+                                                        const std::string& key) {
+  const auto colon = text.rfind(':');
+  int point = -1;
+  try {
+    std::size_t used = 0;
+    if (colon != std::string::npos) point = std::stoi(text.substr(colon + 1), &used);
+    if (colon == std::string::npos || used != text.size() - colon - 1) point = -1;
+  } catch (const std::exception&) {
+    point = -1;
+  }
+  if (point < 0) throw core::InputError(key, fmt::format("'{}' is not DIR:K with K >= 0", text));
+  std::filesystem::path dir = text.substr(0, colon);
+  if (dir.has_extension()) dir = dir.parent_path();
+  return {dir, point};
+}
+
+namespace {
+
+// The state saved with point `point` in state.txt (null when the file or the state is absent).
+std::shared_ptr<const LoopState> read_state(const std::filesystem::path& path, int point,
+                                            const std::string& key) {
+  std::ifstream in(path);
+  if (!in) return nullptr;
+  std::string line;
+  const std::string prefix = fmt::format("{} ", point);
+  while (std::getline(in, line)) {
+    if (line.rfind(prefix, 0) != 0) continue;
+    const std::string rest = line.substr(prefix.size());
+    if (rest == "-") return nullptr;
+    auto state = std::make_shared<LoopState>(
+        parse_state(rest, key, fmt::format("'{}', point {}", path.string(), point)));
+    if (state->index != point)
+      throw core::InputError(key, fmt::format("'{}': the state of point {} says index {}",
+                                              path.string(), point, state->index));
+    return state;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+RestartPoint restart_point(const std::filesystem::path& dir, int point,
+                           const ContinuationOptions& options, const std::string& key) {
+  RestartPoint r;
+  core::Table table({"point"});
+  try {
+    table = core::Table::read_csv(dir / "branch.csv");
+  } catch (const core::InputError& e) {
+    throw core::InputError(key, e.what());
+  }
+  const std::string file = (dir / "branch.csv").string();
+  const auto column = [&](const char* name) {
+    try {
+      return table.column(name);
+    } catch (const core::InputError& e) {
+      throw core::InputError(key, e.what());
+    }
+  };
+  const auto index = column("point"), step = column("step_size"),
+             iterations = column("newton_iterations"), arclength = column("arclength");
+  if (index.empty()) throw core::InputError(key, fmt::format("'{}' holds no point", file));
+  const double wanted = point < 0 ? index.back() : point;
+  const auto row = std::find(index.begin(), index.end(), wanted);
+  if (row == index.end())
+    throw core::InputError(
+        key, fmt::format("'{}' has no point {}", file, static_cast<long long>(wanted)));
+  const std::size_t i = static_cast<std::size_t>(row - index.begin());
+  if (!(wanted >= 0 && wanted < 1e9 && iterations[i] >= 0 && iterations[i] < 1e6 &&
+        std::isfinite(step[i]) && std::isfinite(arclength[i])))
+    throw core::InputError(key, fmt::format("'{}': point {} has no valid step, iterations and "
+                                            "arclength",
+                                            file, wanted));
+  r.index = static_cast<int>(wanted);
+  r.x = read_unknowns(dir / "unknowns.csv", r.index, key);
+  r.arclength = arclength[i];
+  if (r.index > 0) {
+    r.secant = r.x - read_unknowns(dir / "unknowns.csv", r.index - 1, key);
+    r.next_step = adapted_step(step[i], static_cast<int>(iterations[i]), options);
+  }
+  r.state = read_state(dir / "state.txt", r.index, key);
+  return r;
+}
+
+std::string state_mismatch(const LoopState& state, const core::Problem& problem,
+                           const ContinuationOptions& options) {
+  const bool natural_run =
+      options.method == Method::natural ||
+      (options.method == Method::natural_then_arclength && state.switch_index < 0);
+  return state_mismatch(state, problem, options, natural_run ? Method::natural : Method::arclength);
+}
+
+std::string state_mismatch(const LoopState& state, const core::Problem& problem,
+                           const ContinuationOptions& options, Method loop) {
+  const int n = problem.num_unknowns();
+  if (state.z.size() != n)
+    return fmt::format("the saved state has {} unknowns, the problem {}", state.z.size(), n);
+  const ScaledProblem scaled(problem, loop_unit_scale(problem, options));
+  if (state.scale != scaled.scale())
+    return "the saved state was taken in other scaled units (another scene or scale_unknowns)";
+  if (state.method != loop)
+    return fmt::format("the saved state is of a {} loop, this run's is {}", to_string(state.method),
+                       to_string(loop));
+  return {};
+}
+
+void take_up(RestartPoint& restart, const std::string& key, int direction,
+             const core::Problem& problem, ContinuationOptions& options, core::Vector& guess,
+             core::Vector& hint) {
+  if (restart.x.size() != guess.size())
+    throw core::InputError(key, fmt::format("the saved point has {} unknowns, this scene's "
+                                            "problem {} (same grid keys?)",
+                                            restart.x.size(), guess.size()));
+  if (restart.index + 1 >= options.max_points)
+    throw core::InputError(
+        "max_points", fmt::format("the saved branch has {} points already", restart.index + 1));
+  if (restart.state) {
+    restart.note = state_mismatch(*restart.state, problem, options);
+    if (!restart.note.empty()) restart.state = nullptr;
+  }
+  if (restart.state && direction < 0) {
+    auto back = std::make_shared<LoopState>(*restart.state);
+    back->tangent = -back->tangent;
+    back->previous = back->method == Method::natural ? back->z : core::Vector();
+    back->previous_step = 0;
+    back->samples.clear();
+    restart.state = back;
+  }
+  guess = restart.x;
+  if (restart.secant.size() == guess.size()) hint = restart.secant;
+  hint *= static_cast<double>(direction);
+  // A state carries its own step (options.ds stays the first step of a later arclength part).
+  if (restart.next_step > 0 && !restart.state)
+    options.ds = std::clamp(restart.next_step, options.ds_min, options.ds_max);
+}
+
+}  // namespace backbone::continuation

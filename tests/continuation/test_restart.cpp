@@ -1,0 +1,227 @@
+// Restarting a branch from the loop state saved with one of its points (continuation/
+// restart.hpp): the state's text form reads back bit for bit, and every loop continued from the
+// state of point k, written and read back as state.txt would hold it, takes exactly the steps
+// of the uninterrupted run. The oracle is that run itself, compared with ==: the arithmetic of
+// both runs is the same, so any difference is state the restart lost (the re-corrected point,
+// the re-derived tangent or step of the restart this replaced moved the branch by ~1e-14 and
+// then let it diverge at a retried step).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "continuation/branch_points.hpp"
+#include "continuation/natural.hpp"
+#include "continuation/pseudo_arclength.hpp"
+#include "continuation/restart.hpp"
+#include "continuation/switching.hpp"
+#include "core/errors.hpp"
+#include "problems/algebraic/algebraic.hpp"
+
+using namespace backbone;
+using continuation::Branch;
+using continuation::LoopState;
+
+namespace {
+
+core::Vector vec(double a, double b) {
+  core::Vector v(2);
+  v << a, b;
+  return v;
+}
+
+// x^2 + lambda = 1 with lambda in thousandths: typical scale (1, 1e-3), so the scaled unknowns
+// differ from the problem's and a restart from the unknowns alone would not be exact.
+class ScaledFold : public core::Problem {
+ public:
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 1; }
+  core::Observables observables(const core::Vector& x) const override {
+    return {{"x", x[0]}, {"lambda", x[1]}};
+  }
+  core::Vector typical_scale() const override { return vec(1.0, 1e-3); }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    r.resize(1);
+    r[0] = x[0] * x[0] + 1e3 * x[1] - 1.0;
+    return core::EvalStatus::ok;
+  }
+};
+
+// The state of a point as it comes back from state.txt.
+LoopState through_text(const continuation::BranchPoint& p) {
+  EXPECT_TRUE(p.state) << "point " << p.index << " has no saved state";
+  return continuation::parse_state(continuation::format_state(*p.state), "state", "test");
+}
+
+// Points from index `from` + 1 on of `full` and all of `rest` (which begins there) are equal,
+// every unknown and the step and arclength of each point.
+void expect_same_tail(const Branch& full, const Branch& rest, int from) {
+  ASSERT_EQ(full.points.size(), from + 1 + rest.points.size()) << rest.message;
+  for (std::size_t i = 0; i < rest.points.size(); ++i) {
+    const auto& a = full.points[from + 1 + i];
+    const auto& b = rest.points[i];
+    EXPECT_EQ(a.index, b.index);
+    EXPECT_TRUE(a.x == b.x) << "point " << a.index << ": " << (a.x - b.x).norm();
+    EXPECT_EQ(a.step_size, b.step_size) << a.index;
+    EXPECT_EQ(a.arclength, b.arclength) << a.index;
+    EXPECT_EQ(a.newton_iterations, b.newton_iterations) << a.index;
+  }
+  EXPECT_EQ(full.reason, rest.reason);
+}
+
+continuation::ContinuationOptions options(int points) {
+  continuation::ContinuationOptions o;
+  o.ds = 0.05;
+  o.ds_max = 0.3;
+  o.max_points = points;
+  o.rank_check_every = 0;
+  o.verify = false;
+  return o;
+}
+
+}  // namespace
+
+// Awkward doubles (a third, subnormals, -0, the largest, an infinity) and vectors of every
+// field come back identical.
+TEST(LoopState, TextFormReadsBackBitForBit) {
+  LoopState s;
+  s.method = continuation::Method::natural;
+  s.index = 17;
+  s.arclength = 1.0 / 3.0;
+  s.ds = 0.1 + 0.2;
+  s.lambda = -0.0;
+  s.previous_step = std::numeric_limits<double>::denorm_min();
+  s.switch_index = 9;
+  s.jacobian_scale = std::numeric_limits<double>::max();
+  s.scale = vec(1e-300, 7.0 / 3.0);
+  s.z = vec(std::nextafter(1.0, 2.0), -1e-310);
+  s.tangent = vec(0.6, -0.8);
+  continuation::TestFunctionSample a;
+  a.index = 16;
+  a.s = 2.0 / 7.0;
+  a.z = vec(1e-17, 3.0);
+  a.tangent = vec(1.0, 0.0);
+  a.tau.value = -std::numeric_limits<double>::infinity();
+  a.tau.continued = false;
+  a.tau.left = core::Vector::Constant(3, std::sqrt(2.0));
+  a.tau.right = vec(std::sqrt(3.0), -std::sqrt(5.0));
+  s.samples = {a, a};
+  const LoopState b = continuation::parse_state(continuation::format_state(s), "state", "test");
+  EXPECT_EQ(b.method, s.method);
+  EXPECT_EQ(b.index, s.index);
+  for (const auto& [x, y] :
+       std::vector<std::pair<double, double>>{{b.arclength, s.arclength},
+                                              {b.ds, s.ds},
+                                              {b.previous_step, s.previous_step},
+                                              {b.jacobian_scale, s.jacobian_scale}})
+    EXPECT_EQ(x, y);
+  EXPECT_TRUE(std::signbit(b.lambda));
+  EXPECT_EQ(b.switch_index, 9);
+  EXPECT_TRUE(b.scale == s.scale && b.z == s.z && b.tangent == s.tangent);
+  EXPECT_EQ(b.previous.size(), 0);
+  ASSERT_EQ(b.samples.size(), 2u);
+  EXPECT_EQ(b.samples[1].index, 16);
+  EXPECT_EQ(b.samples[1].s, a.s);
+  EXPECT_EQ(b.samples[1].tau.value, a.tau.value);
+  EXPECT_FALSE(b.samples[1].tau.continued);
+  EXPECT_TRUE(b.samples[1].tau.left == a.tau.left && b.samples[1].tau.right == a.tau.right);
+  EXPECT_TRUE(b.samples[1].z == a.z && b.samples[1].tangent == a.tangent);
+}
+
+TEST(LoopState, DefectsAreInputErrorsNamingTheKey) {
+  LoopState s;
+  s.z = vec(1, 2);
+  s.scale = vec(1, 1);
+  s.tangent = vec(1, 0);
+  s.ds = 0.1;
+  const std::string good = continuation::format_state(s);
+  EXPECT_NO_THROW(continuation::parse_state(good, "resume", "test"));
+  for (const std::string& bad :
+       {std::string("method=arclength"), good + " z=1,x", good + " tangent=1", good + " ds=0",
+        good + " samples=4", good + " junk"}) {
+    try {
+      continuation::parse_state(bad, "resume", "test");
+      ADD_FAILURE() << bad;
+    } catch (const core::InputError& e) {
+      EXPECT_EQ(e.key(), "resume") << bad;
+    }
+  }
+}
+
+// Pseudo-arclength round the fold of x^2 + 1000 lambda = 1 (tangent and secant predictors,
+// the step growing and shrinking), continued from the states of points 0, 7 and 20.
+TEST(PseudoArclength, ContinuesFromASavedStateBitForBit) {
+  ScaledFold fold;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  for (const auto predictor : {continuation::Predictor::tangent, continuation::Predictor::secant}) {
+    auto opt = options(40);
+    opt.predictor = predictor;
+    const Branch full =
+        continuation::pseudo_arclength(fold, vec(-1.5, -1.25e-3), vec(1, 0), *newton, opt);
+    ASSERT_EQ(full.points.size(), 40u) << full.message;
+    ASSERT_GT(full.points.back().x[0], 0.5);  // round the fold at x = 0
+    for (int k : {0, 7, 20}) {
+      const LoopState state = through_text(full.points[k]);
+      const Branch rest = continuation::pseudo_arclength(fold, state, false, *newton, opt);
+      expect_same_tail(full, rest, k);
+      // record_from: the saved point comes first, as it was (not corrected again).
+      const Branch with = continuation::pseudo_arclength(fold, state, true, *newton, opt);
+      ASSERT_FALSE(with.points.empty());
+      EXPECT_TRUE(with.points.front().x == full.points[k].x);
+      EXPECT_EQ(with.points.front().index, k);
+    }
+  }
+}
+
+// Natural continuation in lambda, and the paper's strategy continued from a state of its
+// natural part (before the switch) and of its arclength part (after it).
+TEST(NaturalThenArclength, ContinuesFromSavedStatesOfBothParts) {
+  ScaledFold fold;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = options(50);
+  opt.ds_min = 1e-4;
+  const auto lambda = continuation::NaturalParameter::of_unknown(1, "lambda");
+  const Branch natural =
+      continuation::natural(fold, vec(-1.5, -1.25e-3), lambda, *newton, options(20));
+  ASSERT_EQ(natural.points.size(), 20u) << natural.message;
+  expect_same_tail(natural,
+                   continuation::natural(fold, through_text(natural.points[6]), false, lambda,
+                                         *newton, options(20)),
+                   6);
+  const auto full =
+      continuation::natural_then_arclength(fold, vec(-1.5, -1.25e-3), lambda, *newton, opt);
+  ASSERT_GT(full.switch_index, 3) << full.branch.message;
+  ASSERT_LT(full.switch_index + 5, 50);
+  for (int k : {full.switch_index - 2, full.switch_index - 1, full.switch_index + 3}) {
+    const LoopState state = through_text(full.branch.points[k]);
+    const auto rest =
+        continuation::natural_then_arclength(fold, state, false, lambda, *newton, opt);
+    EXPECT_EQ(rest.switch_index, full.switch_index) << k;
+    expect_same_tail(full.branch, rest.branch, k);
+  }
+}
+
+// A state is taken up only by a run in the same scaled units: another typical scale, another
+// size or another loop is refused, named.
+TEST(LoopState, MismatchIsNamed) {
+  ScaledFold fold;
+  algebraic::FoldCurve unit_fold;  // typical scale 1
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  const auto opt = options(5);
+  const Branch b =
+      continuation::pseudo_arclength(fold, vec(-1.5, -1.25e-3), vec(1, 0), *newton, opt);
+  const LoopState state = *b.points.back().state;
+  EXPECT_TRUE(continuation::state_mismatch(state, fold, opt).empty());
+  EXPECT_NE(continuation::state_mismatch(state, unit_fold, opt).find("scaled units"),
+            std::string::npos);
+  auto natural = opt;
+  natural.method = continuation::Method::natural;
+  EXPECT_NE(continuation::state_mismatch(state, fold, natural).find("arclength loop"),
+            std::string::npos);
+  EXPECT_THROW(continuation::pseudo_arclength(unit_fold, state, false, *newton, opt),
+               core::InputError);
+}
