@@ -62,24 +62,7 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
                       const BranchStart& start, core::Corrector& corrector,
                       const ContinuationOptions& options, const ContinuationHooks& hooks) {
   const double threshold = options.rank.relative_threshold;
-<<<<<<< HEAD
-  LoopSteps steps(problem, corrector, options, hooks);
-  // One bordered system for every correction: F plus the arclength row, moved at each step.
-  // The first point is the guess corrected on the hyperplane through it orthogonal to the hint.
-  core::BorderedSystem system(problem, {core::BorderRow::linear(hint, guess, 0.0, "arclength")});
-  core::Vector x = guess;
-  if (!steps.start(system, x, "")) return steps.take();
-  core::Vector tangent;
-  core::Matrix J;
-  if (problem.jacobian(x, J) != core::EvalStatus::ok ||
-      tangent_from_jacobian(J, hint, threshold, tangent) != core::EvalStatus::ok)
-    return steps.end(
-        StopReason::evaluation_failed,
-        fmt::format("the Jacobian could not be evaluated at point 0 ({})", steps.describe(x)));
-  if (options.start_along_direction) tangent = hint;
-=======
   LoopSteps steps(problem, corrector, options, hooks, start);
->>>>>>> a-resume
   std::optional<BranchPointDetector> detector;
   if (options.branch_points.detect) detector.emplace(problem, options, hooks, corrector);
   core::Vector x, tangent, previous;
@@ -117,6 +100,7 @@ Branch arclength_loop(const ScaledProblem& problem, const core::Vector& guess,
                        fmt::format("the Jacobian could not be evaluated at point {} ({})",
                                    start.index, steps.describe(x)));
     }
+    if (options.start_along_direction) tangent = hint;
     auto state = std::make_shared<LoopState>();
     state->method = Method::arclength;
     state->z = x;
