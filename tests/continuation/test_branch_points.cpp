@@ -9,28 +9,14 @@
 #include "continuation/pseudo_arclength.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
+#include "tests/continuation/test_support.hpp"
 
 using namespace backbone;
 using continuation::Branch;
+using continuation_tests::detecting;
+using continuation_tests::vec;
 
 namespace {
-
-continuation::ContinuationOptions detecting(double ds, int points) {
-  continuation::ContinuationOptions o;
-  o.ds = ds;
-  o.ds_max = ds;  // a fixed step, so that no point lands on a branch point by chance
-  o.max_points = points;
-  o.rank_check_every = 0;
-  o.branch_points.detect = true;
-  return o;
-}
-
-core::Vector vec(std::initializer_list<double> values) {
-  core::Vector v(static_cast<Eigen::Index>(values.size()));
-  Eigen::Index i = 0;
-  for (double x : values) v[i++] = x;
-  return v;
-}
 
 double largest_abs(const Branch& b, int coordinate) {
   double worst = 0;

@@ -18,18 +18,14 @@
 #include "continuation/switching.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
+#include "tests/continuation/test_support.hpp"
 
 using namespace backbone;
 using continuation::Branch;
 using continuation::StopReason;
+using continuation_tests::vec;
 
 namespace {
-
-core::Vector vec(double a, double b) {
-  core::Vector v(2);
-  v << a, b;
-  return v;
-}
 
 continuation::ContinuationOptions quick(int points) {
   continuation::ContinuationOptions o;

@@ -10,30 +10,14 @@
 #include "continuation/pseudo_arclength.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
+#include "tests/continuation/test_support.hpp"
 
 using namespace backbone;
 using continuation::Branch;
+using continuation_tests::detecting;
+using continuation_tests::vec;
 
-namespace {
-
-continuation::ContinuationOptions detecting(double ds, int points) {
-  continuation::ContinuationOptions o;
-  o.ds = ds;
-  o.ds_max = ds;
-  o.max_points = points;
-  o.rank_check_every = 0;
-  o.branch_points.detect = true;
-  return o;
-}
-
-core::Vector vec(std::initializer_list<double> values) {
-  core::Vector v(static_cast<Eigen::Index>(values.size()));
-  Eigen::Index i = 0;
-  for (double x : values) v[i++] = x;
-  return v;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 TEST(Follow, SelectionParsesNoneAllAndK) {
   using Kind = continuation::FollowSelection::Kind;

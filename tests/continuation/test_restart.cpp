@@ -19,18 +19,14 @@
 #include "continuation/switching.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
+#include "tests/continuation/test_support.hpp"
 
 using namespace backbone;
 using continuation::Branch;
 using continuation::LoopState;
+using continuation_tests::vec;
 
 namespace {
-
-core::Vector vec(double a, double b) {
-  core::Vector v(2);
-  v << a, b;
-  return v;
-}
 
 // x^2 + lambda = 1 with lambda in thousandths: typical scale (1, 1e-3), so the scaled unknowns
 // differ from the problem's and a restart from the unknowns alone would not be exact.
