@@ -122,13 +122,21 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
   const auto& names = saved.columns();
   const auto column =
       static_cast<std::size_t>(std::find(names.begin(), names.end(), "dimension") - names.begin());
+  const auto flag_column = static_cast<std::size_t>(
+      std::find(names.begin(), names.end(), "dimension_flag") - names.begin());
   std::vector<std::string> columns = names;
   for (const char* name : {"contact_phases", "grazing_instants", "min_gap"})
     columns.emplace_back(name);
   core::Table rewritten(columns);
   for (std::size_t i = 0; i < saved.rows(); ++i) {
     std::vector<core::Table::Cell> cells = saved.cells(i);
-    if (check && column < names.size() && i < dimensions.size()) cells[column] = dimensions[i];
+    if (check && column < names.size() && i < dimensions.size()) {
+      cells[column] = dimensions[i];
+      // Every member lies on the traced curve in F's zero set, so F's dimension is at least 1:
+      // a verified 0 (the probes left the two-knot chart near shape 0) is flagged unconfirmed
+      // (dimension_flag 2, continuation/README.md), never reported as an isolated orbit.
+      if (dimensions[i] < 1 && flag_column < names.size()) cells[flag_column] = 2.0;
+    }
     const bool known = i < structures.size() && structures[i].ok;
     const double nan = std::nan("");
     cells.emplace_back(known ? structures[i].contact_phases : nan);
