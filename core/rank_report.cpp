@@ -102,12 +102,27 @@ Probe probe(const Problem& problem, const Vector& x, const Vector& d, double h,
   Vector f;
   // Judge the corrected point by F itself (the corrector's own tolerance may be looser).
   if (problem.residual(y, f) != EvalStatus::ok) return result;
-  result.converged = (s.converged() || s.status == NewtonStatus::stalled) &&
-                     f.lpNorm<Eigen::Infinity>() <= options.residual_tolerance &&
-                     std::abs(d.dot(y - stepped)) <= options.residual_tolerance + 1e-12 * h;
+  result.converged =
+      (s.converged() || s.status == NewtonStatus::stalled) &&
+      f.lpNorm<Eigen::Infinity>() <= options.residual_tolerance &&
+      std::abs(d.dot(y - stepped)) <= options.residual_tolerance + 1e-12 * std::abs(h);
   result.secant = (y - x) / h;
-  result.drift = (y - stepped).norm() / h;
+  result.drift = (y - stepped).norm() / std::abs(h);
   return result;
+}
+
+bool found_neighbour(const Probe& p, const VerifyOptions& options) {
+  return p.converged && p.drift <= options.drift_ratio;
+}
+
+// Probes along +d, and along -d when +d finds no neighbour: at a point on the boundary of a
+// manifold (a grazing limit of a continuum) only one side holds solutions.
+Probe probe_either_side(const Problem& problem, const Vector& x, const Vector& d, double h,
+                        Corrector& corrector, const VerifyOptions& options) {
+  Probe forward = probe(problem, x, d, h, corrector, options);
+  if (found_neighbour(forward, options)) return forward;
+  Probe backward = probe(problem, x, d, -h, corrector, options);
+  return found_neighbour(backward, options) ? backward : forward;
 }
 
 }  // namespace
@@ -138,8 +153,8 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
   bool all_verified = true;
   for (int i = 0; i < k; ++i) {
     auto& p = first[static_cast<std::size_t>(i)];
-    p = probe(problem, x, D.col(i), step_along(D.col(i)), corrector, options);
-    all_verified = all_verified && p.converged && p.drift <= options.drift_ratio;
+    p = probe_either_side(problem, x, D.col(i), step_along(D.col(i)), corrector, options);
+    all_verified = all_verified && found_neighbour(p, options);
   }
   if (all_verified) {
     report.direction_verified.assign(static_cast<std::size_t>(k), true);
@@ -166,8 +181,9 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
   }
   int verified = 0;
   for (int i = 0; i < k; ++i) {
-    const Probe p = probe(problem, x, D.col(i), step_along(D.col(i)), corrector, options);
-    const bool real = p.converged && p.drift <= options.drift_ratio;
+    const Probe p =
+        probe_either_side(problem, x, D.col(i), step_along(D.col(i)), corrector, options);
+    const bool real = found_neighbour(p, options);
     report.direction_verified[static_cast<std::size_t>(i)] = real;
     verified += real ? 1 : 0;
   }

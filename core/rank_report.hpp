@@ -75,6 +75,8 @@ RankReport rank_report(const Matrix& J, const RankOptions& options);
 
 // Fills verified_dimension and direction_verified. Evaluates the problem; never throws on
 // numerical failure (a direction that fails to re-correct is simply not verified).
+// Each direction d is probed at +h, and at -h when +h finds no neighbour: at a point on the
+// boundary of a manifold (a grazing limit of a continuum) solutions lie on one side only.
 // When some candidate direction fails, the basis of the candidate null space is rotated
 // (same span, still orthonormal) onto the secants of the successful probes and probed again,
 // because the SVD basis need not be aligned with the solution set (J = 0 at a double root):

@@ -6,6 +6,7 @@
 //   EXPECT_TRUE(newton->solve(rosenbrock, x).converged());
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -81,6 +82,22 @@ class DoubleRootParabola : public Problem {
   EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override {
     const double g = x[1] - x[0] * x[0];
     J << -4.0 * x[0] * g, 2.0 * g;
+    return EvalStatus::ok;
+  }
+};
+
+// F(x, y) = max(x, 0)^2: the solution set is the half-plane x <= 0, a 2-manifold with the
+// boundary x = 0 (as a continuum of periodic orbits ends at its grazing limits). On the
+// boundary, solutions lie along -e_x only.
+class HalfPlane : public Problem {
+ public:
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 1; }
+
+ protected:
+  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
+    const double p = std::max(x[0], 0.0);
+    r[0] = p * p;
     return EvalStatus::ok;
   }
 };

@@ -16,6 +16,7 @@ namespace backbone::core {
 namespace {
 
 using testing::DoubleRootParabola;
+using testing::HalfPlane;
 using testing::Sphere;
 
 TEST(RankReport, DiagonalMatrixWithAClearGap) {
@@ -215,6 +216,25 @@ TEST(VerifyNullDirections, DoubleRootNeedsTheVerifiersIterationBudget) {
     verify_null_directions(p, x, *make_verifier(v), v, r);
     EXPECT_EQ(r.verified_dimension, cap == 60 ? 1 : 0) << cap << ": " << r.summary();
   }
+}
+
+TEST(VerifyNullDirections, BoundaryOfAHalfPlaneIsASurface) {
+  // At the origin e_x points out of the half-plane x <= 0: the probe at x = +h stalls at
+  // F = h^2 = 1e-6, far above the 1e-9 tolerance, so a one-sided verifier rejects it (given
+  // alone, no successful probe can rotate it). Solutions exist along -e_x (F = 0 exactly), so
+  // probing the other side verifies it, and with e_y the half-plane is a surface up to its
+  // boundary.
+  HalfPlane p;
+  const Vector x = Vector::Zero(2);
+  VerifyOptions v;
+  RankReport outward;
+  outward.null_directions = Vector::Unit(2, 0);
+  verify_null_directions(p, x, *make_verifier(v), v, outward);
+  EXPECT_EQ(outward.verified_dimension, 1) << outward.summary();
+  RankReport both;
+  both.null_directions = Matrix::Identity(2, 2);
+  verify_null_directions(p, x, *make_verifier(v), v, both);
+  EXPECT_EQ(both.verified_dimension, 2) << both.summary();
 }
 
 TEST(VerifyNullDirections, IsolatedRootHasNothingToVerify) {
