@@ -18,6 +18,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The main job's mode-1 trace with --follow (plugin.cpp, reproduce step mode1_resonances): at
+// 40 intervals, where the family attached at T = 3.2 L/c is resolved.
+constexpr const char* resonances_folder = "mode1_resonances";
+
 std::vector<fs::path> followed_branches(const fs::path& mode1) {
   std::vector<fs::path> attached;
   if (!fs::exists(mode1)) return attached;
@@ -32,10 +36,10 @@ std::vector<fs::path> followed_branches(const fs::path& mode1) {
 }  // namespace
 
 int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
-  const std::vector<fs::path> attached = followed_branches(out / "mode1");
+  const std::vector<fs::path> attached = followed_branches(out / resonances_folder);
   if (attached.empty()) {
     fmt::print("[figures] resonant_end skipped: no followed branch in {} (trace --follow)\n",
-               (out / "mode1").string());
+               (out / resonances_folder).string());
     return 0;
   }
   const core::Scene scene = core::read_scene(scene_keys(), scene_path.string(), {},
@@ -84,10 +88,10 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
 }
 
 int draw_resonant_spacetime(const fs::path& out, const fs::path& scene_path) {
-  const std::vector<fs::path> attached = followed_branches(out / "mode1");
+  const std::vector<fs::path> attached = followed_branches(out / resonances_folder);
   if (attached.empty()) {
     fmt::print("[figures] resonant_spacetime skipped: no followed branch in {} (trace --follow)\n",
-               (out / "mode1").string());
+               (out / resonances_folder).string());
     return 0;
   }
   const core::Scene scene = core::read_scene(scene_keys(), scene_path.string(), {},
@@ -137,7 +141,7 @@ int draw_resonant_spacetime(const fs::path& out, const fs::path& scene_path) {
 }
 
 int draw_attached_branches(const fs::path& out) {
-  const fs::path mode1 = out / "mode1";
+  const fs::path mode1 = out / resonances_folder;
   if (!fs::exists(mode1 / "branch.csv")) {
     fmt::print("[figures] attached_branches skipped: no {}\n", (mode1 / "branch.csv").string());
     return 0;

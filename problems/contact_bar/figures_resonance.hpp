@@ -1,6 +1,7 @@
 // Figures of the internal resonances of mode 1 (problems/contact_bar/README.md, section
 // 'Dimension changes'), drawn from the outputs of `backbone trace --branch mode1
-// --follow all`: OUT/mode1/branch.csv and the followed branches OUT/mode1/branch_point_K/.
+// --follow all` into OUT/mode1_resonances (the main job's step of that name: 40 intervals, E up
+// to 3e-5 J): its branch.csv and the followed branches branch_point_K/.
 //   attached_branches  attached_branches.png (paper Fig. 4, label d): frequency-energy plot of
 //                      mode 1 with every followed attached branch (vertical: they leave at
 //                      constant frequency) and the branch points of branch_points.csv
@@ -25,7 +26,7 @@ namespace backbone::contact_bar {
 
 std::vector<continuation::ProblemJob> resonance_figure_jobs();
 
-// 0 when drawn or skipped with a line (no OUT/mode1, or no followed branch in it).
+// 0 when drawn or skipped with a line (no OUT/mode1_resonances, or no followed branch in it).
 int draw_attached_branches(const std::filesystem::path& out);
 int draw_resonant_spacetime(const std::filesystem::path& out, const std::filesystem::path& scene);
 int draw_resonant_end(const std::filesystem::path& out, const std::filesystem::path& scene);
