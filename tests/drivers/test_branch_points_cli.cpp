@@ -103,7 +103,8 @@ TEST(BranchPointsCli, UnverifiedRowIsNotFollowed) {
 // exact oracle within return_tolerance = 1e-6 (trace's per-point check; closed_form_check.csv
 // re-measures it on another grid: measured 4.9e-9 worst).
 TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
-  const fs::path root = cli::scratch("branch_points_cli", "follow"), out = root / "mode1";
+  const fs::path root = cli::scratch("branch_points_cli", "follow"),
+                 out = root / "mode1_resonances";
   fs::create_directories(root);
   const cli::Run r = cli::run("trace", detecting + " --follow all --follow_max_points 30", out);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -134,7 +135,11 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   // 1e-8 relative) and contact at u(L) = g0 = 1e-3 (the exact oracle: round-off). The attached
   // orbit is mode 1 plus low-magnitude content: differs by more than 1e-6 and less than g0
   // (measured 1.0e-4 at E = 2.08e-5).
-  // From the source folder: the figure jobs read the paper scene by its repository path.
+  // From the source folder: the figure jobs read the paper scene by its repository path. The
+  // followed run is in mode1_resonances (the main job's folder); it also stands for mode1, so
+  // that the backbone figure has its branch.
+  fs::remove_all(root / "mode1");
+  fs::create_directory_symlink("mode1_resonances", root / "mode1");
   const std::string figures = "cd '" + std::string(BACKBONE_SOURCE_DIR) + "' && '" +
                               std::string(BACKBONE_BINARY_DIR) + "/bin/backbone' figures --out '" +
                               root.string() + "' > /dev/null 2>&1";
