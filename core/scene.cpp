@@ -17,9 +17,28 @@ namespace {
 
 constexpr const char* utf8_byte_order_mark = "\xEF\xBB\xBF";
 
+// Boost builds its message by replacing placeholders such as %value% with the user's text
+// until none is left: a value that itself contains "%value%" never ends (found by the fuzzer,
+// tests/fuzz/). The user's text is given a lookalike percent sign (U+FF05) before what().
+struct SubstitutionsOf : po::error_with_option_name {
+  static constexpr auto member = &SubstitutionsOf::m_substitutions;
+};
+
+std::string message_of(const po::error& e) {
+  const auto* named = dynamic_cast<const po::error_with_option_name*>(&e);
+  if (!named) return e.what();
+  po::error_with_option_name copy = *named;
+  for (auto& [placeholder, text] : copy.*SubstitutionsOf::member) {
+    std::string safe;
+    for (char ch : text) safe += ch == '%' ? std::string("\xEF\xBC\x85") : std::string(1, ch);
+    text = std::move(safe);
+  }
+  return copy.what();
+}
+
 // Boost's messages quote the option with its dashes; the user wants the key.
 [[noreturn]] void rethrow_as_input_error(const po::error& e, const std::string& where) {
-  std::string message = e.what();
+  std::string message = message_of(e);
   throw InputError("", where.empty() ? message : where + ": " + message);
 }
 
@@ -166,7 +185,7 @@ po::variables_map parse_options(const po::options_description& keys,
     po::store(po::command_line_parser(arguments).options(keys).run(), vm);
     po::notify(vm);
   } catch (const po::error& e) {
-    throw InputError("", e.what());
+    throw InputError("", message_of(e));
   }
   return vm;
 }

@@ -109,6 +109,21 @@ TEST_F(SceneInput, ByteOrderMarkIsSkipped) {
   EXPECT_THROW(read_scene(keys(), inside.string(), {}, {}), InputError);
 }
 
+// Boost's message template replaces %value% with the value until none is left, so a value
+// holding "%value%" looped for ever (a libFuzzer timeout, tests/fuzz/corpus/scene/
+// percent_placeholder). Now it is refused at once, quoted with a lookalike percent sign.
+TEST_F(SceneInput, ValueHoldingABoostPlaceholderIsRefusedWithoutHanging) {
+  const fs::path ini = write("percent.ini", "length = %value%'\n");
+  const std::string in_file = input_error([&] { read_scene(keys(), ini.string(), {}, {}); }, "");
+  EXPECT_NE(in_file.find("length"), std::string::npos) << in_file;
+  const std::string on_line = input_error(
+      [&] {
+        read_scene(keys(), "", {"--points", "%value%"}, {});
+      },
+      "");
+  EXPECT_NE(on_line.find("points"), std::string::npos) << on_line;
+}
+
 TEST_F(SceneInput, OutputFolderThatCanBeCreatedPassesAndLeavesNothing) {
   EXPECT_NO_THROW(check_output_folder("out", dir_ / "new" / "deeper"));
   EXPECT_NO_THROW(check_output_folder("out", dir_));  // an existing writable directory
