@@ -191,4 +191,19 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
   report.verified_dimension = verified;
 }
 
+RankReport rank_report_beside(const Problem& problem, const Vector& x, const Vector& into,
+                              double step, const RankOptions& options) {
+  RankReport best;
+  best.null_directions = Matrix(x.size(), 0);
+  const double norm = into.norm();
+  if (into.size() != x.size() || !(norm > 0) || !std::isfinite(norm)) return best;
+  for (const double side : {1.0, -1.0}) {
+    Matrix J;
+    if (problem.jacobian(x + (side * step / norm) * into, J) != EvalStatus::ok) continue;
+    RankReport there = rank_report(J, options);
+    if (there.nullity > best.nullity) best = std::move(there);
+  }
+  return best;
+}
+
 }  // namespace backbone::core

@@ -85,4 +85,14 @@ RankReport rank_report(const Matrix& J, const RankOptions& options);
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
                             const VerifyOptions& options, RankReport& report);
 
+// The candidates where J(x) cannot give them: at a point where F is not differentiable (the
+// grazing limit of a contact family, where a contact phase vanishes, forward differences mix
+// the two sides and see fewer null directions than the family has). `into` is a direction
+// along which the family is known to continue from x (a chord to a neighbouring point): the
+// rank report of J at x + s step into, s = +1 and -1, the one of larger nullity, whose null
+// directions verify_null_directions then probes from x itself. Empty report (nullity 0) when
+// neither Jacobian can be evaluated.
+RankReport rank_report_beside(const Problem& problem, const Vector& x, const Vector& into,
+                              double step, const RankOptions& options);
+
 }  // namespace backbone::core

@@ -22,6 +22,9 @@ std::string DimensionEvidence::text() const {
       "threshold {:.3e} = max({:.1e} x sigma_max, floor), gap sigma_rank / "
       "sigma_rank+1 = {:.3e}\n",
       report.threshold, report.relative_threshold, report.gap);
+  if (beside)
+    s += "candidates from J one probe step towards the neighbouring point (J here verified "
+         "fewer: F is not differentiable here)\n";
   s += "singular values (relative to sigma_max), smallest kept and all dropped:\n";
   const auto n = report.singular_values.size();
   const double top = n > 0 ? report.singular_values[0] : 1.0;
@@ -40,7 +43,8 @@ std::string DimensionEvidence::text() const {
 
 DimensionEvidence dimension_evidence(const core::Problem& problem, const core::Vector& x,
                                      const core::RankOptions& rank,
-                                     const core::VerifyOptions& verify) {
+                                     const core::VerifyOptions& verify,
+                                     const core::Vector& neighbour) {
   const auto start = std::chrono::steady_clock::now();
   DimensionEvidence e;
   e.step = verify.step;
@@ -52,6 +56,17 @@ DimensionEvidence dimension_evidence(const core::Problem& problem, const core::V
   e.report = core::rank_report(J, rank);
   auto verifier = core::make_verifier(verify);
   core::verify_null_directions(scaled, z, *verifier, verify, e.report);
+  if (neighbour.size() == x.size()) {
+    core::RankReport beside =
+        core::rank_report_beside(scaled, z, scaled.to_scaled(neighbour) - z, verify.step, rank);
+    if (beside.nullity > e.report.verified_dimension) {
+      core::verify_null_directions(scaled, z, *verifier, verify, beside);
+      if (beside.verified_dimension > e.report.verified_dimension) {
+        e.report = std::move(beside);
+        e.beside = true;
+      }
+    }
+  }
   // The distances along the final (possibly rotated) basis: the probe verify ran, repeated.
   for (Eigen::Index i = 0; i < e.report.null_directions.cols(); ++i) {
     const core::Vector d = e.report.null_directions.col(i);
@@ -98,8 +113,17 @@ int inspect_command(const continuation::ProblemPlugin& plugin,
     throw core::InputError("orbit", fmt::format("the point has {} unknowns, the problem {} (same "
                                                 "grid keys as the trace?)",
                                                 x.size(), setup.problem->num_unknowns()));
+  // The next point of the branch (else the previous one) as the neighbour, when there is one.
+  core::Vector neighbour;
+  for (const int other : {point + 1, point - 1}) {
+    if (point < 0 || other < 0 || neighbour.size() > 0) continue;  // point -1: the last
+    try {
+      neighbour = continuation::read_unknowns(dir / "unknowns.csv", other, "orbit");
+    } catch (const core::InputError&) {
+    }
+  }
   const DimensionEvidence e =
-      dimension_evidence(*setup.problem, x, run.options.rank, run.options.verification);
+      dimension_evidence(*setup.problem, x, run.options.rank, run.options.verification, neighbour);
   fmt::print("{} / {} point {}: {} equations, {} unknowns\n{}", plugin.name, branch, point,
              setup.problem->num_equations(), x.size(), e.text());
   return e.report.verified_dimension >= 0 ? core::exit_ok : core::exit_numerical_failure;

@@ -30,14 +30,21 @@ struct DimensionEvidence {
   double step = 0;          // probe step (scaled units)
   double drift_ratio = 0;
   std::vector<NullProbe> probes;  // one per (rotated) candidate null direction
+  // The candidates came from J a probe step towards the neighbour (core::rank_report_beside),
+  // because J(x) verified fewer directions: F is not differentiable at x.
+  bool beside = false;
   double seconds = 0;
   std::string text() const;  // the report `backbone inspect` prints
 };
 
 // Never throws on numerical failure (a failed Jacobian gives an empty report, dimension -1).
+// neighbour: another point of the same family (unknowns of the problem, e.g. the next member of
+// a branch) or empty. With it, the candidates of J one probe step along the chord towards it,
+// on either side, are verified too, and kept when they verify more directions (beside).
 DimensionEvidence dimension_evidence(const core::Problem& problem, const core::Vector& x,
                                      const core::RankOptions& rank,
-                                     const core::VerifyOptions& verify);
+                                     const core::VerifyOptions& verify,
+                                     const core::Vector& neighbour = {});
 
 // `backbone inspect SCENE --orbit DIR/orbits.csv:K [--branch NAME] [--key value ...]` for the
 // plugin of SCENE: builds the problem with plugin.setup (the branch of DIR/summary.txt unless

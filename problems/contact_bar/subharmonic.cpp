@@ -95,6 +95,7 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
                      "contact_phases", "grazing_instants", "min_gap", "return_error", "dimension_F",
                      "nullity_F", "gap_F", "seconds_F"});
   std::vector<double> dimensions;
+  std::vector<bool> beside;  // the dimension came from J beside the point (rechecked)
   std::vector<ContactStructure> structures;
   for (const auto& point : branch.points) {
     structures.push_back(
@@ -105,8 +106,15 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
     const ReturnError re = return_error(problem, point.x, oracle);
     const double nan = std::nan("");
     DimensionEvidence e;
-    if (check) e = dimension_evidence(alone, point.x, rank, core::VerifyOptions{});
+    // The neighbouring member: at a grazing limit F is not differentiable (a contact phase
+    // vanishes) and J there misses a direction that J a step into the continuum shows.
+    const std::size_t i = static_cast<std::size_t>(&point - branch.points.data());
+    const std::size_t j = i + 1 < branch.points.size() ? i + 1 : (i > 0 ? i - 1 : i);
+    if (check)
+      e = dimension_evidence(alone, point.x, rank, core::VerifyOptions{},
+                             j != i ? branch.points[j].x : core::Vector{});
     dimensions.push_back(check ? e.report.verified_dimension : nan);
+    beside.push_back(check && e.beside);
     table.add_row({static_cast<double>(point.index), energy, period, exact,
                    std::abs(period / exact - 1), point.observable("shape"),
                    c.ok ? c.contact_phases : nan, c.ok ? c.grazing_instants : nan,
@@ -136,6 +144,7 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
       // a verified 0 (the probes left the two-knot chart near shape 0) is flagged unconfirmed
       // (dimension_flag 2, continuation/README.md), never reported as an isolated orbit.
       if (dimensions[i] < 1 && flag_column < names.size()) cells[flag_column] = 2.0;
+      if (beside[i] && flag_column < names.size()) cells[flag_column] = 1.0;
     }
     const bool known = i < structures.size() && structures[i].ok;
     const double nan = std::nan("");

@@ -102,6 +102,20 @@ class HalfPlane : public Problem {
   }
 };
 
+// F = max(x, 0): the same half-plane x <= 0 as a zero set, but F has a kink on its boundary, so
+// the forward-difference Jacobian at the origin is (1, 0) (nullity 1) while the family is 2D.
+class KinkedHalfPlane : public Problem {
+ public:
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 1; }
+
+ protected:
+  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
+    r[0] = std::max(x[0], 0.0);
+    return EvalStatus::ok;
+  }
+};
+
 // A square system whose residual is NaN for x[0] > 0.5 (a "simulation that blew up").
 class NanBeyondHalf : public Problem {
  public:

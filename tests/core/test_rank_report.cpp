@@ -17,6 +17,7 @@ namespace {
 
 using testing::DoubleRootParabola;
 using testing::HalfPlane;
+using testing::KinkedHalfPlane;
 using testing::Sphere;
 
 TEST(RankReport, DiagonalMatrixWithAClearGap) {
@@ -235,6 +236,25 @@ TEST(VerifyNullDirections, BoundaryOfAHalfPlaneIsASurface) {
   both.null_directions = Matrix::Identity(2, 2);
   verify_null_directions(p, x, *make_verifier(v), v, both);
   EXPECT_EQ(both.verified_dimension, 2) << both.summary();
+}
+
+TEST(RankReportBeside, KinkOnTheBoundaryHidesADirectionThatTheInteriorShows) {
+  // At the origin forward differences give J = (1, 0): one candidate, e_y. The family (x <= 0)
+  // continues along -e_x; J there is exactly 0 (F = 0 for x < 0), so both directions are
+  // candidates and both verify from the origin (e_x on its -h side, F = 0 exactly).
+  KinkedHalfPlane p;
+  const Vector x = Vector::Zero(2);
+  VerifyOptions v;
+  Matrix J;
+  ASSERT_EQ(p.jacobian(x, J), EvalStatus::ok);
+  RankReport at = rank_report(J, RankOptions{});
+  EXPECT_EQ(at.nullity, 1);
+  RankReport beside = rank_report_beside(p, x, -Vector::Unit(2, 0), v.step, RankOptions{});
+  EXPECT_EQ(beside.nullity, 2);
+  verify_null_directions(p, x, *make_verifier(v), v, beside);
+  EXPECT_EQ(beside.verified_dimension, 2) << beside.summary();
+  // A direction along which nothing is known gives nothing.
+  EXPECT_EQ(rank_report_beside(p, x, Vector::Zero(2), v.step, RankOptions{}).nullity, 0);
 }
 
 TEST(VerifyNullDirections, IsolatedRootHasNothingToVerify) {
