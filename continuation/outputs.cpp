@@ -251,4 +251,42 @@ core::Vector read_unknowns(const std::filesystem::path& path, int point, const s
   return x;
 }
 
+Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
+                    const Branch& resumed) {
+  Branch whole;
+  const int first = resumed.points.empty() ? 0 : resumed.points.front().index;
+  if (first > 0) {
+    const auto columns = read_columns(dir / "unknowns.csv", {"point", "index", "value"}, "resume");
+    std::map<int, std::vector<double>> saved;  // point -> values in file order (index order)
+    for (std::size_t i = 0; i < columns[0].size(); ++i)
+      if (columns[0][i] >= 0 && columns[0][i] < first)
+        saved[static_cast<int>(columns[0][i])].push_back(columns[2][i]);
+    for (const auto& [index, values] : saved) {
+      BranchPoint p;
+      p.index = index;
+      p.x = Eigen::Map<const core::Vector>(values.data(), static_cast<Eigen::Index>(values.size()));
+      if (p.x.size() != problem.num_unknowns()) continue;
+      p.observables = problem.observables(p.x);
+      whole.points.push_back(std::move(p));
+    }
+  }
+  whole.points.insert(whole.points.end(), resumed.points.begin(), resumed.points.end());
+  whole.branch_points = resumed.branch_points;
+  whole.reason = resumed.reason;
+  whole.message = resumed.message;
+  return whole;
+}
+
+core::Table merge_saved_rows(const core::Table& saved, const core::Table& fresh,
+                             const std::string& column, double below) {
+  // An empty table may lack columns that only rows bring (the problem's descriptions).
+  if (saved.columns() != fresh.columns() && fresh.rows() > 0) return fresh;
+  core::Table merged(saved.columns());
+  const std::vector<double> key = saved.column(column);
+  for (std::size_t i = 0; i < saved.rows(); ++i)
+    if (key[i] < below) merged.add_cells(saved.cells(i));
+  for (std::size_t i = 0; i < fresh.rows(); ++i) merged.add_cells(fresh.cells(i));
+  return merged;
+}
+
 }  // namespace backbone::continuation

@@ -81,4 +81,17 @@ int repair_branch_files(const std::filesystem::path& out, const std::string& key
 // when the file cannot be read or has no such point.
 core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key);
 
+// A resumed run's whole branch, as its files hold it: the saved points before the first point of
+// `resumed` (their unknowns from DIR/unknowns.csv, observables recomputed by `problem`; rank
+// fields unset), then resumed's points, branch points, reason and message. Outputs written after
+// the run (the problem's extra outputs, branch_points.csv) then cover the whole branch.
+Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
+                    const Branch& resumed);
+
+// Rows of `saved` (an earlier run's table, e.g. branch_points.csv) whose column `column` is
+// below `below`, then the rows of `fresh`: the table of a resumed run. `fresh` alone when the
+// two tables have different columns and fresh has rows.
+core::Table merge_saved_rows(const core::Table& saved, const core::Table& fresh,
+                             const std::string& column, double below);
+
 }  // namespace backbone::continuation

@@ -243,10 +243,18 @@ int run_trace(const std::vector<std::string>& args_in) {
     cont::plot_branch(out, table,
                       fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()),
                       entry.units);
-    if (setup.write_extra_outputs) setup.write_extra_outputs(out, branch);
-    if (options.branch_points.detect)
-      cont::branch_point_table(branch, branch.points.front().observables)
-          .write_csv(out / "branch_points.csv");
+    // After --resume the branch holds only the resumed points; the files hold them all.
+    const cont::Branch whole =
+        resume.empty() ? cont::Branch{} : cont::whole_branch(out, problem, branch);
+    const cont::Branch& all = resume.empty() ? branch : whole;
+    if (setup.write_extra_outputs) setup.write_extra_outputs(out, all);
+    if (options.branch_points.detect) {
+      core::Table rows = cont::branch_point_table(branch, branch.points.front().observables);
+      if (!resume.empty() && std::filesystem::exists(out / "branch_points.csv"))
+        rows = cont::merge_saved_rows(core::Table::read_csv(out / "branch_points.csv"), rows,
+                                      "after_point", branch.points.front().index);
+      rows.write_csv(out / "branch_points.csv");
+    }
     for (const auto& f :
          cont::follow_branch_points(problem, branch, run.follow, *corrector, options, hooks, out,
                                     setup.write_extra_outputs, entry.units))

@@ -147,11 +147,12 @@ const std::string small_mode1 = paper + " --branch mode1 --shooting_elements 10 
 // resumed without a point budget to the energy bound. The whole branch, to its end, is the
 // uninterrupted run's bit for bit (the restart corrects and re-derives nothing; the restart this
 // replaced agreed to 1e-14 up to a retried step, then diverged), and so are unknowns.csv and
-// state.txt byte for byte.
+// state.txt byte for byte, and the closed-form check and branch points cover the whole branch.
 TEST(TraceCli, ResumeContinuesAnInterruptedBranch) {
   const fs::path full = cli::scratch("trace_cli", "full"), part = cli::scratch("trace_cli", "part");
-  ASSERT_EQ(cli::run("trace", small_mode1, full).code, 0);
-  ASSERT_EQ(cli::run("trace", small_mode1 + " --max_points 30", part).code, 0);
+  const std::string detect = small_mode1 + " --detect_branch_points true";
+  ASSERT_EQ(cli::run("trace", detect, full).code, 0);
+  ASSERT_EQ(cli::run("trace", detect + " --max_points 30", part).code, 0);
   const fs::path unknowns = part / "unknowns.csv";
   fs::resize_file(unknowns, fs::file_size(unknowns) - 10);  // cut the last row
   const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
@@ -169,6 +170,14 @@ TEST(TraceCli, ResumeContinuesAnInterruptedBranch) {
   expect_same_rows(a, b, 0, 0);
   EXPECT_EQ(file_text(part / "unknowns.csv"), file_text(full / "unknowns.csv"));
   EXPECT_EQ(file_text(part / "state.txt"), file_text(full / "state.txt"));
+  // The outputs written after the run cover the whole branch, saved points included.
+  EXPECT_EQ(file_text(part / "closed_form_check.csv"), file_text(full / "closed_form_check.csv"));
+  const auto bp_full = backbone::core::Table::read_csv(full / "branch_points.csv");
+  const auto bp_part = backbone::core::Table::read_csv(part / "branch_points.csv");
+  EXPECT_GE(bp_full.rows(), 1u);  // else the comparison below says nothing
+  ASSERT_EQ(bp_part.rows(), bp_full.rows());
+  for (const char* c : {"period", "energy", "after_point"})
+    EXPECT_EQ(bp_part.column(c), bp_full.column(c)) << c;
   EXPECT_NE(file_text(part / "summary.txt").find(fmt_points(a.rows())), std::string::npos);
   fs::remove_all(full);
   fs::remove_all(part);
