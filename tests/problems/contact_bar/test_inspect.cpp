@@ -48,5 +48,37 @@ TEST(DimensionEvidence, ModeTwoIsOneDimensional) {
   EXPECT_GT(e.report.gap, 1e4) << e.text();  // measured 2e7 on the traced branch
 }
 
+// Mode 1 over two periods (T = 2 T1, near omega1 / 2), started at rest away from the wall: the
+// same orbit run twice. Unlike mode 2 over two periods (a 2D continuum, README 'Subharmonic
+// continuum'), it is one-dimensional: a member of a continuum would need a second contact phase
+// of another shape, and mode 1's two phases per 2 T1 are copies. Amplitudes off the whole
+// multiples of g0 (T = 3 + 1/k: contact events on the time grid, where forward differences
+// give spurious candidates; README 'Dimension changes').
+TEST(DimensionEvidence, ModeOneOverTwoPeriodsIsACurve) {
+  bar::BarSetup s;
+  s.left = {bar::EndType::fixed, 0};
+  s.right = {bar::EndType::contact, 1e-3};
+  const TdbemSolver tdbem(ContactMethod::event);
+  core::RankOptions rank;
+  rank.relative_threshold = 1e-5;  // the trace default of the contact bar
+  for (const int elements : {20, 40}) {
+    OrbitOptions o;
+    o.elements = elements;
+    o.steps_per_period = 80;  // the dt of 40 steps over one period
+    o.test_elements = 2 * elements + 2;
+    const ContactBarOrbitProblem p(s, tdbem, o);
+    for (const double ratio : {3.3, 7.3}) {
+      core::Vector x = p.contact_family_guess(1, ratio);
+      x[p.period_index()] *= 2;
+      core::Vector r;
+      ASSERT_EQ(p.residual(x, r), core::EvalStatus::ok);
+      EXPECT_LT(r.lpNorm<Eigen::Infinity>(), 1e-12) << "the closed form solves F over 2 T1";
+      const DimensionEvidence e = dimension_evidence(p, x, rank, core::VerifyOptions{});
+      EXPECT_EQ(e.report.verified_dimension, 1) << elements << " " << ratio << "\n" << e.text();
+      EXPECT_GT(e.report.gap, 1e4) << e.text();  // measured 5e5-2e6: one clear null direction
+    }
+  }
+}
+
 }  // namespace
 }  // namespace backbone::contact_bar
