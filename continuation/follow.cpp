@@ -93,6 +93,13 @@ FollowedBranch follow_attached(const core::Problem& problem, const BranchPointRe
   return f;
 }
 
+core::NewtonOptions follow_newton_options(const core::NewtonOptions& newton,
+                                          const ContinuationOptions& options) {
+  core::NewtonOptions o = newton;
+  o.rank_cutoff = std::max(o.rank_cutoff, options.rank.relative_threshold);
+  return o;
+}
+
 std::vector<FollowedBranch> follow_branch_points(
     const core::Problem& problem, const Branch& branch, const FollowRun& run,
     core::Corrector& corrector, const ContinuationOptions& options, const ContinuationHooks& hooks,

@@ -94,6 +94,15 @@ struct FollowRun {
   std::string observable = "energy";
   int start_attempts = 3;
 };
+// The corrector settings for following: the rank cut-off raised to the rank report's relative
+// threshold. In an attached family of dimension d the bordered Jacobian has d - 1 singular
+// values at the finite-difference noise (1e-8..1e-6 relative at the contact bar's T = 3.5 and
+// 3.6 L/c, d = 19-24): a cut-off below them divides by noise, and the minimum-norm step jumps
+// across the family (measured: every step turned by 90 degrees, the branch ended after 6 and 12
+// points; with the cut-off, 30 of 30).
+core::NewtonOptions follow_newton_options(const core::NewtonOptions& newton,
+                                          const ContinuationOptions& options);
+
 std::vector<FollowedBranch> follow_branch_points(
     const core::Problem& problem, const Branch& branch, const FollowRun& run,
     core::Corrector& corrector, const ContinuationOptions& options, const ContinuationHooks& hooks,

@@ -123,6 +123,8 @@ int run_trace(const std::vector<std::string>& args_in) {
   cont::RunSettings run = cont::read_run_settings(scene);
   cont::ContinuationOptions& options = run.options;
   auto corrector = core::make_corrector(run.newton, run.newton_options);
+  auto follow_corrector =
+      core::make_corrector(run.newton, cont::follow_newton_options(run.newton_options, options));
   const long start_direction = scene.integer("direction", -1);
   if (start_direction != 1 && start_direction != -1)
     throw core::InputError("direction", fmt::format("must be 1 or -1 (got {})", start_direction));
@@ -256,8 +258,8 @@ int run_trace(const std::vector<std::string>& args_in) {
       rows.write_csv(out / "branch_points.csv");
     }
     for (const auto& f :
-         cont::follow_branch_points(problem, branch, run.follow, *corrector, options, hooks, out,
-                                    setup.write_extra_outputs, entry.units))
+         cont::follow_branch_points(problem, branch, run.follow, *follow_corrector, options, hooks,
+                                    out, setup.write_extra_outputs, entry.units))
       fmt::print("  followed {}\n", cont::follow_line(f));
   }
   core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",

@@ -94,6 +94,33 @@ TEST(BranchPointsCli, UnverifiedRowIsNotFollowed) {
   fs::remove_all(out);
 }
 
+// The family attached at T = 3.5 L/c at the paper's 100 intervals has 22-24 dimensions: the
+// bordered Jacobian there has 21-23 singular values at the finite-difference noise, and with
+// Newton's default rank cut-off (1e-12) the minimum-norm steps divided by them: every step
+// turned by 90 degrees and the followed branch ended (step_floor) after 6 points. With the
+// follow corrector's cut-off at the rank threshold (follow_newton_options) it takes its whole
+// budget at constant period (measured 30 of 30, period within 1.2e-12). About 15 s of CPU.
+TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
+  const fs::path out = cli::scratch("branch_points_cli", "follow_3.5");
+  const cli::Run r = cli::run("trace",
+                              paper +
+                                  " --branch mode1 --shooting_elements 100 --energy_max 3e-6 "
+                                  "--detect_branch_points true --follow 3 --follow_max_points 10",
+                              out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Table t = Table::read_csv(out / "branch_points.csv");
+  const int row = verified_row_near(t, 3.5);
+  ASSERT_EQ(row, 2) << "row 3 (followed): T = 3.5 after a dip near 3.67 and T = 3.6";
+  EXPECT_NEAR(t.column("period")[static_cast<std::size_t>(row)], 3.5, 1e-8);
+  const fs::path dir = out / ("branch_point_" + std::to_string(row + 1));
+  const Table b = Table::read_csv(dir / "branch.csv");
+  EXPECT_EQ(b.rows(), 10u) << "ended early: " << r.err;
+  for (double p : b.column("period")) EXPECT_NEAR(p / 3.5, 1.0, 1e-9);
+  const Table check = Table::read_csv(dir / "closed_form_check.csv");
+  for (const char* column : {"return_error_u", "return_error_v"})
+    for (double e : check.column(column)) EXPECT_LE(e, 1e-6) << column;
+}
+
 }  // namespace
 
 // --follow all: the family attached at T = 3.2 is traced into branch_point_K/ (K: its row). It
