@@ -16,6 +16,10 @@ const char* to_string(ShootingFormulation f) {
   return "?";
 }
 
+const char* scene_name(ShootingFormulation f) {
+  return f == ShootingFormulation::displacement_periodicity ? "paper" : "regular";
+}
+
 ShootingFormulation parse_formulation(const std::string& name) {
   if (name == "paper" || name == "displacement_periodicity")
     return ShootingFormulation::displacement_periodicity;

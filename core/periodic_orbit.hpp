@@ -30,6 +30,9 @@ namespace backbone::core {
 
 enum class ShootingFormulation { displacement_periodicity, half_period_velocity };
 const char* to_string(ShootingFormulation f);
+// The scene key's value for f: "regular" (half_period_velocity) or "paper"
+// (displacement_periodicity), what `formulation =` takes and run logs echo.
+const char* scene_name(ShootingFormulation f);
 // Accepts "paper" / "displacement_periodicity" and "regular" / "half_period_velocity".
 // Throws InputError("formulation", ...) otherwise.
 ShootingFormulation parse_formulation(const std::string& name);

@@ -171,7 +171,7 @@ int run_trace(const std::vector<std::string>& args_in) {
              branch_name, m, n, expected_dimension);
   fmt::print("  {} continuation, {} predictor, newton {}, {}{}{}\n",
              cont::to_string(options.method), cont::to_string(options.predictor), corrector->name(),
-             periodic ? fmt::format("formulation {}, ", core::to_string(run.formulation)) : "",
+             periodic ? fmt::format("formulation {}, ", core::scene_name(run.formulation)) : "",
              fmt::format("ds {:g} in [{:g}, {:g}], at most {} points", options.ds, options.ds_min,
                          options.ds_max, options.max_points),
              restart ? fmt::format(", restarting from point {} ({})", restart->index,
@@ -192,7 +192,7 @@ int run_trace(const std::vector<std::string>& args_in) {
         "switch_index {}\nstop_reason {}\nmessage {}\ndimension_rechecked {}\n"
         "dimension_unconfirmed {}\n",
         entry.name, branch_name, status, m, n, expected_dimension, cont::to_string(options.method),
-        corrector->name(), periodic ? core::to_string(run.formulation) : "-", points_in_files,
+        corrector->name(), periodic ? core::scene_name(run.formulation) : "-", points_in_files,
         rejected, switch_index, branch ? cont::to_string(branch->reason) : "-",
         branch ? branch->message : "-", dimension_flags[1], dimension_flags[2]);
   };

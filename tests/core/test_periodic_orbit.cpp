@@ -19,6 +19,11 @@ TEST(ShootingFormulation, ParsesBothSpellings) {
   for (auto f :
        {ShootingFormulation::displacement_periodicity, ShootingFormulation::half_period_velocity})
     EXPECT_EQ(parse_formulation(to_string(f)), f);
+  // What the logs echo is what the scene key takes.
+  EXPECT_STREQ(scene_name(ShootingFormulation::half_period_velocity), "regular");
+  for (auto f :
+       {ShootingFormulation::displacement_periodicity, ShootingFormulation::half_period_velocity})
+    EXPECT_EQ(parse_formulation(scene_name(f)), f);
   try {
     parse_formulation("Paper");
     ADD_FAILURE();
