@@ -84,28 +84,43 @@ class TdbemMarch {
   std::size_t stored_knots() const;  // history window size (both ends)
 
  private:
-  // A time on the march's step grid: (step + frac) steps of step_ seconds, frac in [0, 1). The
-  // march never forms an absolute time in seconds, so a sub-step, a retarded time t - tau and
-  // an echo t + tau keep the precision of the first step however long the run (README.md,
-  // 'Hard cases': absolute times lost 6e-11 s at t = 3e5 s).
+  // A time on the march's step grid: step + tick / 2^62 steps of step_ seconds, tick in
+  // [0, 2^62). The march never forms an absolute time in seconds, so a sub-step, a retarded time
+  // t - tau and an echo t + tau keep the precision of the first step however long the run, and
+  // the fraction is fixed-point: an echo of an echo is exact, so kinks that coincide in exact
+  // arithmetic coincide here (README.md, 'Hard cases').
   struct GridTime {
     std::int64_t step = 0;
-    double frac = 0;
+    std::int64_t tick = 0;
     auto operator<=>(const GridTime&) const = default;
   };
+  static constexpr std::int64_t ticks_per_step = std::int64_t{1} << 62;
+  static constexpr double step_per_tick = 0x1p-62;
   static GridTime normalized(std::int64_t step, double frac);  // any frac, |frac| < 2^52
-  static GridTime later(GridTime t, double steps) { return normalized(t.step, t.frac + steps); }
   static GridTime plus(GridTime a, GridTime b) {
-    return normalized(a.step + b.step, a.frac + b.frac);
+    GridTime t{a.step + b.step, a.tick + b.tick};
+    if (t.tick >= ticks_per_step) {
+      t.tick -= ticks_per_step;
+      t.step += 1;
+    }
+    return t;
   }
   static GridTime minus(GridTime a, GridTime b) {
-    return normalized(a.step - b.step, a.frac - b.frac);
+    GridTime t{a.step - b.step, a.tick - b.tick};
+    if (t.tick < 0) {
+      t.tick += ticks_per_step;
+      t.step -= 1;
+    }
+    return t;
   }
+  static GridTime later(GridTime t, double steps) { return plus(t, normalized(0, steps)); }
+  static double fraction(GridTime t) { return static_cast<double>(t.tick) * step_per_tick; }
   // a - b in steps (exact for a == b; meant for nearby times).
   static double steps_between(GridTime a, GridTime b) {
-    return static_cast<double>(a.step - b.step) + (a.frac - b.frac);
+    return static_cast<double>(a.step - b.step) +
+           static_cast<double>(a.tick - b.tick) * step_per_tick;
   }
-  double seconds(GridTime t) const { return (static_cast<double>(t.step) + t.frac) * step_; }
+  double seconds(GridTime t) const { return (static_cast<double>(t.step) + fraction(t)) * step_; }
   double seconds_between(GridTime a, GridTime b) const { return steps_between(a, b) * step_; }
   GridTime grid_time(double t) const;  // seconds -> grid time, round-off of a grid point snapped
   GridTime retarded(double t_seconds_before) const;  // now_ - t_seconds_before
@@ -154,8 +169,10 @@ class TdbemMarch {
   bar::BarSetup setup_;
   ContactMethod method_;
   double dt_, L_, c_, tau_, ea_, body_coef_, v0_total_;
-  double step_ = 0;         // grid step [s]: dt, or tau / m when tau is m dt to round-off
-  GridTime tau_grid_;       // tau on the grid (m steps exactly in that case)
+  double step_ = 0;  // grid step [s]: dt, or tau / m when tau is m dt to round-off
+  GridTime tau_grid_;
+  double merge_steps_ = 0;  // sub-step instants closer than this (in steps) are one       // tau on
+                            // the grid (m steps exactly in that case)
   double gauge_scale_ = 0;  // displacement scale of the scene; regauge() keeps Q within it
   double t_ = 0;            // time() [s]: the last target reached
   GridTime now_;            // the current time on the grid
