@@ -78,7 +78,7 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   // The attached family leaves transversally to mode 1. The angle is the smallest over the
   // probes of a 7-8 dimensional null space that re-correct, and which do, and where, follows the
   // round-off of the march: measured 89.996 degrees, 83.6 with an equivalent interpolation
-  // formula in the TD-BEM, 80.0 with its times on the step grid (problems/contact_bar/README.md,
+  // formula in the TD-BEM, 79.6 with its times on the step grid (problems/contact_bar/README.md,
   // 'Hard cases'). Bound 60 (mode 1 itself would give 0).
   EXPECT_GT(at("tangent_angle"), 60);
   fs::remove_all(out);
@@ -123,7 +123,7 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   const auto period = b.column("period"), energy = b.column("energy");
   for (double p : period) EXPECT_NEAR(p / 3.2, 1.0, 1e-9);
   EXPECT_GT(energy.front(), 1.25e-5);
-  // Measured 2.08e-5 after 30 points, 1.85e-5 since the TD-BEM times are on the step grid: the
+  // Measured 2.08e-5 after 30 points, 1.78e-5 since the TD-BEM times are on the step grid: the
   // followed direction inside the attached family follows the round-off (see tangent_angle).
   EXPECT_GT(energy.back(), 1.25 * 1.25e-5);
   const Table check = Table::read_csv(dir / "closed_form_check.csv");
