@@ -33,6 +33,8 @@
 //   m.advance_to(2.5);  double v = m.velocity(0.3);  auto events = m.events();
 #pragma once
 
+#include <compare>
+#include <cstdint>
 #include <deque>
 #include <string>
 #include <vector>
@@ -82,49 +84,98 @@ class TdbemMarch {
   std::size_t stored_knots() const;  // history window size (both ends)
 
  private:
+  // A time on the march's step grid: step + tick / 2^62 steps of step_ seconds, tick in
+  // [0, 2^62). The march never forms an absolute time in seconds, so a sub-step, a retarded time
+  // t - tau and an echo t + tau keep the precision of the first step however long the run, and
+  // the fraction is fixed-point: an echo of an echo is exact, so kinks that coincide in exact
+  // arithmetic coincide here (README.md, 'Hard cases').
+  struct GridTime {
+    std::int64_t step = 0;
+    std::int64_t tick = 0;
+    auto operator<=>(const GridTime&) const = default;
+  };
+  static constexpr std::int64_t ticks_per_step = std::int64_t{1} << 62;
+  static constexpr double step_per_tick = 0x1p-62;
+  static GridTime normalized(std::int64_t step, double frac);  // any frac, |frac| < 2^52
+  static GridTime plus(GridTime a, GridTime b) {
+    GridTime t{a.step + b.step, a.tick + b.tick};
+    if (t.tick >= ticks_per_step) {
+      t.tick -= ticks_per_step;
+      t.step += 1;
+    }
+    return t;
+  }
+  static GridTime minus(GridTime a, GridTime b) {
+    GridTime t{a.step - b.step, a.tick - b.tick};
+    if (t.tick < 0) {
+      t.tick += ticks_per_step;
+      t.step -= 1;
+    }
+    return t;
+  }
+  static GridTime later(GridTime t, double steps) { return plus(t, normalized(0, steps)); }
+  static double fraction(GridTime t) { return static_cast<double>(t.tick) * step_per_tick; }
+  // a - b in steps (exact for a == b; meant for nearby times).
+  static double steps_between(GridTime a, GridTime b) {
+    return static_cast<double>(a.step - b.step) +
+           static_cast<double>(a.tick - b.tick) * step_per_tick;
+  }
+  double seconds(GridTime t) const { return (static_cast<double>(t.step) + fraction(t)) * step_; }
+  double seconds_between(GridTime a, GridTime b) const { return steps_between(a, b) * step_; }
+  GridTime grid_time(double t) const;  // seconds -> grid time, round-off of a grid point snapped
+  GridTime retarded(double t_seconds_before) const;  // now_ - t_seconds_before
+
   struct Knot {
-    double t, u, s, q;  // time, U, S, Q = (c/2) S + U/2
-    bool kink;          // a slope change whose echo must be tracked (event method)
+    GridTime t;
+    double u, s, q;  // U, S, Q = (c/2) S + U/2
+    bool kink;       // a slope change whose echo must be tracked (event method)
   };
   struct EndState {
     bar::End end;
-    double normal = 1;  // outward normal
-    double wall = 0;    // wall position n * gap
+    double normal = 1;     // outward normal
+    double wall = 0;       // wall position n * gap
+    double contact_u = 0;  // U held while closed: the wall, or a round-off off it (solve_open)
     std::deque<Knot> knots;
-    std::deque<double> pending;  // times of kinks of R_e still ahead (event method)
+    std::deque<GridTime> pending;  // times of kinks of R_e still ahead (event method)
     double force = 0;
     bool closed = false;
   };
 
-  double r_end(int e, double t) const;  // R_e(t), t > 0
+  double r_end(int e, GridTime t) const;  // R_e(t), t > 0
   // Q_e(s) (s > 0) and its slope. hint: when given, the knot search walks from the index of the
   // previous query and stores the new one there (O(1) for monotone queries: the march's
   // retarded times, a projection's sweep in x); else a binary search. Same value either way.
-  double q_at(int e, double s, std::size_t* hint = nullptr) const;
-  double q_slope(int e, double s, std::size_t* hint = nullptr) const;
+  double q_at(int e, GridTime s, std::size_t* hint = nullptr) const;
+  double q_slope(int e, GridTime s, std::size_t* hint = nullptr) const;
   // Index of the first knot of end e with time >= s (std::lower_bound), see hint above.
-  std::size_t knot_index(int e, double s, std::size_t* hint) const;
+  std::size_t knot_index(int e, GridTime s, std::size_t* hint) const;
   // velocity(x) with the knot searches of both ends walking from hints (project's sweep).
   double velocity(double x, std::size_t* hints) const;
   double strain(double x, std::size_t* hints) const;
   void velocity_and_strain(double x, std::size_t* hints, double& v, double& ux) const;
-  void step_end(int e, double ta, double tb);
-  void substep_event(int e, double ta, double tb, bool kink_at_end);
-  void push_knot(int e, double t, double u, double s, bool kink);
+  void step_end(int e, GridTime ta, GridTime tb);
+  void substep_event(int e, GridTime ta, GridTime tb, bool kink_at_end);
+  void push_knot(int e, GridTime t, double u, double s, bool kink);
   void mark_kink(int e);  // flags the last knot of end e as a kink and schedules its echo
-  void solve_open(int e, double ta, double tb, bool kink_at_end);
-  void solve_closed_to(int e, double ta, double tb, bool kink_at_end);
+  void solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end);
+  void solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_end);
+  void regauge();  // moves a constant between the ends' Q (u unchanged) to keep both small
   std::vector<double> breakpoints(int elements) const;
   template <class F>
   void integrate_pieces(int elements, F&& f) const;
   std::vector<double> project(int elements, bool velocity) const;
   double window_energy() const;  // energy() without body force once t > tau, O(window)
-  double tolerance() const;
 
   bar::BarSetup setup_;
   ContactMethod method_;
   double dt_, L_, c_, tau_, ea_, body_coef_, v0_total_;
-  double t_ = 0;
+  double step_ = 0;  // grid step [s]: dt, or tau / m when tau is m dt to round-off
+  GridTime tau_grid_;
+  double merge_steps_ = 0;  // sub-step instants closer than this (in steps) are one       // tau on
+                            // the grid (m steps exactly in that case)
+  double gauge_scale_ = 0;  // displacement scale of the scene; regauge() keeps Q within it
+  double t_ = 0;            // time() [s]: the last target reached
+  GridTime now_;            // the current time on the grid
   bool ok_ = true;
   EndState ends_[2];  // 0: x = 0, 1: x = L
   // Knot index of the last retarded-time query of each end's R (r_end reads the OTHER end's

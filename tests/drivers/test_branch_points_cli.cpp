@@ -4,8 +4,8 @@
 //
 // At shooting_elements 40 and E <= 3e-5 the run takes about 4 s and finds two candidates: a dip
 // near T = 3.33 that its probes do not verify, and T = 3.2 with an attached family of
-// dimension 6 (measured; the dimension depends on N, problems/contact_bar/README.md, section
-// 'Dimension changes').
+// dimension 6 or 7 (measured; it depends on N and on round-off, problems/contact_bar/README.md,
+// section 'Dimension changes').
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -75,8 +75,12 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   EXPECT_GE(at("dimension"), 1);
   // The attached content is high-frequency: its dominant harmonic is well above the orbit's.
   EXPECT_GT(at("frequency_ratio"), 2);
-  // The attached family leaves at right angles to mode 1 (measured 89.996 degrees).
-  EXPECT_NEAR(at("tangent_angle"), 90, 1);
+  // The attached family leaves transversally to mode 1. The angle is the smallest over the
+  // probes of a 7-8 dimensional null space that re-correct, and which do, and where, follows the
+  // round-off of the march: measured 89.996 degrees, 83.6 with an equivalent interpolation
+  // formula in the TD-BEM, 79.6 with its times on the step grid (problems/contact_bar/README.md,
+  // 'Hard cases'). Bound 60 (mode 1 itself would give 0).
+  EXPECT_GT(at("tangent_angle"), 60);
   fs::remove_all(out);
 }
 
@@ -146,7 +150,9 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   const auto period = b.column("period"), energy = b.column("energy");
   for (double p : period) EXPECT_NEAR(p / 3.2, 1.0, 1e-9);
   EXPECT_GT(energy.front(), 1.25e-5);
-  EXPECT_GT(energy.back(), 1.5 * 1.25e-5);  // measured 2.08e-5 after 30 points
+  // Measured 2.08e-5 after 30 points, 1.78e-5 since the TD-BEM times are on the step grid: the
+  // followed direction inside the attached family follows the round-off (see tangent_angle).
+  EXPECT_GT(energy.back(), 1.25 * 1.25e-5);
   const Table check = Table::read_csv(dir / "closed_form_check.csv");
   for (const char* column : {"return_error_u", "return_error_v"})
     for (double e : check.column(column)) EXPECT_LE(e, 1e-6) << column;
