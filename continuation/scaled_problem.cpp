@@ -29,6 +29,7 @@ ScaledProblem::ScaledProblem(const core::Problem& base, core::Vector scale)
   check_positive("step_weights", weights, base.num_unknowns());
   unit_scale_ = scale.cwiseQuotient(weights);
   scale_ = unit_scale_;
+  if (local_ && !local_->local_scale_enabled()) local_ = nullptr;
 }
 
 core::Vector ScaledProblem::local_factor_at(const core::Vector& x) const {

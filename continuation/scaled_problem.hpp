@@ -48,6 +48,8 @@ namespace backbone::continuation {
 class LocalScale {
  public:
   virtual ~LocalScale() = default;
+  // false: this instance keeps fixed units (ScaledProblem then ignores the interface).
+  virtual bool local_scale_enabled() const { return true; }
   virtual core::Vector local_scale_factor(const core::Vector& x) const = 0;
   virtual core::Vector local_residual_factor(const core::Vector& x) const { return {}; }
 };
@@ -77,7 +79,7 @@ class ScaledProblem : public core::Problem {
   const core::Vector& scale() const { return scale_; }
   // s ./ w, whatever the factor: the units a saved loop state is written in (restart.hpp).
   const core::Vector& unit_scale() const { return unit_scale_; }
-  // The base implements LocalScale.
+  // The base implements LocalScale and enables it.
   bool has_local_scale() const { return local_ != nullptr; }
   // The base's factor at x (problem's unknowns); ones without LocalScale. InputError when an
   // entry is not finite and >= 1.

@@ -127,6 +127,7 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continu
   // With options.amplitude_units: max(1, A / u_s) for the u0 entries, A = the L2 norm of u0
   // over the bar divided by sqrt(L) (the step_weights norm), 1 for knots and the period; ones
   // without. The unit of u0 is then max(u_s, A): the gap near grazing, the amplitude above.
+  bool local_scale_enabled() const override { return options_.amplitude_units; }
   core::Vector local_scale_factor(const core::Vector& x) const override;
   // The same ratio for the M periodicity rows (in units of u_s: then of max(u_s, A)), 1 for
   // the path rows; empty without options.amplitude_units.
