@@ -105,7 +105,8 @@ po::options_description trace_keys() {
        "(independent of the grid), knot / L and T c / L")                                   //
       ("ds_max", po::value<double>()->default_value(0.45), "largest step (dimensionless)")  //
       ("newton_tolerance", po::value<double>()->default_value(3e-9),
-       "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
+       "||F||_inf to converge; F is in units of the gap (with amplitude_units: of the orbit's "
+       "amplitude above the gap), so this is relative to g0. The "
        "residual's round-off grows with the amplitude: measured at shooting_elements 100 on "
        "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there)")  //
       ("amplitude_units", po::value<bool>()->default_value(true),
