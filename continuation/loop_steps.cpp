@@ -59,7 +59,7 @@ void LoopSteps::attach(BranchPoint& point, std::shared_ptr<LoopState> state) con
   if (!state) return;
   state->index = point.index;
   state->arclength = point.arclength;
-  state->scale = problem_.scale();
+  state->scale = problem_.unit_scale();
   state->switch_index = switch_index_;
   point.state = std::move(state);
 }
@@ -74,7 +74,7 @@ void LoopSteps::report_first(std::shared_ptr<LoopState> state) {
 void LoopSteps::resume(const LoopState& state, bool record) {
   const std::string mismatch = state.z.size() != problem_.num_unknowns()
                                    ? std::string("another number of unknowns")
-                                   : (state.scale != problem_.scale() ? "another scale" : "");
+                                   : (state.scale != problem_.unit_scale() ? "another scale" : "");
   if (!mismatch.empty())
     throw core::InputError(
         "state", fmt::format("the saved loop state of point {} has {}", state.index, mismatch));
@@ -96,9 +96,21 @@ void LoopSteps::resume(const LoopState& state, bool record) {
   push(std::move(point));
 }
 
-void LoopSteps::push(BranchPoint point) {
+void LoopSteps::push_back(BranchPoint point) {
   branch_.points.push_back(std::move(point));
+  point_scales_.push_back(problem_.scale());
+}
+
+void LoopSteps::push(BranchPoint point) {
+  push_back(std::move(point));
   if (hooks_.on_point) hooks_.on_point(branch_.points.back());
+}
+
+Branch LoopSteps::take() {
+  for (std::size_t i = 0; i < branch_.points.size(); ++i)
+    branch_.points[i].x = branch_.points[i].x.cwiseProduct(point_scales_[i]);
+  point_scales_.clear();
+  return std::move(branch_);
 }
 
 void LoopSteps::add_branch_point(BranchPointReport report) {
@@ -134,7 +146,7 @@ bool LoopSteps::start(const core::Problem& system, core::Vector& z, const std::s
                     describe(z), rejection);
     return false;
   }
-  branch_.points.push_back(recorder_.finish(z, first_index_, s.iterations, 0.0, arclength_, true));
+  push_back(recorder_.finish(z, first_index_, s.iterations, 0.0, arclength_, true));
   return true;
 }
 
@@ -155,12 +167,14 @@ bool LoopSteps::begin_step() {
 
 bool LoopSteps::record(const core::Vector& x, const core::Vector& y, const core::Vector& forward,
                        int newton_iterations, double ds, bool force_rank,
-                       std::shared_ptr<LoopState> state) {
+                       std::shared_ptr<LoopState> state, const core::Vector* curve_direction) {
   const double arclength_at_x = arclength_;
   arclength_ += (y - x).norm();
   // The curve's direction at y for a dimension re-check: the tangent when the loop has it.
   const core::Vector direction =
-      state && state->tangent.size() == y.size() ? state->tangent : core::Vector(y - x);
+      curve_direction
+          ? *curve_direction
+          : (state && state->tangent.size() == y.size() ? state->tangent : core::Vector(y - x));
   BranchPoint point =
       recorder_.finish(y, next_index(), newton_iterations, ds, arclength_, force_rank, direction);
   double bound_value = 0;

@@ -36,6 +36,7 @@
 #include <algorithm>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "continuation/branch.hpp"
 #include "continuation/callbacks.hpp"
@@ -121,10 +122,12 @@ CorrectedStep correct_with_shrinking(double ds, int index, const ContinuationOpt
 // Runs loop(scaled, inner) -> Branch on the view of `problem` in scaled unknowns (the identity
 // view when options.scale_unknowns is false). inner is `hooks` with on_point and reject_point
 // seeing the problem's own unknowns; the returned branch's points are converted back to them.
+// A loop may change the units of the view between points (ScaledProblem::set_factor): the
+// hooks convert with the units of the moment, LoopSteps::take each point with its own.
 template <class Loop>
 Branch in_scaled_unknowns(const core::Problem& problem, const ContinuationOptions& options,
                           const ContinuationHooks& hooks, Loop&& loop) {
-  const ScaledProblem scaled(problem, loop_unit_scale(problem, options));
+  ScaledProblem scaled(problem, loop_unit_scale(problem, options));
   ContinuationHooks inner = hooks;
   if (hooks.on_point)
     inner.on_point = [&](const BranchPoint& p) {
@@ -136,9 +139,7 @@ Branch in_scaled_unknowns(const core::Problem& problem, const ContinuationOption
     inner.reject_point = [&](const core::Vector& z) {
       return hooks.reject_point(scaled.to_unknowns(z));
     };
-  Branch branch = loop(scaled, static_cast<const ContinuationHooks&>(inner));
-  for (BranchPoint& p : branch.points) p.x = scaled.to_unknowns(p.x);
-  return branch;
+  return loop(scaled, static_cast<const ContinuationHooks&>(inner));
 }
 
 // The branch under construction and the steps that add to it. All vectors are in the scaled
@@ -191,18 +192,24 @@ class LoopSteps {
   // (false): with options.land_on_bounds, F plus the bound's observable row is corrected from y,
   // then from x, and the solution is recorded in y's place (without a state) if it lies ahead of
   // x along `forward` and hooks.reject_point accepts it.
+  // curve_direction: the curve's direction at y for a dimension re-check, in the units of y
+  // (null: the state's tangent, else y - x).
   bool record(const core::Vector& x, const core::Vector& y, const core::Vector& forward,
-              int newton_iterations, double ds, bool force_rank, std::shared_ptr<LoopState> state);
+              int newton_iterations, double ds, bool force_rank, std::shared_ptr<LoopState> state,
+              const core::Vector* curve_direction = nullptr);
 
   // Ends the branch: sets reason and message, returns the branch.
   Branch end(StopReason reason, std::string message);
-  Branch take() { return std::move(branch_); }
+  // The branch, each point converted to the problem's unknowns with the units it was
+  // recorded in.
+  Branch take();
 
   // describe_point of z in the problem's unknowns.
   std::string describe(const core::Vector& z) const;
 
  private:
   void push(BranchPoint point);
+  void push_back(BranchPoint point);  // adds without reporting
   void attach(BranchPoint& point, std::shared_ptr<LoopState> state) const;
   std::string rejection_of(const core::Vector& z) const;
   void land_on_bound(const Bound& bound, double value, const core::Vector& x, const core::Vector& y,
@@ -214,6 +221,7 @@ class LoopSteps {
   const ContinuationHooks& hooks_;
   PointRecorder recorder_;
   Branch branch_;
+  std::vector<core::Vector> point_scales_;  // problem_.scale() when each point was added
   int first_index_ = 0;
   double arclength_ = 0;
   int switch_index_ = -1;

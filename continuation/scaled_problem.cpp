@@ -22,15 +22,49 @@ void check_positive(const char* what, const core::Vector& v, int unknowns) {
 }
 }  // namespace
 
-ScaledProblem::ScaledProblem(const core::Problem& base, core::Vector scale) : base_(base) {
+ScaledProblem::ScaledProblem(const core::Problem& base, core::Vector scale)
+    : base_(base), local_(dynamic_cast<const LocalScale*>(&base)) {
   check_positive("typical_scale", scale, base.num_unknowns());
   const core::Vector weights = base.step_weights();
   check_positive("step_weights", weights, base.num_unknowns());
-  scale_ = scale.cwiseQuotient(weights);
+  unit_scale_ = scale.cwiseQuotient(weights);
+  scale_ = unit_scale_;
+  if (local_ && !local_->local_scale_enabled()) local_ = nullptr;
+}
+
+core::Vector ScaledProblem::local_factor_at(const core::Vector& x) const {
+  if (!local_) return core::Vector::Ones(num_unknowns());
+  core::Vector factor = local_->local_scale_factor(x);
+  check_positive("local_scale_factor", factor, num_unknowns());
+  for (Eigen::Index i = 0; i < factor.size(); ++i)
+    if (!(factor[i] >= 1))
+      throw core::InputError("local_scale_factor",
+                             fmt::format("entry {} must be >= 1 (got {})", i, factor[i]));
+  return factor;
+}
+
+core::Vector ScaledProblem::local_residual_factor_at(const core::Vector& x) const {
+  if (!local_) return {};
+  core::Vector factor = local_->local_residual_factor(x);
+  if (factor.size() > 0) check_positive("local_residual_factor", factor, num_equations());
+  return factor;
+}
+
+void ScaledProblem::set_factor(const core::Vector& factor, const core::Vector& residual_factor) {
+  check_positive("factor", factor, num_unknowns());
+  if (residual_factor.size() > 0)
+    check_positive("residual_factor", residual_factor, num_equations());
+  scale_ = unit_scale_.cwiseProduct(factor);
+  residual_factor_ = residual_factor;
+  const std::lock_guard<std::mutex> lock(cache_mutex_);
+  cached_z_.resize(0);
 }
 
 core::EvalStatus ScaledProblem::compute_residual(const core::Vector& z, core::Vector& r) const {
-  return base_.residual(to_unknowns(z), r);
+  const core::EvalStatus s = base_.residual(to_unknowns(z), r);
+  if (s == core::EvalStatus::ok && residual_factor_.size() > 0)
+    r = r.cwiseQuotient(residual_factor_);
+  return s;
 }
 
 core::EvalStatus ScaledProblem::compute_jacobian(const core::Vector& z, core::Matrix& J) const {
@@ -45,6 +79,7 @@ core::EvalStatus ScaledProblem::compute_jacobian(const core::Vector& z, core::Ma
   const core::EvalStatus s = base_.jacobian(to_unknowns(z), J);
   if (s != core::EvalStatus::ok) return s;
   J = J * scale_.asDiagonal();
+  if (residual_factor_.size() > 0) J = residual_factor_.cwiseInverse().asDiagonal() * J;
   const std::lock_guard<std::mutex> lock(cache_mutex_);
   cached_z_ = z;
   cached_jacobian_ = J;

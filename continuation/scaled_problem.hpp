@@ -16,10 +16,21 @@
 // it twice at every point (tangent, then rank report), and the second request at the same z
 // (bit for bit) is a copy, not a new finite-difference Jacobian of the base.
 //
+// Units that follow the point (LocalScale): a problem whose natural unit of some unknowns
+// changes along a branch says so by implementing LocalScale. The contact bar's displacements
+// are in units of the gap near grazing, but far above it the gap no longer matters (only
+// E / g0^2 does) and the orbit's own amplitude is the unit: with a fixed unit a step uniform in
+// z cannot cover 1e-6..1e4 J, and the period column of J diag(s), which grows with the
+// amplitude, pushes every other singular value below a relative threshold. set_factor(f)
+// makes the unit s ./ w .* f (f from local_factor_at(x)); pseudo-arclength re-anchors it at
+// every point (continuation/README.md, section 'Scaled unknowns'). unit_scale() stays s ./ w.
+//
 //   ScaledProblem scaled(problem);                 // s = typical_scale(), w = step_weights()
 //   core::Vector z = scaled.to_scaled(x);          // x ./ scale(), scale() = s ./ w
 //   scaled.residual(z, r);                         // = problem.residual(x, r)
 //   core::Vector back = scaled.to_unknowns(z);     // scale() .* z
+//   scaled.set_factor(scaled.local_factor_at(x));  // units of the point x (LocalScale), then
+//   z = scaled.to_scaled(x);                       // z in them
 #pragma once
 
 #include <mutex>
@@ -28,6 +39,20 @@
 #include "core/problem.hpp"
 
 namespace backbone::continuation {
+
+// Optional interface of a problem whose natural unit of some unknowns depends on the point:
+// entry j of the factor (finite, >= 1) multiplies typical_scale()_j at x; 1 everywhere means
+// the fixed units. Equations measured in those units say so with a residual factor (entry i
+// divides F_i; empty: none), so that F and the rows that border it keep their balance and a
+// residual tolerance stays relative to the point's own size (its round-off grows with it).
+class LocalScale {
+ public:
+  virtual ~LocalScale() = default;
+  // false: this instance keeps fixed units (ScaledProblem then ignores the interface).
+  virtual bool local_scale_enabled() const { return true; }
+  virtual core::Vector local_scale_factor(const core::Vector& x) const = 0;
+  virtual core::Vector local_residual_factor(const core::Vector& x) const { return {}; }
+};
 
 class ScaledProblem : public core::Problem {
  public:
@@ -50,19 +75,34 @@ class ScaledProblem : public core::Problem {
 
   core::Vector to_scaled(const core::Vector& x) const { return x.cwiseQuotient(scale_); }
   core::Vector to_unknowns(const core::Vector& z) const { return z.cwiseProduct(scale_); }
-  // s ./ w: x = scale() .* z.
+  // x = scale() .* z: s ./ w .* factor.
   const core::Vector& scale() const { return scale_; }
+  // s ./ w, whatever the factor: the units a saved loop state is written in (restart.hpp).
+  const core::Vector& unit_scale() const { return unit_scale_; }
+  // The base implements LocalScale and enables it.
+  bool has_local_scale() const { return local_ != nullptr; }
+  // The base's factor at x (problem's unknowns); ones without LocalScale. InputError when an
+  // entry is not finite and >= 1.
+  core::Vector local_factor_at(const core::Vector& x) const;
+  // The same for the equations (empty without LocalScale or a residual factor).
+  core::Vector local_residual_factor_at(const core::Vector& x) const;
+  // Units s ./ w .* factor from now on, F divided by residual_factor (empty: as the base's);
+  // the cached Jacobian is dropped.
+  void set_factor(const core::Vector& factor, const core::Vector& residual_factor = {});
   const core::Problem& base() const { return base_; }
 
  protected:
   core::EvalStatus compute_residual(const core::Vector& z, core::Vector& r) const override;
-  // J_z = J_x diag(s ./ w): the base's Jacobian (analytic or FD with its own step rule), or the
-  // last one when z is the last z asked for.
+  // J_z = diag(1 ./ residual factor) J_x diag(scale()): the base's Jacobian (analytic or FD with
+  // its own step rule), or the last one when z is the last z asked for.
   core::EvalStatus compute_jacobian(const core::Vector& z, core::Matrix& J) const override;
 
  private:
   const core::Problem& base_;
+  const LocalScale* local_ = nullptr;  // the base, when it implements LocalScale
+  core::Vector unit_scale_;
   core::Vector scale_;
+  core::Vector residual_factor_;    // empty: F as the base's
   mutable std::mutex cache_mutex_;  // compute_jacobian may be called from several threads
   mutable core::Vector cached_z_;   // empty: nothing cached
   mutable core::Matrix cached_jacobian_;

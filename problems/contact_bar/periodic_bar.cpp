@@ -241,6 +241,31 @@ Vector ContactBarOrbitProblem::step_weights() const {
   return w;
 }
 
+namespace {
+// max(1, A / u_s): A = the L2 norm of u0 over the bar / sqrt(L), the step_weights() norm.
+double amplitude_ratio(const ContactBarOrbitProblem& p, const Vector& x) {
+  const int nodal = p.options().nodal_unknowns();
+  const double amplitude = x.head(nodal).cwiseProduct(p.step_weights().head(nodal)).norm();
+  const double ratio = amplitude / p.displacement_scale();
+  return std::isfinite(ratio) && ratio > 1 ? ratio : 1.0;
+}
+}  // namespace
+
+Vector ContactBarOrbitProblem::local_scale_factor(const Vector& x) const {
+  Vector factor = Vector::Ones(num_unknowns());
+  if (options_.amplitude_units)
+    factor.head(options_.nodal_unknowns()).setConstant(amplitude_ratio(*this, x));
+  return factor;
+}
+
+Vector ContactBarOrbitProblem::local_residual_factor(const Vector& x) const {
+  if (!options_.amplitude_units) return {};
+  const int m = options_.test_elements > 0 ? options_.test_elements : state_size();
+  Vector factor = Vector::Ones(num_equations());
+  factor.head(m).setConstant(amplitude_ratio(*this, x));
+  return factor;
+}
+
 EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
   const int n = options_.elements;
   const int m = options_.test_elements > 0 ? options_.test_elements : state_size();  // grid

@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "continuation/scaled_problem.hpp"
 #include "core/periodic_orbit.hpp"
 #include "problems/bar/bar.hpp"
 
@@ -69,13 +70,18 @@ struct OrbitOptions {
                             // contact time) fixed, a linear row in knots 1 and 2 (needs
                             // start_on_wall, K >= 2): 1 - k2 = shape (1 - 3 (k2 - k1) / 2)
                             // (knots in units of L), times L / g0 as the residual rows
+  // Units that follow the orbit (continuation::LocalScale): above the gap, the unit of u0 in
+  // continuation is the orbit's amplitude (its L2 norm over the bar), not g0, so that a step
+  // is relative and the rank report's column scaling does not degrade as the amplitude grows
+  // (README.md, section 'Cost'). false: g0 throughout.
+  bool amplitude_units = false;
   int path_rows() const { return (fixed_energy > 0 ? 1 : 0) + (fixed_shape >= 0 ? 1 : 0); }
   int nodal_unknowns() const { return elements - (start_on_wall ? 1 : 0); }
   int state_size() const { return nodal_unknowns() + free_knots; }
   void validate() const;  // throws core::InputError naming the field
 };
 
-class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
+class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continuation::LocalScale {
  public:
   // setup: material and ends (left fixed, right contact or free, no body force); its u0, v0
   // are ignored. The solver must outlive the problem. Throws core::InputError.
@@ -118,6 +124,14 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem {
   // 1 for a free knot and the period: a step is then |du0|_L2 / (u_s sqrt(L)) plus the period
   // change in L/c, the same at every N for the same change of the orbit.
   core::Vector step_weights() const override;
+  // With options.amplitude_units: max(1, A / u_s) for the u0 entries, A = the L2 norm of u0
+  // over the bar divided by sqrt(L) (the step_weights norm), 1 for knots and the period; ones
+  // without. The unit of u0 is then max(u_s, A): the gap near grazing, the amplitude above.
+  bool local_scale_enabled() const override { return options_.amplitude_units; }
+  core::Vector local_scale_factor(const core::Vector& x) const override;
+  // The same ratio for the M periodicity rows (in units of u_s: then of max(u_s, A)), 1 for
+  // the path rows; empty without options.amplitude_units.
+  core::Vector local_residual_factor(const core::Vector& x) const override;
   // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
   double displacement_scale() const;
 

@@ -105,9 +105,14 @@ po::options_description trace_keys() {
        "(independent of the grid), knot / L and T c / L")                                   //
       ("ds_max", po::value<double>()->default_value(0.45), "largest step (dimensionless)")  //
       ("newton_tolerance", po::value<double>()->default_value(3e-9),
-       "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
+       "||F||_inf to converge; F is in units of the gap (with amplitude_units: of the orbit's "
+       "amplitude above the gap), so this is relative to g0. The "
        "residual's round-off grows with the amplitude: measured at shooting_elements 100 on "
        "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there)")  //
+      ("amplitude_units", po::value<bool>()->default_value(true),
+       "mode1, mode2: above the gap, steps and rank reports in units of the orbit's amplitude "
+       "(the L2 norm of u0) instead of the gap, so that ds is relative and a branch covers "
+       "decades of energy (README.md, section 'Cost'); false: the gap throughout")  //
       ("max_residual_work", po::value<double>()->default_value(1e7),
        "refuse a trace whose residual costs more than this many element-steps "
        "(shooting_elements x steps_per_period; a point evaluates the residual about 2 x "
@@ -166,6 +171,10 @@ continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements = static_cast<int>(
       test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);
+  // Branch-point detection compares its samples in fixed units, and a followed family's
+  // probes and paths are measured in units of the gap: both keep the gap as the unit.
+  options.amplitude_units = scene.flag("amplitude_units") && !scene.flag("detect_branch_points") &&
+                            scene.text("follow") == "none";
 
   auto problem = std::make_unique<ContactBarOrbitProblem>(setup, solver, options);
   const double ratio = 1 + scene.positive("start_offset");

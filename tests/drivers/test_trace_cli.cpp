@@ -138,8 +138,10 @@ std::string file_text(const fs::path& path) {
   return text.str();
 }
 
-// mode 1 on a coarse grid up to 2e-3 J: 82 points in a fraction of a second.
-const std::string small_mode1 = paper + " --branch mode1 --shooting_elements 10 --energy_max 2e-3";
+// mode 1 on a coarse grid up to 2e-3 J: 88 points in a fraction of a second (steps of 5 % of
+// the amplitude above the gap: amplitude_units, problems/contact_bar/README.md 'Cost').
+const std::string small_mode1 =
+    paper + " --branch mode1 --shooting_elements 10 --energy_max 2e-3 --ds 0.05 --ds_max 0.05";
 
 // An interrupted trace keeps its points and --resume continues it from the loop state saved
 // with its last complete point (state.txt, continuation/restart.hpp): a 30-point run whose last

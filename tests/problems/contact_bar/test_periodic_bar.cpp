@@ -269,3 +269,57 @@ TEST(ContactBarOrbit, TestElementsBelowTheUnknownsAreRejected) {
 }
 
 }  // namespace
+
+// Step control over ten decades of energy (problems/contact_bar/README.md, section 'Cost'):
+// mode 1 from end amplitude 1.05 g0 (E = 5.5e-7 J) to E = 1e4 J (1.4e5 g0) with the trace's
+// settings (20 intervals, 40 test elements, ds = ds_max = 0.45, Newton tolerance 3e-9, rank
+// report with threshold 1e-5 at every point). In units of the gap a step moves u0 by about
+// 0.45 g0 in L2, so the branch would need ~2e5 points (measured: 200 points end at 1.2e-2 J);
+// with amplitude_units the unit of u0 and of the residual is the orbit's amplitude and steps
+// are relative: 37 points (measured; asserted <= 50). Jacobians: one per Newton iteration plus
+// the tangent (4-9), except the last two points above 1.2e5 g0, where mode 1's own smallest
+// kept singular value falls below 1e-5 relative (it shrinks like g0 / A) and the rank report
+// probes a candidate (138 and 245): mean 15.2 a point (measured; asserted <= 30, since the
+// probes vary with the points' exact position). Before the chord check of the
+// tangent (pseudo_arclength.cpp), a forward-difference Jacobian across a kink of the contact
+// map at 8e3 J gave a tangent 52.8 degrees off: 24 points crawled there with rank probes, 60
+// points and 80 Jacobians a point. Every point is an exact mode-1 orbit: within 1e-10 of the
+// closed-form frequency (measured 7e-12; the Newton tolerance, relative to the amplitude,
+// bounds the period error by ~1e-11).
+TEST(ContactBarOrbit, HighEnergyModeOneTakesRelativeSteps) {
+  const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
+  OrbitOptions options = grid(20, 40, 0, 40);
+  const auto trace = [&](bool amplitude_units) {
+    options.amplitude_units = amplitude_units;
+    ContactBarOrbitProblem p(paper_setup(), event, options);
+    core::NewtonOptions newton_options;
+    newton_options.residual_tolerance = 3e-9;
+    auto newton = core::make_corrector("eigen", newton_options);
+    continuation::ContinuationOptions o;
+    o.ds = o.ds_max = 0.45;
+    o.max_points = 200;
+    o.rank.relative_threshold = 1e-5;
+    o.verification.residual_tolerance = 3e-9;
+    o.bounds.push_back({"energy", 0.0, 1e4});
+    const Vector guess = p.contact_family_guess(1, 1.05);
+    const Vector direction = p.contact_family_guess(1, 1.05 * 1.01) - guess;  // as the trace
+    return continuation::pseudo_arclength(p, guess, direction, *newton, o);
+  };
+  const continuation::Branch gap_units = trace(false);
+  EXPECT_EQ(gap_units.reason, continuation::StopReason::max_points);
+  EXPECT_LT(gap_units.points.back().observable("energy"), 0.1);
+  const continuation::Branch b = trace(true);
+  ASSERT_EQ(b.reason, continuation::StopReason::bound_reached) << b.message;
+  EXPECT_LE(b.points.size(), 50u);
+  EXPECT_NEAR(b.points.back().observable("energy"), 1e4, 1e-6);
+  const contact_bar::ContactFamily family(paper_setup().material, kGap, 1);
+  double jacobians = 0;
+  for (const auto& point : b.points) {
+    jacobians += static_cast<double>(point.jacobian_evaluations);
+    EXPECT_EQ(point.dimension, 1) << point.index;
+    const double energy = point.observable("energy");
+    EXPECT_LE(std::abs(point.observable("frequency") / family.frequency(energy) - 1), 1e-10)
+        << point.index << " at E = " << energy;
+  }
+  EXPECT_LE(jacobians / static_cast<double>(b.points.size()), 30.0);
+}
