@@ -59,10 +59,10 @@ struct TraceSetup {
   std::function<std::string(const core::Vector& x)> reject_point;
   // Optional: words appended to each progress line (e.g. "closed-form rel err 1e-14").
   std::function<std::string(const BranchPoint& point)> describe_point;
-  // Optional: the branch's own continuation settings, applied by `trace` to the options read
-  // from the scene before the run (a setup keeps a value the user gave: the scene's
-  // values()[key].defaulted() tells a default from a given key).
-  std::function<void(ContinuationOptions& options)> branch_options;
+  // Optional: the branch's own continuation and corrector settings, applied by `trace` to the
+  // options read from the scene before the run (a setup keeps a value the user gave: the
+  // scene's values()[key].defaulted() tells a default from a given key).
+  std::function<void(ContinuationOptions& options, core::NewtonOptions& newton)> branch_options;
   // Optional: describes a verified branch point (ContinuationHooks::describe_branch_point).
   std::function<core::Observables(const core::Vector& on_branch, const core::Vector& attached)>
       describe_branch_point;

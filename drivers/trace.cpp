@@ -122,9 +122,6 @@ int run_trace(const std::vector<std::string>& args_in) {
   core::check_output_folder("out", out);
   cont::RunSettings run = cont::read_run_settings(scene);
   cont::ContinuationOptions& options = run.options;
-  auto corrector = core::make_corrector(run.newton, run.newton_options);
-  auto follow_corrector =
-      core::make_corrector(run.newton, cont::follow_newton_options(run.newton_options, options));
   const long start_direction = scene.integer("direction", -1);
   if (start_direction != 1 && start_direction != -1)
     throw core::InputError("direction", fmt::format("must be 1 or -1 (got {})", start_direction));
@@ -133,9 +130,13 @@ int run_trace(const std::vector<std::string>& args_in) {
   if (!setup.problem) throw core::InputError("problem", "setup returned no problem");
   const core::Problem& problem = *setup.problem;
   if (setup.branch_options) {
-    setup.branch_options(options);
+    setup.branch_options(options, run.newton_options);
     options.validate();
+    run.newton_options.validate();
   }
+  auto corrector = core::make_corrector(run.newton, run.newton_options);
+  auto follow_corrector =
+      core::make_corrector(run.newton, cont::follow_newton_options(run.newton_options, options));
   auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get());
   if (periodic) periodic->set_formulation(run.formulation);
   core::Vector direction = setup.direction;

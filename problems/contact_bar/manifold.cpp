@@ -183,8 +183,9 @@ void add_manifold_outputs(const core::Scene& scene, continuation::TraceSetup& se
   core::NewtonOptions newton;
   newton.residual_tolerance = scene.positive("newton_tolerance");
   auto continuum_options = setup.branch_options;
-  setup.branch_options = [continuum_options](continuation::ContinuationOptions& o) {
-    if (continuum_options) continuum_options(o);
+  setup.branch_options = [continuum_options](continuation::ContinuationOptions& o,
+                                             core::NewtonOptions& n) {
+    if (continuum_options) continuum_options(o, n);
     o.max_points = 1;  // the seed only: the manifold is the atlas's
     o.bounds.clear();
   };

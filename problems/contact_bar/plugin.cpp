@@ -102,13 +102,16 @@ po::options_description trace_keys() {
        "the contact map), the smallest kept one is 5.6e-5; verify decides")  //
       ("ds", po::value<double>()->default_value(0.45),
        "first step, dimensionless: the L2 norm of the change of u0 / gap over the bar "
-       "(independent of the grid), knot / L and T c / L")                                   //
-      ("ds_max", po::value<double>()->default_value(0.45), "largest step (dimensionless)")  //
+       "(independent of the grid), knot / L and T c / L; mode1 and mode2 in amplitude units "
+       "default to 0.1 (10 % of the amplitude)")  //
+      ("ds_max", po::value<double>()->default_value(0.45),
+       "largest step (dimensionless; mode1, mode2 in amplitude units: 0.1)")  //
       ("newton_tolerance", po::value<double>()->default_value(3e-9),
-       "||F||_inf to converge; F is in units of the gap (with amplitude_units: of the orbit's "
-       "amplitude above the gap), so this is relative to g0. The "
+       "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
        "residual's round-off grows with the amplitude: measured at shooting_elements 100 on "
-       "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there)")  //
+       "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there). mode1 "
+       "and mode2 in amplitude units (F relative to the amplitude above the gap) default to "
+       "1e-10")  //
       ("amplitude_units", po::value<bool>()->default_value(true),
        "mode1, mode2: above the gap, steps and rank reports in units of the orbit's amplitude "
        "(the L2 norm of u0) instead of the gap, so that ds is relative and a branch covers "
@@ -181,6 +184,21 @@ continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string
   const std::string guess = scene.choice("start_guess", {"contact_family", "linear_mode"});
 
   continuation::TraceSetup s;
+  if (options.amplitude_units) {
+    // In units of the amplitude a step ds is a relative change of the orbit and F's round-off
+    // is relative too (README.md, section 'Cost'): 10 % steps (mode 1 to 1e-2 J in 54 points,
+    // to 1e4 J in 126; 0.45 gave 18 and 37, too few for the figures) and a tolerance of 1e-10
+    // of the amplitude (closed-form error 4e-13 at 20 intervals and 1e-13 at 100, against 7e-12
+    // with the gap units' 3e-9, at the same Jacobians per point).
+    const bool ds_given = !scene.values()["ds"].defaulted();
+    const bool ds_max_given = !scene.values()["ds_max"].defaulted();
+    const bool tolerance_given = !scene.values()["newton_tolerance"].defaulted();
+    s.branch_options = [=](continuation::ContinuationOptions& o, core::NewtonOptions& newton) {
+      if (!ds_max_given) o.ds_max = 0.1;
+      if (!ds_given) o.ds = std::min(0.1, o.ds_max);
+      if (!tolerance_given) newton.residual_tolerance = 1e-10;
+    };
+  }
   s.guess = guess == "linear_mode" ? problem->linear_mode_guess(mode, ratio)
                                    : problem->contact_family_guess(mode, ratio);
   // Energy grows along the family: the direction of the contact family's own tangent.
@@ -254,7 +272,7 @@ std::shared_ptr<const bar::BarSolver> shooting_solver(const core::Scene& scene) 
 //    step of the last knot, 1.5e-8 L, crosses L once L - k2 is smaller), so the branch lands
 //    on the member with L - k2 = 1e-6 L, whose contact phase at t = 0 lasts 2e-6 L / c, and
 //    ends there with bound_reached (a complete branch; the limit itself: grazing_limits.hpp).
-std::function<void(continuation::ContinuationOptions&)> continuum_options(
+std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)> continuum_options(
     const core::Scene& scene, const ContactBarOrbitProblem& problem, double energy, double shape,
     double toward) {
   const bar::Material& material = problem.setup_template().material;
@@ -279,7 +297,7 @@ std::function<void(continuation::ContinuationOptions&)> continuum_options(
   }
   const bool ds_given = !scene.values()["ds"].defaulted();
   const bool ds_max_given = !scene.values()["ds_max"].defaulted();
-  return [=](continuation::ContinuationOptions& options) {
+  return [=](continuation::ContinuationOptions& options, core::NewtonOptions&) {
     options.start_along_direction = true;
     const double step = length / 40;
     if (!ds_given) options.ds = ds_max_given ? std::min(step, options.ds_max) : step;

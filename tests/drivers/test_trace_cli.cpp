@@ -200,7 +200,10 @@ TEST(TraceCli, StartFromASavedPointReproducesTheRestOfTheBranch) {
   const auto b = backbone::core::Table::read_csv(from / "branch.csv");
   ASSERT_GT(a.rows(), 45u);
   EXPECT_EQ(b.column("point").front(), 40);
-  EXPECT_EQ(b.column("energy").front(), a.column("energy")[40]);
+  // Point K itself is recorded from its saved state, kept in fixed units, while the first run
+  // recorded it in the units of its amplitude (LocalScale): the conversions may differ in the
+  // last bit (measured 3e-16 relative). The points after it are the same bit for bit.
+  EXPECT_NEAR(b.column("energy").front() / a.column("energy")[40], 1.0, 1e-14);
   expect_same_rows(a, b, 41, 1);
   ASSERT_EQ(cli::run("trace", small_mode1 + start + " --direction -1 --max_points 45", back).code,
             0);
