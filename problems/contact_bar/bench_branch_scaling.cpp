@@ -8,10 +8,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <fstream>
 #include <limits>
 #include <sstream>
+#include <thread>
 
 #include "continuation/bench_report.hpp"
 #include "continuation/scene_options.hpp"
@@ -77,6 +80,14 @@ void read_mode1_scene(Mode1Scene& s, const Mode1BranchSettings& settings) {
 
 // Errors of exactly 0 (round-off luck) are drawn at this floor on the log axes.
 constexpr double plot_floor = 1e-17;
+
+// The 1-minute load average of the machine (Linux /proc/loadavg), "unknown" elsewhere: wall
+// times with threads mean little when other work keeps every core busy.
+std::string load_average() {
+  std::ifstream file("/proc/loadavg");
+  std::string first;
+  return file >> first ? first : std::string("unknown");
+}
 
 std::string significant(double value) {
   return std::isfinite(value) ? fmt::format("{:.3g}", value) : std::string("-");
@@ -270,12 +281,21 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
       fmt::join(grids, ", "));
   std::vector<Mode1BranchCost> runs, grid_runs;
   int status = 0;
+  const double short_run_seconds = 2;
   const auto run = [&](const Mode1BranchSettings& settings) -> const Mode1BranchCost& {
     runs.push_back(trace_mode1_cost(settings));
-    const Mode1BranchCost& c = runs.back();
+    Mode1BranchCost& c = runs.back();
+    // A short run is repeated and timed at its best (the branch is the same each time): the
+    // machine's load inflates even CPU time, by up to ~30 % measured on short runs.
+    for (int k = 1; k < 3 && c.cpu_seconds < short_run_seconds; ++k) {
+      const Mode1BranchCost again = trace_mode1_cost(settings);
+      if (again.cpu_seconds < c.cpu_seconds)
+        c.cpu_seconds = again.cpu_seconds, c.wall_seconds = again.wall_seconds;
+    }
     fmt::print("  {:<50} {:>5} points {:>7.3g} ms/point (CPU) {:>8.3g} s  worst error {:.2e}{}\n",
                settings.label(), c.points, c.ms_per_point(), c.cpu_seconds, c.worst_error,
                c.complete ? "" : "  stopped early: " + c.message);
+    std::fflush(stdout);  // a long bench shows its progress run by run
     return c;
   };
   for (int n : grids) {
@@ -324,6 +344,7 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
   if (!threads_same) status = 1;
 
   const int jacobian_n = 200;
+  const std::string load = load_average();
   const JacobianThreadsTiming jt = time_jacobian_threads(jacobian_n);
   fmt::print(
       "  FD Jacobian alone at N = {} ({} x {}), best of 3 wall: 1 thread {:.4g} s, 2 threads "
@@ -380,16 +401,25 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
               "'target at N = 160: 25 ms'\n"
               "set format y '%.0e'\nset xlabel 'CPU seconds per branch'\n"
               "set ylabel 'worst relative frequency error (closed form)'\n"
-              "set title 'Work-precision: whole branches (errors of 0 at 1e-17)'\nset key "
-              "right top\n"
-              "plot {0} using (strcol(1) eq 'grid' ? $9 : NaN):($11 > {2} ? $11 : {2}) with "
-              "linespoints pt 7 ps 1.5 title 'N (labels)', "
-              "{0} using (strcol(1) eq 'grid' ? $9 : NaN):($11 > {2} ? $11 : {2}):(sprintf('%d', "
-              "$3)) with labels offset 0,1 notitle, "
-              "{0} using (strcol(1) ne 'grid' ? $9 : NaN):($11 > {2} ? $11 : {2}) with points pt "
-              "5 ps 1.5 title 'variants (steps per period, formulation, corrector, threads)', "
-              "{0} using (strcol(1) ne 'grid' ? $9 : NaN):($11 > {2} ? $11 : {2}):2 with labels "
-              "offset 0,-1 font ',7' notitle\n"
+              "set title 'Work-precision: whole branches that reach E = 5e-3 (errors of 0 at "
+              "1e-17)'\nset key left bottom\n"
+              "plot {0} using (strcol(1) eq 'grid' && $14 == 1 ? $9 : NaN):($11 > {2} ? $11 : {2}) "
+              "with linespoints pt 7 ps 1.5 title 'N (labels): regular, eigen, 1 thread', "
+              "{0} using (strcol(1) eq 'grid' && $14 == 1 ? $9 : NaN):($11 > {2} ? $11 : "
+              "{2}):(sprintf('%d', $3)) with labels offset 0,1 notitle, "
+              "{0} using (strcol(1) eq 'steps_per_period' && $14 == 1 ? $9 : NaN):($11 > {2} ? "
+              "$11 : {2}) with points pt 5 ps 1.5 title 'N = 40, 80 steps per period', "
+              "{0} using (strcol(1) eq 'formulation' && $14 == 1 ? $9 : NaN):($11 > {2} ? $11 : "
+              "{2}) with points pt 9 ps 1.5 title 'N = 40, paper formulation (drawn only if it "
+              "reaches the bound)', "
+              "{0} using (strcol(2) eq 'N = 40, newton eigen (square: test_elements 0)' && $14 "
+              "== 1 ? $9 : NaN):($11 > {2} ? $11 : {2}) with points pt 11 ps 1.5 title 'N = 40, "
+              "square system, eigen', "
+              "{0} using (strcol(2) eq 'N = 40, newton kinsol (square: test_elements 0)' && $14 "
+              "== 1 ? $9 : NaN):($11 > {2} ? $11 : {2}) with points pt 13 ps 1.5 title 'N = 40, "
+              "square system, kinsol', "
+              "{0} using (strcol(1) eq 'threads' && $14 == 1 ? $9 : NaN):($11 > {2} ? $11 : {2}) "
+              "with points pt 3 ps 2 lw 2 title 'N = 80, 2 threads (CPU of both)'\n"
               "unset multiplot\n",
               q, fit_clause, plot_floor),
           {1600, 700}),
@@ -442,11 +472,12 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
       threads_run.cpu_seconds / threads_base.cpu_seconds);
   const std::string jacobian_verdict = fmt::format(
       "2 threads compute the {} x {} Jacobian {:.3g}x faster than one (target >= 1.7x: {}), "
-      "{}; wall times, so they depend on the machine's load (process CPU: {:.3g} s and {:.3g} "
-      "s).",
+      "{}; these are wall times on a machine of {} cores with a load average of {} when they "
+      "were taken (2 threads can only gain when a second core is free), and the process CPU "
+      "time of 2 threads is {:.2g}x that of one (the cost of sharing the work).",
       jt.rows, jt.columns, jt.speedup(), jt.speedup() >= 1.7 ? "met" : "not met",
       jt.identical ? "bit-identical to one thread's" : "NOT identical to one thread's",
-      jt.one_thread_cpu, jt.two_thread_cpu);
+      std::thread::hardware_concurrency(), load, jt.two_thread_cpu / jt.one_thread_cpu);
   fmt::print("  {}\n  {}\n  {}\n", grid_verdict, variant_verdict, jacobian_verdict);
   continuation::write_bench_section(
       out, "mode1_scaling",
@@ -461,7 +492,7 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
           "averaged. Error: |omega / omega_exact(E) - 1| against the mode-1 closed form at "
           "each point's own energy. Grids: BACKBONE_MODE1_SCALING_N (default 20,40,80,160,320; "
           "`BACKBONE_MODE1_SCALING_N=20,40,80,160,320,640,1000 backbone bench --case "
-          "mode1_scaling` adds the large ones).\n\n"
+          "mode1_scaling` adds the large ones). Runs under 2 s CPU: best of 3.\n\n"
           "### Over the grid\n\n{0}{1}\n**Where backbone stands:** {2}\n\n"
           "### Steps per period, formulation, corrector, threads\n\n{0}{3}\n"
           "**Where backbone stands:** {4}\n\n"
