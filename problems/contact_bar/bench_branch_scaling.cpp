@@ -182,16 +182,16 @@ bool same_branch(const Mode1BranchCost& a, const Mode1BranchCost& b) {
 }
 
 core::Table branch_cost_table(const std::vector<Mode1BranchCost>& runs) {
-  core::Table table({"study", "setting", "N", "steps_per_period", "threads", "points",
-                     "jacobians_per_point", "ms_per_point", "total_seconds", "wall_seconds",
-                     "worst_closed_form_error", "median_closed_form_error", "energy_reached",
-                     "complete"});
+  core::Table table({"study", "setting", "N", "steps_per_period", "formulation", "newton",
+                     "test_elements", "threads", "points", "jacobians_per_point", "ms_per_point",
+                     "total_seconds", "wall_seconds", "worst_closed_form_error",
+                     "median_closed_form_error", "energy_reached", "complete"});
   for (const Mode1BranchCost& c : runs)
     table.add_cells({c.settings.study, c.settings.label(), double(c.settings.elements),
-                     double(c.settings.steps_per_period), double(c.settings.threads),
-                     double(c.points), c.jacobians_per_point(), c.ms_per_point(), c.cpu_seconds,
-                     c.wall_seconds, c.worst_error, c.median_error, c.energy_reached,
-                     c.complete ? 1.0 : 0.0});
+                     double(c.settings.steps_per_period), c.settings.formulation, c.settings.newton,
+                     double(c.settings.test_elements), double(c.settings.threads), double(c.points),
+                     c.jacobians_per_point(), c.ms_per_point(), c.cpu_seconds, c.wall_seconds,
+                     c.worst_error, c.median_error, c.energy_reached, c.complete ? 1.0 : 0.0});
   return table;
 }
 
@@ -394,32 +394,36 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
           png,
           fmt::format(
               "set termoption noenhanced\nset multiplot layout 1,2\nset logscale xy\nset grid\n"
+              "floor = {2}\n"
+              "err(d) = column('worst_closed_form_error') > floor ? "
+              "column('worst_closed_form_error') : floor\n"
+              "cpu(s) = strcol('study') eq s && column('complete') == 1 ? "
+              "column('total_seconds') : NaN\n"
+              "square(n) = strcol('study') eq 'corrector' && strcol('newton') eq n && "
+              "column('complete') == 1 ? column('total_seconds') : NaN\n"
               "set key left top\nset xlabel 'shooting intervals N'\n"
               "set ylabel 'CPU ms per point'\nset title 'Mode 1, T 3.8 -> 3.01: cost per point'\n"
-              "plot {0} using (strcol(1) eq 'grid' ? $3 : NaN):8 with linespoints pt 7 ps 1.5 "
-              "title 'regular, eigen, 1 thread, 40 steps per period'{1}, 25 dt 3 title "
-              "'target at N = 160: 25 ms'\n"
+              "plot {0} using (strcol('study') eq 'grid' ? column('N') : NaN):'ms_per_point' "
+              "with linespoints pt 7 ps 1.5 title 'regular, eigen, 1 thread, 40 steps per "
+              "period'{1}, 25 dt 3 title 'target at N = 160: 25 ms'\n"
               "set format y '%.0e'\nset xlabel 'CPU seconds per branch'\n"
               "set ylabel 'worst relative frequency error (closed form)'\n"
               "set title 'Work-precision: whole branches that reach E = 5e-3 (errors of 0 at "
-              "1e-17)'\nset key left bottom\n"
-              "plot {0} using (strcol(1) eq 'grid' && $14 == 1 ? $9 : NaN):($11 > {2} ? $11 : {2}) "
-              "with linespoints pt 7 ps 1.5 title 'N (labels): regular, eigen, 1 thread', "
-              "{0} using (strcol(1) eq 'grid' && $14 == 1 ? $9 : NaN):($11 > {2} ? $11 : "
-              "{2}):(sprintf('%d', $3)) with labels offset 0,1 notitle, "
-              "{0} using (strcol(1) eq 'steps_per_period' && $14 == 1 ? $9 : NaN):($11 > {2} ? "
-              "$11 : {2}) with points pt 5 ps 1.5 title 'N = 40, 80 steps per period', "
-              "{0} using (strcol(1) eq 'formulation' && $14 == 1 ? $9 : NaN):($11 > {2} ? $11 : "
-              "{2}) with points pt 9 ps 1.5 title 'N = 40, paper formulation (drawn only if it "
-              "reaches the bound)', "
-              "{0} using (strcol(2) eq 'N = 40, newton eigen (square: test_elements 0)' && $14 "
-              "== 1 ? $9 : NaN):($11 > {2} ? $11 : {2}) with points pt 11 ps 1.5 title 'N = 40, "
+              "1e-17)'\nset key left top\n"
+              "plot {0} using (cpu('grid')):(err(0)) with linespoints pt 7 ps 1.5 title 'N "
+              "(labels): regular, eigen, 1 thread', "
+              "{0} using (cpu('grid')):(err(0)):(sprintf('%d', column('N'))) with labels offset "
+              "0,1 notitle, "
+              "{0} using (cpu('steps_per_period')):(err(0)) with points pt 5 ps 1.5 title 'N = "
+              "40, 80 steps per period', "
+              "{0} using (cpu('formulation')):(err(0)) with points pt 9 ps 1.5 title 'N = 40, "
+              "paper formulation (drawn only if it reaches the bound)', "
+              "{0} using (square('eigen')):(err(0)) with points pt 11 ps 1.5 title 'N = 40, "
               "square system, eigen', "
-              "{0} using (strcol(2) eq 'N = 40, newton kinsol (square: test_elements 0)' && $14 "
-              "== 1 ? $9 : NaN):($11 > {2} ? $11 : {2}) with points pt 13 ps 1.5 title 'N = 40, "
+              "{0} using (square('kinsol')):(err(0)) with points pt 13 ps 1.5 title 'N = 40, "
               "square system, kinsol', "
-              "{0} using (strcol(1) eq 'threads' && $14 == 1 ? $9 : NaN):($11 > {2} ? $11 : {2}) "
-              "with points pt 3 ps 2 lw 2 title 'N = 80, 2 threads (CPU of both)'\n"
+              "{0} using (cpu('threads')):(err(0)) with points pt 3 ps 2 lw 2 title 'N = 80, 2 "
+              "threads (CPU of both)'\n"
               "unset multiplot\n",
               q, fit_clause, plot_floor),
           {1600, 700}),

@@ -60,7 +60,8 @@ Mode1BranchCost trace_mode1_cost(const Mode1BranchSettings& settings);
 // True when both branches have the same points, every unknown equal bit for bit.
 bool same_branch(const Mode1BranchCost& a, const Mode1BranchCost& b);
 
-// The rows of mode1_scaling.csv: study, setting, N, steps_per_period, threads, points,
+// The rows of mode1_scaling.csv: study, setting, N, steps_per_period, formulation, newton,
+// test_elements, threads, points,
 // jacobians_per_point, ms_per_point (CPU), total_seconds (CPU), wall_seconds,
 // worst_closed_form_error, median_closed_form_error, energy_reached, complete (1 or 0).
 core::Table branch_cost_table(const std::vector<Mode1BranchCost>& runs);
