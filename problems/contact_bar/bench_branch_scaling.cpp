@@ -431,12 +431,13 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
 
   // BENCHMARKS.md: the grid table, the variants, the Jacobian alone.
   const auto row = [](const Mode1BranchCost& c) {
-    return fmt::format(
-        "| {} | {} | {} | {} | {} | {} | {} |{}\n", c.settings.label(), c.points,
-        significant(c.jacobians_per_point()), significant(c.ms_per_point()),
-        significant(c.cpu_seconds), error_text(c.worst_error), error_text(c.median_error),
-        c.complete ? ""
-                   : fmt::format(" stopped at E = {:.3g} ({})", c.energy_reached, c.stop_reason));
+    const std::string stopped =
+        c.complete ? std::string()
+                   : fmt::format(" (stopped at E = {:.2g}: {})", c.energy_reached, c.stop_reason);
+    return fmt::format("| {}{} | {} | {} | {} | {} | {} | {} |\n", c.settings.label(), stopped,
+                       c.points, significant(c.jacobians_per_point()),
+                       significant(c.ms_per_point()), significant(c.cpu_seconds),
+                       error_text(c.worst_error), error_text(c.median_error));
   };
   const std::string header =
       "| setting | points | Jacobians/point | ms/point (CPU) | total CPU s | worst error | "
@@ -449,13 +450,14 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
   const std::string grid_verdict = fmt::format(
       "ms per point grows like N^{:.2f} over N >= 40 (target <= 1.5: {}), N = 160 costs {} ms "
       "per point (target <= 25: {}), and N = {} takes {:.3g}x the points of N = 40 (target "
-      "within 2x at 640: {}).",
+      "within 2x at 640: {}); Jacobians per point grow from {:.3g} at N = 40 to {:.3g} at N = "
+      "{}.",
       exponent, exponent <= 1.5 ? "met" : "not met",
       n160 ? significant(n160->ms_per_point()) : std::string("(not run)"),
       n160 ? (n160->ms_per_point() <= 25 ? "met" : "not met") : "not measured",
       largest.settings.elements, point_ratio,
-      largest.settings.elements < 640 ? "640 not run here"
-                                      : (point_ratio <= 2 ? "met" : "not met"));
+      largest.settings.elements < 640 ? "640 not run here" : (point_ratio <= 2 ? "met" : "not met"),
+      base.jacobians_per_point(), largest.jacobians_per_point(), largest.settings.elements);
   const std::string variant_verdict = fmt::format(
       "at N = 40, 80 steps per period cost {:.2g}x the CPU of 40 for a worst error of {} against "
       "{}; the paper formulation {}; the square system costs {:.2g}x (eigen) and {:.2g}x "
@@ -477,11 +479,12 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
   const std::string jacobian_verdict = fmt::format(
       "2 threads compute the {} x {} Jacobian {:.3g}x faster than one (target >= 1.7x: {}), "
       "{}; these are wall times on a machine of {} cores with a load average of {} when they "
-      "were taken (2 threads can only gain when a second core is free), and the process CPU "
-      "time of 2 threads is {:.2g}x that of one (the cost of sharing the work).",
+      "were taken: the 2 threads ran on {:.2g} cores on average (process CPU / wall), and "
+      "their CPU time is {:.2g}x that of one thread (the cost of sharing the work).",
       jt.rows, jt.columns, jt.speedup(), jt.speedup() >= 1.7 ? "met" : "not met",
       jt.identical ? "bit-identical to one thread's" : "NOT identical to one thread's",
-      std::thread::hardware_concurrency(), load, jt.two_thread_cpu / jt.one_thread_cpu);
+      std::thread::hardware_concurrency(), load, jt.two_thread_cpu / jt.two_thread_seconds,
+      jt.two_thread_cpu / jt.one_thread_cpu);
   fmt::print("  {}\n  {}\n  {}\n", grid_verdict, variant_verdict, jacobian_verdict);
   continuation::write_bench_section(
       out, "mode1_scaling",
@@ -491,12 +494,13 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
           "problems/contact_bar/scenes/paper.ini --branch mode1 --start_offset 0.25 "
           "--energy_max 5e-3 --shooting_elements N` (ds 0.45, steps_per_period 40, regular "
           "formulation, eigen least squares, one thread unless stated), run in-process, one "
-          "run each. Time: process CPU seconds of the continuation (all threads), since the "
+          "run each (best of 3 for runs under 2 s CPU). Time: process CPU seconds of the "
+          "continuation (all threads), since the "
           "machine may be shared; Jacobians per point: BranchPoint::jacobian_evaluations "
           "averaged. Error: |omega / omega_exact(E) - 1| against the mode-1 closed form at "
           "each point's own energy. Grids: BACKBONE_MODE1_SCALING_N (default 20,40,80,160,320; "
           "`BACKBONE_MODE1_SCALING_N=20,40,80,160,320,640,1000 backbone bench --case "
-          "mode1_scaling` adds the large ones). Runs under 2 s CPU: best of 3.\n\n"
+          "mode1_scaling` adds the large ones).\n\n"
           "### Over the grid\n\n{0}{1}\n**Where backbone stands:** {2}\n\n"
           "### Steps per period, formulation, corrector, threads\n\n{0}{3}\n"
           "**Where backbone stands:** {4}\n\n"
