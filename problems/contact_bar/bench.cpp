@@ -12,6 +12,10 @@ std::vector<continuation::ProblemJob> bench_cases() {
        bench_mode1_convergence},
       {"formulations", "regular vs paper shooting residual, Newton from perturbed exact orbits",
        bench_formulations},
+      {"mode1_scaling",
+       "mode 1 branch cost vs closed-form error over N, steps per period, formulation, "
+       "corrector and threads; the FD Jacobian with 1 and 2 threads",
+       bench_mode1_scaling},
   };
 }
 

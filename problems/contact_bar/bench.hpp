@@ -15,6 +15,12 @@
 //                      orbit at fixed energy, iterations, observed orders, error to x*, exact-
 //                      oracle return error and rank reports at the final point, residuals in
 //                      metres whatever unit the problem uses.
+//   mode1_scaling      mode 1 of the paper scene, T 3.8 -> 3.01, traced in-process over the
+//                      grids N (BACKBONE_MODE1_SCALING_N, default 20,40,80,160,320), 80 steps
+//                      per period, the paper formulation, kinsol and 2 threads: points,
+//                      Jacobians and CPU ms per point, worst closed-form error, the exponent of
+//                      ms per point over N >= 40; the FD Jacobian alone at N = 200 with 1 and 2
+//                      threads (bench_branch_scaling.hpp).
 //
 //   for (const continuation::ProblemJob& job : contact_bar::bench_cases())
 //     if (job.name == "bouncing_bar") status = job.run("results/bench");
@@ -27,7 +33,7 @@
 
 namespace backbone::contact_bar {
 
-// The four cases above, in that order (`backbone bench` runs them all).
+// The five cases above, in that order (`backbone bench` runs them all).
 std::vector<continuation::ProblemJob> bench_cases();
 
 // The cases one by one (what bench_cases() calls).
@@ -35,5 +41,6 @@ int bench_tdbem_scaling(const std::filesystem::path& out);
 int bench_bouncing_bar(const std::filesystem::path& out);
 int bench_mode1_convergence(const std::filesystem::path& out);
 int bench_formulations(const std::filesystem::path& out);
+int bench_mode1_scaling(const std::filesystem::path& out);
 
 }  // namespace backbone::contact_bar
