@@ -125,12 +125,12 @@ Mode1BranchCost trace_mode1_cost(const Mode1BranchSettings& settings) {
   Mode1Scene s;
   read_mode1_scene(s, settings);
   continuation::RunSettings run = continuation::read_run_settings(s.scene);
-  const auto corrector = core::make_corrector(run.newton, run.newton_options);
   continuation::TraceSetup setup = s.plugin->setup(s.scene, "mode1");
   if (setup.branch_options) {
-    setup.branch_options(run.options);
+    setup.branch_options(run.options, run.newton_options);
     run.options.validate();
   }
+  const auto corrector = core::make_corrector(run.newton, run.newton_options);
   auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get());
   if (!periodic) throw core::InputError("branch", "mode1 is not a periodic-orbit problem");
   periodic->set_formulation(run.formulation);
