@@ -47,13 +47,6 @@ double wall_seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-double median(std::vector<double> values) {
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
 // The plugin, its keys and the scene of one run, read as `backbone trace` reads them.
 struct Mode1Scene {
   continuation::PluginRegistry registry;
@@ -165,7 +158,7 @@ Mode1BranchCost trace_mode1_cost(const Mode1BranchSettings& settings) {
     c.jacobians += p.jacobian_evaluations;
     c.unknowns.push_back(p.x);
   }
-  c.median_error = median(errors);
+  c.median_error = bench::median(errors);
   c.worst_error = errors.empty() ? std::nan("") : *std::max_element(errors.begin(), errors.end());
   c.energy_reached =
       branch.points.empty() ? std::nan("") : branch.points.back().observable("energy");

@@ -16,6 +16,7 @@
 #include "core/plot.hpp"
 #include "core/scene.hpp"
 #include "core/table.hpp"
+#include "problems/contact_bar/bench_support.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/scene.hpp"
 #include "problems/contact_bar/tdbem.hpp"
@@ -39,13 +40,6 @@ std::filesystem::path contact_bar_folder() {
   const std::filesystem::path built_in = BACKBONE_CONTACT_BAR_DIR;
   if (std::filesystem::exists(built_in / "scenes" / "paper.ini")) return built_in;
   return "problems/contact_bar";  // a moved source tree: relative to the repository root
-}
-
-double median(std::vector<double> values) {
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 // Compute seconds of a run: the process CPU time on one thread, since the peers' figures are of
@@ -134,7 +128,7 @@ Mode1Trace trace_paper_mode1(int shooting_elements) {
   for (const continuation::BranchPoint& p : branch.points)
     errors.push_back(
         std::abs(p.observable("frequency") / family.frequency(p.observable("energy")) - 1));
-  t.median_error = median(errors);
+  t.median_error = bench::median(errors);
   t.max_error = errors.empty() ? std::nan("") : *std::max_element(errors.begin(), errors.end());
   return t;
 }
@@ -163,11 +157,12 @@ int bench_lu_legrand(const std::filesystem::path& out) {
     for (std::size_t j = 0; j < points.rows(); ++j)
       if (admissible[j] == 1) errors.push_back(error[j]);
     peer_rows.push_back({harmonics, static_cast<int>(points.rows()), runs.column("seconds")[i],
-                         runs.column("ms_per_point")[i], median(errors),
+                         runs.column("ms_per_point")[i], bench::median(errors),
                          *std::max_element(errors.begin(), errors.end())});
     table.add_cells({std::string("lu_legrand"), fmt::format("{} harmonics", harmonics),
                      double(points.rows()), runs.column("seconds")[i],
-                     runs.column("ms_per_point")[i], median(errors), peer_rows.back().max, 0.0});
+                     runs.column("ms_per_point")[i], bench::median(errors), peer_rows.back().max,
+                     0.0});
   }
 
   int status = 0;
@@ -180,7 +175,7 @@ int bench_lu_legrand(const std::filesystem::path& out) {
       seconds.push_back(t.seconds);
       if (t.seconds > 5) break;  // one run of a slow grid is enough
     }
-    t.seconds = median(seconds);
+    t.seconds = bench::median(seconds);
     if (!t.complete) {
       fmt::print("  warning: N = {} stopped early: {}\n", elements, t.message);
       status = 1;
@@ -305,7 +300,7 @@ int bench_siconos_bar(const std::filesystem::path& out) {
     const double energy_change = he.energy.empty()
                                      ? std::nan("")
                                      : (he.energy.back() - he.energy.front()) / he.energy.front();
-    const double us = 1e6 * median(seconds) / static_cast<double>(steps);
+    const double us = 1e6 * bench::median(seconds) / static_cast<double>(steps);
     rows.push_back({elements, us, error, energy_change});
     table.add_cells({std::string("backbone_tdbem"), double(elements), double(steps), us, error,
                      energy_change, 1.0});

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 namespace backbone::contact_bar::bench {
 
@@ -19,6 +20,13 @@ PaperMode1 paper_mode1() {
   const double energy = m.eps * m.eps / 2 * material.axial_stiffness() * material.length;
   m.episode = mode1_contact_episode(material, gap, energy);
   return m;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 double seconds_of(const std::function<void()>& run) {

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <vector>
 
 #include "core/plot.hpp"
 #include "problems/bar/bar.hpp"
@@ -23,6 +24,9 @@ struct PaperMode1 {
   Mode1ContactEpisode episode;
 };
 PaperMode1 paper_mode1();
+
+// The median (NaN for none): the middle value, or the mean of the two middle ones.
+double median(std::vector<double> values);
 
 // Wall-clock seconds of one run.
 double seconds_of(const std::function<void()>& run);
