@@ -251,6 +251,9 @@ core::Vector read_unknowns(const std::filesystem::path& path, int point, const s
   return x;
 }
 
+namespace {
+
+// The saved points before resumed's first (dir/unknowns.csv), then resumed's own.
 Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
                     const Branch& resumed) {
   Branch whole;
@@ -277,9 +280,10 @@ Branch whole_branch(const std::filesystem::path& dir, const core::Problem& probl
   return whole;
 }
 
+// Rows of `saved` whose `column` is below `below`, then those of `fresh`; `fresh` alone when
+// the columns differ and fresh has rows (an empty table may lack the description columns).
 core::Table merge_saved_rows(const core::Table& saved, const core::Table& fresh,
                              const std::string& column, double below) {
-  // An empty table may lack columns that only rows bring (the problem's descriptions).
   if (saved.columns() != fresh.columns() && fresh.rows() > 0) return fresh;
   core::Table merged(saved.columns());
   const std::vector<double> key = saved.column(column);
@@ -287,6 +291,22 @@ core::Table merge_saved_rows(const core::Table& saved, const core::Table& fresh,
     if (key[i] < below) merged.add_cells(saved.cells(i));
   for (std::size_t i = 0; i < fresh.rows(); ++i) merged.add_cells(fresh.cells(i));
   return merged;
+}
+
+}  // namespace
+
+void write_after_run(
+    const std::filesystem::path& out, const core::Problem& problem, const Branch& branch,
+    bool resumed, bool detect,
+    const std::function<void(const std::filesystem::path&, const Branch&)>& extra) {
+  if (extra) extra(out, resumed ? whole_branch(out, problem, branch) : branch);
+  if (!detect) return;
+  core::Table rows = branch_point_table(branch, branch.points.front().observables);
+  const std::filesystem::path saved = out / "branch_points.csv";
+  if (resumed && std::filesystem::exists(saved))
+    rows = merge_saved_rows(core::Table::read_csv(saved), rows, "after_point",
+                            branch.points.front().index);
+  rows.write_csv(saved);
 }
 
 }  // namespace backbone::continuation

@@ -23,6 +23,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -81,17 +82,13 @@ int repair_branch_files(const std::filesystem::path& out, const std::string& key
 // when the file cannot be read or has no such point.
 core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key);
 
-// A resumed run's whole branch, as its files hold it: the saved points before the first point of
-// `resumed` (their unknowns from DIR/unknowns.csv, observables recomputed by `problem`; rank
-// fields unset), then resumed's points, branch points, reason and message. Outputs written after
-// the run (the problem's extra outputs, branch_points.csv) then cover the whole branch.
-Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
-                    const Branch& resumed);
-
-// Rows of `saved` (an earlier run's table, e.g. branch_points.csv) whose column `column` is
-// below `below`, then the rows of `fresh`: the table of a resumed run. `fresh` alone when the
-// two tables have different columns and fresh has rows.
-core::Table merge_saved_rows(const core::Table& saved, const core::Table& fresh,
-                             const std::string& column, double below);
+// What trace writes after the run: the problem's extra outputs (`extra`) and, with `detect`,
+// branch_points.csv. After a resume (`resumed`) the branch holds only the resumed points; both
+// then cover the whole branch as its files hold it: the saved points before the first resumed
+// one are read back from out/unknowns.csv (observables recomputed, rank fields unset), and the
+// saved rows of branch_points.csv located before it are kept.
+void write_after_run(const std::filesystem::path& out, const core::Problem& problem,
+                     const Branch& branch, bool resumed, bool detect,
+                     const std::function<void(const std::filesystem::path&, const Branch&)>& extra);
 
 }  // namespace backbone::continuation

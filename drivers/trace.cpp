@@ -8,6 +8,7 @@
 // before anything is written (exit 2). A branch that ends early keeps and writes its points
 // (exit 0, reason printed and in summary.txt); exit 1 only when no point converged.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <csignal>
@@ -48,12 +49,6 @@ po::options_description driver_keys() {
   return keys;
 }
 
-std::string joined(const std::vector<std::string>& words) {
-  std::string list;
-  for (const auto& w : words) list += (list.empty() ? "" : ", ") + w;
-  return list;
-}
-
 void print_help(const cont::ProblemPlugin* problem) {
   fmt::print(
       "usage: backbone trace SCENE [--branch NAME] [--out DIR] [--start DIR:K] [--key value ...]\n"
@@ -61,7 +56,7 @@ void print_help(const cont::ProblemPlugin* problem) {
   fmt::print("problems (scene key `problem`):\n");
   for (const auto& p : plugins().all())
     if (p.can_trace())
-      fmt::print("  {:<14} {} (branches: {})\n", p.name, p.summary, joined(p.branches));
+      fmt::print("  {:<14} {} (branches: {})\n", p.name, p.summary, fmt::join(p.branches, ", "));
   std::ostringstream text;
   text << "\n" << driver_keys() << "\n";
   if (problem) {
@@ -115,8 +110,9 @@ int run_trace(const std::vector<std::string>& args_in) {
   const core::Scene scene = core::read_scene(keys, scene_path, rest, driver_keys());
   const std::string branch_name = scene.has("branch") ? scene.text("branch") : entry.branches.at(0);
   if (std::find(entry.branches.begin(), entry.branches.end(), branch_name) == entry.branches.end())
-    throw core::InputError("branch", fmt::format("'{}' is not a branch of {} (known: {})",
-                                                 branch_name, entry.name, joined(entry.branches)));
+    throw core::InputError(
+        "branch", fmt::format("'{}' is not a branch of {} (known: {})", branch_name, entry.name,
+                              fmt::join(entry.branches, ", ")));
   const std::filesystem::path out =
       scene.has("out") ? scene.text("out") : fmt::format("out/{}_{}", entry.name, branch_name);
   core::check_output_folder("out", out);
@@ -246,18 +242,8 @@ int run_trace(const std::vector<std::string>& args_in) {
     cont::plot_branch(out, table,
                       fmt::format("{} / {} ({} points)", entry.name, branch_name, table.rows()),
                       entry.units);
-    // After --resume the branch holds only the resumed points; the files hold them all.
-    const cont::Branch whole =
-        resume.empty() ? cont::Branch{} : cont::whole_branch(out, problem, branch);
-    const cont::Branch& all = resume.empty() ? branch : whole;
-    if (setup.write_extra_outputs) setup.write_extra_outputs(out, all);
-    if (options.branch_points.detect) {
-      core::Table rows = cont::branch_point_table(branch, branch.points.front().observables);
-      if (!resume.empty() && std::filesystem::exists(out / "branch_points.csv"))
-        rows = cont::merge_saved_rows(core::Table::read_csv(out / "branch_points.csv"), rows,
-                                      "after_point", branch.points.front().index);
-      rows.write_csv(out / "branch_points.csv");
-    }
+    cont::write_after_run(out, problem, branch, !resume.empty(), options.branch_points.detect,
+                          setup.write_extra_outputs);
     for (const auto& f :
          cont::follow_branch_points(problem, branch, run.follow, *follow_corrector, options, hooks,
                                     out, setup.write_extra_outputs, entry.units))
