@@ -4,6 +4,14 @@
 
 namespace backbone::continuation {
 
+void TraceSetup::apply_branch_options(ContinuationOptions& options,
+                                      core::NewtonOptions& newton) const {
+  if (!branch_options) return;
+  branch_options(options, newton);
+  options.validate();
+  newton.validate();
+}
+
 void PluginRegistry::add(ProblemPlugin plugin) {
   if (plugin.name.empty()) throw std::logic_error("a problem plugin needs a name");
   if (find(plugin.name))

@@ -33,6 +33,7 @@
 
 #include "continuation/branch.hpp"
 #include "continuation/options.hpp"
+#include "core/newton.hpp"
 #include "core/problem.hpp"
 #include "core/scene.hpp"
 #include "core/types.hpp"
@@ -66,6 +67,9 @@ struct TraceSetup {
   // Optional: describes a verified branch point (ContinuationHooks::describe_branch_point).
   std::function<core::Observables(const core::Vector& on_branch, const core::Vector& attached)>
       describe_branch_point;
+  // Applies branch_options (when set) to the settings a run read from its scene and checks
+  // them: what every runner of a trace (trace, the benchmarks) does before making its corrector.
+  void apply_branch_options(ContinuationOptions& options, core::NewtonOptions& newton) const;
 };
 
 // A named job of a problem that writes into a folder: a benchmark case (`backbone bench

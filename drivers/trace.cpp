@@ -125,11 +125,7 @@ int run_trace(const std::vector<std::string>& args_in) {
   cont::TraceSetup setup = entry.setup(scene, branch_name);
   if (!setup.problem) throw core::InputError("problem", "setup returned no problem");
   const core::Problem& problem = *setup.problem;
-  if (setup.branch_options) {
-    setup.branch_options(options, run.newton_options);
-    options.validate();
-    run.newton_options.validate();
-  }
+  setup.apply_branch_options(options, run.newton_options);
   auto corrector = core::make_corrector(run.newton, run.newton_options);
   auto follow_corrector =
       core::make_corrector(run.newton, cont::follow_newton_options(run.newton_options, options));

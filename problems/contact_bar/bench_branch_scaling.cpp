@@ -119,10 +119,7 @@ Mode1BranchCost trace_mode1_cost(const Mode1BranchSettings& settings) {
   read_mode1_scene(s, settings);
   continuation::RunSettings run = continuation::read_run_settings(s.scene);
   continuation::TraceSetup setup = s.plugin->setup(s.scene, "mode1");
-  if (setup.branch_options) {
-    setup.branch_options(run.options, run.newton_options);
-    run.options.validate();
-  }
+  setup.apply_branch_options(run.options, run.newton_options);
   const auto corrector = core::make_corrector(run.newton, run.newton_options);
   auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get());
   if (!periodic) throw core::InputError("branch", "mode1 is not a periodic-orbit problem");

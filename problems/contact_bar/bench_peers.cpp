@@ -100,8 +100,9 @@ Mode1Trace trace_paper_mode1(int shooting_elements) {
                        po::options_description());
   continuation::RunSettings run = continuation::read_run_settings(scene);
   run.threads = core::default_jacobian_threads();  // `backbone bench --threads K`
-  const auto corrector = core::make_corrector(run.newton, run.newton_options);
   continuation::TraceSetup setup = plugin.setup(scene, "mode1");
+  setup.apply_branch_options(run.options, run.newton_options);  // as `trace` does
+  const auto corrector = core::make_corrector(run.newton, run.newton_options);
   auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get());
   if (!periodic) throw core::InputError("branch", "mode1 is not a periodic-orbit problem");
   periodic->set_formulation(run.formulation);
