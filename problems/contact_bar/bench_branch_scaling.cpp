@@ -37,12 +37,6 @@ namespace {
 
 namespace po = boost::program_options;
 
-double process_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 double wall_seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -117,41 +111,18 @@ double Mode1BranchCost::jacobians_per_point() const {
 Mode1BranchCost trace_mode1_cost(const Mode1BranchSettings& settings) {
   Mode1Scene s;
   read_mode1_scene(s, settings);
-  continuation::RunSettings run = continuation::read_run_settings(s.scene);
-  continuation::TraceSetup setup = s.plugin->setup(s.scene, "mode1");
-  setup.apply_branch_options(run.options, run.newton_options);
-  const auto corrector = core::make_corrector(run.newton, run.newton_options);
-  auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get());
-  if (!periodic) throw core::InputError("branch", "mode1 is not a periodic-orbit problem");
-  periodic->set_formulation(run.formulation);
-  if (run.newton == "kinsol" && periodic->num_equations() != periodic->num_unknowns() - 1)
-    throw core::InputError("newton", "kinsol solves square systems only: use test_elements 0");
-  const core::Vector direction =
-      setup.direction.size()
-          ? setup.direction
-          : core::Vector::Unit(periodic->num_unknowns(), periodic->period_index());
-  continuation::ContinuationHooks hooks;
-  hooks.reject_point = setup.reject_point;
-
-  const double cpu_start = process_cpu_seconds();
-  const auto wall_start = std::chrono::steady_clock::now();
-  const continuation::SwitchingBranch traced =
-      continuation::run_continuation(*periodic, setup.guess, direction, run, *corrector, hooks);
+  const bench::InProcessTrace t = bench::trace_in_process(*s.plugin, s.scene, "mode1");
   Mode1BranchCost c;
-  c.cpu_seconds = process_cpu_seconds() - cpu_start;
-  c.wall_seconds = wall_seconds_since(wall_start);
+  c.cpu_seconds = t.cpu_seconds;
+  c.wall_seconds = t.wall_seconds;
   c.settings = settings;
-  const continuation::Branch& branch = traced.branch;
+  const continuation::Branch& branch = t.traced.branch;
   c.points = static_cast<int>(branch.points.size());
   c.message = branch.message;
   c.stop_reason = continuation::to_string(branch.reason);
   c.complete = branch.reason == continuation::StopReason::bound_reached;
-  const bar::BarSetup bar = bar_from_scene(s.scene);
-  const ContactFamily family(bar.material, bar.right.gap, 1);
-  std::vector<double> errors;
+  const std::vector<double> errors = bench::mode1_frequency_errors(s.scene, branch);
   for (const continuation::BranchPoint& p : branch.points) {
-    errors.push_back(
-        std::abs(p.observable("frequency") / family.frequency(p.observable("energy")) - 1));
     c.jacobians += p.jacobian_evaluations;
     c.unknowns.push_back(p.x);
   }
@@ -242,11 +213,11 @@ JacobianThreadsTiming time_jacobian_threads(int elements, int repetitions) {
     fd.threads = k + 1;
     wall[k] = std::numeric_limits<double>::infinity();
     for (int r = 0; r < std::max(repetitions, 1); ++r) {
-      const double cpu_start = process_cpu_seconds();
+      const double cpu_start = bench::process_cpu_seconds();
       const auto wall_start = std::chrono::steady_clock::now();
       const core::EvalStatus status =
           core::finite_difference_jacobian(problem, setup.guess, J[k], fd);
-      const double w = wall_seconds_since(wall_start), c = process_cpu_seconds() - cpu_start;
+      const double w = wall_seconds_since(wall_start), c = bench::process_cpu_seconds() - cpu_start;
       if (status != core::EvalStatus::ok) J[k].resize(0, 0);  // not identical to anything
       if (w < wall[k]) wall[k] = w, cpu[k] = c;
     }

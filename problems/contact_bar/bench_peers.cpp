@@ -74,13 +74,6 @@ std::string clock_name() {
 // Errors of exactly 0 (round-off luck) are drawn at this floor on the log axes.
 constexpr double plot_floor = 1e-17;
 
-void report_plot(const core::PlotResult& result, const std::filesystem::path& png) {
-  if (result.ok)
-    fmt::print("  wrote {}\n", png.string());
-  else
-    fmt::print("  figure skipped: {}\n", result.message);
-}
-
 }  // namespace
 
 std::filesystem::path contact_bar_peers_folder() {
@@ -96,39 +89,19 @@ Mode1Trace trace_paper_mode1(int shooting_elements) {
   const core::Scene scene =
       core::read_scene(keys, (contact_bar_folder() / "scenes" / "paper.ini").string(),
                        {"--start_offset", "0.25", "--energy_max", "5e-3", "--shooting_elements",
-                        std::to_string(shooting_elements)},
+                        std::to_string(shooting_elements), "--threads",
+                        std::to_string(core::default_jacobian_threads())},  // bench --threads K
                        po::options_description());
-  continuation::RunSettings run = continuation::read_run_settings(scene);
-  run.threads = core::default_jacobian_threads();  // `backbone bench --threads K`
-  continuation::TraceSetup setup = plugin.setup(scene, "mode1");
-  setup.apply_branch_options(run.options, run.newton_options);  // as `trace` does
-  const auto corrector = core::make_corrector(run.newton, run.newton_options);
-  auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get());
-  if (!periodic) throw core::InputError("branch", "mode1 is not a periodic-orbit problem");
-  periodic->set_formulation(run.formulation);
-  const core::Vector direction =
-      setup.direction.size()
-          ? setup.direction
-          : core::Vector::Unit(periodic->num_unknowns(), periodic->period_index());
-  continuation::ContinuationHooks hooks;
-  hooks.reject_point = setup.reject_point;
-
-  const Stopwatch stopwatch;
-  const continuation::SwitchingBranch traced =
-      continuation::run_continuation(*periodic, setup.guess, direction, run, *corrector, hooks);
+  const bench::InProcessTrace run = bench::trace_in_process(plugin, scene, "mode1");
   Mode1Trace t;
-  t.seconds = stopwatch.seconds();
-  const continuation::Branch& branch = traced.branch;
+  // As Stopwatch: CPU time on one thread, wall time with `bench --threads K > 1`.
+  t.seconds = core::default_jacobian_threads() > 1 ? run.wall_seconds : run.cpu_seconds;
+  const continuation::Branch& branch = run.traced.branch;
   t.elements = shooting_elements;
   t.points = static_cast<int>(branch.points.size());
   t.message = branch.message;
   t.complete = branch.reason == continuation::StopReason::bound_reached;
-  const bar::BarSetup bar = bar_from_scene(scene);
-  const ContactFamily family(bar.material, bar.right.gap, 1);
-  std::vector<double> errors;
-  for (const continuation::BranchPoint& p : branch.points)
-    errors.push_back(
-        std::abs(p.observable("frequency") / family.frequency(p.observable("energy")) - 1));
+  const std::vector<double> errors = bench::mode1_frequency_errors(scene, branch);
   t.median_error = bench::median(errors);
   t.max_error = errors.empty() ? std::nan("") : *std::max_element(errors.begin(), errors.end());
   return t;
@@ -191,7 +164,7 @@ int bench_lu_legrand(const std::filesystem::path& out) {
 
   const std::string q = core::gnuplot_quote(csv);
   const std::filesystem::path png = out / "lu_legrand.png";
-  report_plot(
+  bench::report_plot(
       core::render_png(
           png,
           fmt::format(
@@ -312,7 +285,7 @@ int bench_siconos_bar(const std::filesystem::path& out) {
 
   const std::string q = core::gnuplot_quote(csv);
   const std::filesystem::path png = out / "siconos_bar.png";
-  report_plot(
+  bench::report_plot(
       core::render_png(
           png,
           fmt::format(

@@ -4,7 +4,16 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <ctime>
 #include <limits>
+
+#include "continuation/scene_options.hpp"
+#include "core/errors.hpp"
+#include "core/newton.hpp"
+#include "core/periodic_orbit.hpp"
+#include "problems/contact_bar/family.hpp"
+#include "problems/contact_bar/scene.hpp"
 
 namespace backbone::contact_bar::bench {
 
@@ -27,6 +36,53 @@ double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const std::size_t n = values.size();
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+InProcessTrace trace_in_process(const continuation::ProblemPlugin& plugin, const core::Scene& scene,
+                                const std::string& branch) {
+  continuation::RunSettings run = continuation::read_run_settings(scene);
+  continuation::TraceSetup setup = plugin.setup(scene, branch);
+  setup.apply_branch_options(run.options, run.newton_options);
+  const auto corrector = core::make_corrector(run.newton, run.newton_options);
+  auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get());
+  if (!periodic)
+    throw core::InputError("branch", fmt::format("{} is not a periodic-orbit problem", branch));
+  periodic->set_formulation(run.formulation);
+  if (run.newton == "kinsol" && periodic->num_equations() != periodic->num_unknowns() - 1)
+    throw core::InputError("newton", "kinsol solves square systems only: use test_elements 0");
+  const core::Vector direction =
+      setup.direction.size()
+          ? setup.direction
+          : core::Vector::Unit(periodic->num_unknowns(), periodic->period_index());
+  continuation::ContinuationHooks hooks;
+  hooks.reject_point = setup.reject_point;
+
+  InProcessTrace t;
+  const double cpu_start = process_cpu_seconds();
+  const auto wall_start = std::chrono::steady_clock::now();
+  t.traced =
+      continuation::run_continuation(*periodic, setup.guess, direction, run, *corrector, hooks);
+  t.cpu_seconds = process_cpu_seconds() - cpu_start;
+  t.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return t;
+}
+
+std::vector<double> mode1_frequency_errors(const core::Scene& scene,
+                                           const continuation::Branch& branch) {
+  const bar::BarSetup bar = bar_from_scene(scene);
+  const ContactFamily family(bar.material, bar.right.gap, 1);
+  std::vector<double> errors;
+  for (const continuation::BranchPoint& p : branch.points)
+    errors.push_back(
+        std::abs(p.observable("frequency") / family.frequency(p.observable("energy")) - 1));
+  return errors;
+}
+
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 double seconds_of(const std::function<void()>& run) {

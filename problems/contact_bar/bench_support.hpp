@@ -1,16 +1,22 @@
 // What the contact-bar benchmark cases (bench_*.cpp) share besides their metrics: the mode-1
-// scene, timing and figure reporting. Internal to problems/contact_bar.
+// scene, an in-process trace, timing and figure reporting. Internal to problems/contact_bar.
 //
 //   const bench::PaperMode1 m = bench::paper_mode1();   // m.episode.period = 3.1
 //   const double s = bench::best_seconds([&] { solver.simulate(setup, options); });
+//   const bench::InProcessTrace t = bench::trace_in_process(plugin, scene, "mode1");
+//   const std::vector<double> e = bench::mode1_frequency_errors(scene, t.traced.branch);
 //   bench::report_plot(core::render_png(png, script), png);
 #pragma once
 
 #include <filesystem>
 #include <functional>
+#include <string>
 #include <vector>
 
+#include "continuation/plugin.hpp"
+#include "continuation/switching.hpp"
 #include "core/plot.hpp"
+#include "core/scene.hpp"
 #include "problems/bar/bar.hpp"
 #include "problems/contact_bar/bench_metrics.hpp"
 
@@ -27,6 +33,26 @@ PaperMode1 paper_mode1();
 
 // The median (NaN for none): the middle value, or the mean of the two middle ones.
 double median(std::vector<double> values);
+
+// One branch traced in-process as `backbone trace` traces it: the plugin's setup, the branch's
+// own options (TraceSetup::apply_branch_options), the scene's formulation, corrector and
+// direction, and its reject_point hook; with the CPU and wall seconds of the continuation alone.
+// Throws InputError for a branch that is not a periodic-orbit problem, or kinsol on a
+// non-square system.
+struct InProcessTrace {
+  continuation::SwitchingBranch traced;
+  double cpu_seconds = 0, wall_seconds = 0;
+};
+InProcessTrace trace_in_process(const continuation::ProblemPlugin& plugin, const core::Scene& scene,
+                                const std::string& branch);
+
+// |omega / omega_exact(E) - 1| at each point of a mode-1 branch of the scene, against the
+// closed form (problems/contact_bar/README.md, 'Mode 1').
+std::vector<double> mode1_frequency_errors(const core::Scene& scene,
+                                           const continuation::Branch& branch);
+
+// CPU seconds of this process (all its threads).
+double process_cpu_seconds();
 
 // Wall-clock seconds of one run.
 double seconds_of(const std::function<void()>& run);
