@@ -9,6 +9,7 @@
 
 #include "continuation/pseudo_arclength.hpp"
 #include "core/bordered_system.hpp"
+#include "core/eigen_newton.hpp"
 
 namespace backbone::continuation {
 
@@ -39,16 +40,93 @@ TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vect
   return result;
 }
 
+// Chord corrections with one Jacobian J (the unit scale's, m x n): Gauss-Newton steps with J's
+// truncated pseudo-inverse (singular values <= cutoff count as zero), and, for the hyperplane
+// row a . (y - anchor) = 0, a move in J's null space N towards a. The constraint is met after
+// every step when a has a component in N (|N^T a| >= 1/2): a probe direction is one of N's, and
+// a chord of the branch is close to its tangent, which is in N. One residual per step.
+struct BranchPointDetector::Chord {
+  core::Matrix jacobian;        // J itself
+  core::Matrix pseudo_inverse;  // n x m
+  core::Matrix null_space;      // n x nullity
+  Chord(const core::Matrix& J, double cutoff) : jacobian(J) {
+    Eigen::BDCSVD<core::Matrix> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const Eigen::Index k = svd.singularValues().size();
+    Eigen::Index rank = 0;
+    while (rank < k && svd.singularValues()[rank] > cutoff) ++rank;
+    pseudo_inverse = svd.matrixV().leftCols(rank) *
+                     svd.singularValues().head(rank).cwiseInverse().asDiagonal() *
+                     svd.matrixU().leftCols(rank).transpose();
+    // J is m x n with m >= n - 1: the thin V holds min(m, n) columns; a wide J has n - m more
+    // null directions, which the thin SVD does not return (not needed for m >= n).
+    null_space = svd.matrixV().rightCols(k - rank);
+  }
+};
+
 struct BranchPointDetector::Evaluation {
   bool ok = false;
-  core::Vector z, tangent;
+  core::Vector z, tangent;  // unit scale
+  core::Matrix jacobian;    // unit scale, at z
   TestFunctionValue tau;
 };
+
+core::Vector BranchPointDetector::factor() const {
+  return problem_.scale().cwiseQuotient(problem_.unit_scale());
+}
+
+core::Matrix BranchPointDetector::in_unit_scale(const core::Matrix& J) const {
+  core::Matrix out = J * factor().cwiseInverse().asDiagonal();
+  const core::Vector& rf = problem_.residual_factor();
+  if (rf.size() > 0) out = rf.asDiagonal() * out;
+  return out;
+}
+
+bool BranchPointDetector::chord_correct(const Chord& chord, const core::Vector& normal,
+                                        const core::Vector& anchor, core::Vector& y) const {
+  const core::Vector w = chord.null_space.transpose() * normal;
+  if (!(w.squaredNorm() >= 0.25)) return false;
+  const core::Vector f = factor();
+  const core::Vector& rf = problem_.residual_factor();
+  const double tolerance = options_.verification.corrector_options().residual_tolerance;
+  // On failure y is left at the iterate with the smallest residual (a start for a corrector).
+  core::Vector best = y;
+  double previous = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    core::Vector r;
+    if (problem_.residual(y.cwiseQuotient(f), r) != core::EvalStatus::ok) break;
+    const double plane = normal.dot(y - anchor);
+    if (r.lpNorm<Eigen::Infinity>() <= tolerance && std::abs(plane) <= tolerance) return true;
+    if (rf.size() > 0) r = r.cwiseProduct(rf);
+    // Linear convergence or none: a step that does not shrink the residual by 0.7 ends it.
+    const double norm = r.norm();
+    if (norm < previous) best = y;
+    if (!(norm <= 0.7 * previous)) break;
+    previous = norm;
+    core::Vector dx = -chord.pseudo_inverse * r;
+    dx += chord.null_space * (w * ((-plane - normal.dot(dx)) / w.squaredNorm()));
+    y += dx;
+    if (!y.allFinite()) break;
+  }
+  y = best;
+  return false;
+}
 
 BranchPointDetector::BranchPointDetector(const ScaledProblem& problem,
                                          const ContinuationOptions& options,
                                          const ContinuationHooks& hooks, core::Corrector& corrector)
-    : problem_(problem), options_(options), hooks_(hooks), corrector_(corrector) {}
+    : problem_(problem), options_(options), hooks_(hooks), corrector_(corrector) {
+  // What the chord steps leave is finished by Gauss-Newton that keeps its Jacobian while it
+  // contracts (core::NewtonOptions::reuse_jacobian), to the verifier's tolerance: a located
+  // point's correction within max_iterations 10, a probe's within 5 (the probes that converged
+  // on the contact bar at 100 intervals took at most 4 iterations of the loop's corrector; the
+  // ones that did not, 6 to 10).
+  core::NewtonOptions newton = options.verification.corrector_options();
+  newton.reuse_jacobian = true;
+  newton.max_iterations = 10;
+  finisher_ = core::make_corrector("eigen", newton);
+  newton.max_iterations = 5;
+  probe_finisher_ = core::make_corrector("eigen", newton);
+}
 
 BranchPointDetector::~BranchPointDetector() = default;
 
@@ -59,6 +137,7 @@ double BranchPointDetector::last_value() const {
 void BranchPointDetector::restore(std::vector<TestFunctionSample> samples, double jacobian_scale) {
   samples_ = std::move(samples);
   jacobian_scale_ = jacobian_scale;
+  last_jacobian_.resize(0, 0);
 }
 
 std::vector<BranchPointReport> BranchPointDetector::take() {
@@ -67,17 +146,29 @@ std::vector<BranchPointReport> BranchPointDetector::take() {
   return out;
 }
 
+double BranchPointDetector::null_cutoff() const {
+  // The rank report's: relative to the branch's Jacobian scale (verify()).
+  return options_.rank.relative_threshold * jacobian_scale_;
+}
+
 void BranchPointDetector::add(int index, const core::Vector& z, const core::Vector& tangent,
                               const core::Matrix& J, double arclength) {
+  // Everything the detector keeps and compares is in the unit scale (scaled_problem.hpp): the
+  // loop's units may follow the point (LocalScale), and a test function of J in the point's own
+  // units would change from sample to sample with the units alone (the period column and the
+  // equations in units of the amplitude).
+  const core::Vector f = factor();
   Sample sample;
   sample.index = index;
-  sample.z = z;
-  sample.tangent = tangent;
+  sample.z = z.cwiseProduct(f);
+  sample.tangent = tangent.cwiseProduct(f).normalized();
   sample.s = arclength;
+  last_jacobian_ = in_unit_scale(J);
   // One scale for the whole branch (J may vanish at a branch point: a per-point norm would hide
   // it): the Frobenius norm of the first point's Jacobian.
-  if (!(jacobian_scale_ > 0)) jacobian_scale_ = J.norm() > 0 ? J.norm() : 1.0;
-  sample.tau = bordered_test_function(J, tangent, jacobian_scale_,
+  if (!(jacobian_scale_ > 0))
+    jacobian_scale_ = last_jacobian_.norm() > 0 ? last_jacobian_.norm() : 1.0;
+  sample.tau = bordered_test_function(last_jacobian_, sample.tangent, jacobian_scale_,
                                       samples_.empty() ? nullptr : &samples_.back().tau);
   samples_.push_back(std::move(sample));
   if (samples_.size() > 3) samples_.erase(samples_.begin());
@@ -101,9 +192,60 @@ void BranchPointDetector::add(int index, const core::Vector& z, const core::Vect
   }
 }
 
+bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vector& normal,
+                                           const core::Vector& anchor, core::Vector& y_io,
+                                           int max_iterations) const {
+  // On failure y_io is left as it was.
+  core::Vector y = y_io;
+  const core::Matrix& N = chord.null_space;
+  if (N.cols() == 0) return false;
+  const core::Vector f = factor();
+  const core::Vector& rf = problem_.residual_factor();
+  const double tolerance = options_.verification.corrector_options().residual_tolerance;
+  const auto residual = [&](const core::Vector& at, core::Vector& r) {
+    if (problem_.residual(at.cwiseQuotient(f), r) != core::EvalStatus::ok) return false;
+    if (rf.size() > 0) r = r.cwiseProduct(rf);
+    return r.allFinite();
+  };
+  const core::Matrix JN_chord = chord.jacobian * N;
+  double previous = std::numeric_limits<double>::infinity();  // a step must halve |F|
+  for (int iteration = 0; iteration <= max_iterations; ++iteration) {
+    core::Vector r;
+    if (!residual(y, r)) return false;
+    const double plane = normal.dot(y - anchor);
+    const double local =
+        rf.size() > 0 ? r.cwiseQuotient(rf).lpNorm<Eigen::Infinity>() : r.lpNorm<Eigen::Infinity>();
+    if (local <= tolerance && std::abs(plane) <= tolerance) {
+      y_io = y;
+      return true;
+    }
+    if (iteration == max_iterations || !(local <= 0.5 * previous)) return false;
+    previous = local;
+    // Forward differences along N at y (one residual each).
+    const double h = 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
+    core::Matrix JN(r.size(), N.cols());
+    for (Eigen::Index k = 0; k < N.cols(); ++k) {
+      core::Vector rk;
+      if (!residual(y + h * N.col(k), rk)) return false;
+      JN.col(k) = (rk - r) / h;
+    }
+    core::Matrix bordered(r.size() + 1, y.size());
+    bordered.topRows(r.size()) = chord.jacobian + (JN - JN_chord) * N.transpose();
+    bordered.row(r.size()) = normal.transpose();
+    core::Vector rhs(r.size() + 1);
+    rhs << -r, -plane;
+    core::Vector dx;
+    core::minimum_norm_solve(bordered, rhs, options_.rank.relative_threshold, dx);
+    if (!dx.allFinite()) return false;
+    y += dx;
+  }
+  return false;
+}
+
 BranchPointDetector::Evaluation BranchPointDetector::evaluate(const std::vector<Sample>& polyline,
                                                               double s,
-                                                              const TestFunctionValue& reference) {
+                                                              const TestFunctionValue& reference,
+                                                              const Chord* chord) {
   Evaluation e;
   std::size_t i = 0;
   while (i + 2 < polyline.size() && s > polyline[i + 1].s) ++i;
@@ -111,20 +253,29 @@ BranchPointDetector::Evaluation BranchPointDetector::evaluate(const std::vector<
   const Sample& b = polyline[i + 1];
   const double length = b.s - a.s;
   const double fraction = length > 0 ? std::clamp((s - a.s) / length, 0.0, 1.0) : 0.0;
-  const core::Vector chord = b.z - a.z;
-  const core::Vector through = a.z + fraction * chord;
-  const core::Vector normal = chord.normalized();
-  const core::BorderedSystem on_plane(problem_, {core::BorderRow::hyperplane(normal, through)});
+  const core::Vector segment = b.z - a.z;
+  const core::Vector through = a.z + fraction * segment;
+  const core::Vector normal = segment.normalized();
+  const core::Vector f = factor();
   e.z = through;
-  if (!corrector_.solve(on_plane, e.z).converged() || !e.z.allFinite()) return e;
+  if (!chord || !chord_correct(*chord, normal, through, e.z)) {
+    // From where the chord steps got to, in the loop's units (fresh Jacobians).
+    const core::BorderedSystem on_plane(
+        problem_, {core::BorderRow::hyperplane(normal.cwiseProduct(f).normalized(),
+                                               through.cwiseQuotient(f))});
+    core::Vector z = e.z.cwiseQuotient(f);
+    if (!finisher_->solve(on_plane, z).converged() || !z.allFinite()) return e;
+    e.z = z.cwiseProduct(f);
+  }
   // A point on another family is not a point of the branch: it must stay near the chord.
-  if ((e.z - through).norm() > 0.25 * chord.norm()) return e;
+  if ((e.z - through).norm() > 0.25 * segment.norm()) return e;
   core::Matrix J;
-  if (problem_.jacobian(e.z, J) != core::EvalStatus::ok) return e;
-  if (tangent_from_jacobian(J, normal, options_.rank.relative_threshold, e.tangent) !=
+  if (problem_.jacobian(e.z.cwiseQuotient(f), J) != core::EvalStatus::ok) return e;
+  e.jacobian = in_unit_scale(J);
+  if (tangent_from_jacobian(e.jacobian, normal, options_.rank.relative_threshold, e.tangent) !=
       core::EvalStatus::ok)
     return e;
-  e.tau = bordered_test_function(J, e.tangent, jacobian_scale_, &reference);
+  e.tau = bordered_test_function(e.jacobian, e.tangent, jacobian_scale_, &reference);
   e.ok = true;
   return e;
 }
@@ -133,10 +284,19 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
   const auto started = std::chrono::steady_clock::now();
   const BranchPointOptions& o = options_.branch_points;
   const TestFunctionValue& reference = polyline.front().tau;
+  // Located when |tau| is a thousandth of the rank report's relative threshold: J is singular
+  // there at the resolution the verification uses, with a margin (further steps only refine the
+  // arclength, each at the price of a Jacobian).
+  const double located_value = 1e-3 * options_.rank.relative_threshold;
   BranchPointReport report;
   report.sign_change = sign_change;
+  // Each correction starts with chord steps on the last Jacobian evaluated (Chord): the
+  // bracket is short, so it is close; the loop's corrector takes over when they stall.
+  std::optional<Chord> chord;
+  if (last_jacobian_.size() > 0) chord.emplace(last_jacobian_, null_cutoff());
   // The best point so far: the sampled one with the smallest |tau|.
   core::Vector best_z, best_tangent;
+  core::Matrix best_jacobian;  // empty: not kept (a sample before the last)
   double best_s = 0, best_value = std::numeric_limits<double>::infinity();
   for (const Sample& p : polyline)
     if (std::abs(p.tau.value) < std::abs(best_value)) {
@@ -144,14 +304,17 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       best_tangent = p.tangent;
       best_s = p.s;
       best_value = p.tau.value;
+      best_jacobian = &p == &polyline.back() ? last_jacobian_ : core::Matrix();
     }
-  const auto keep = [&](const Evaluation& e, double s) {
+  const auto keep = [&](Evaluation& e, double s) {
     if (std::abs(e.tau.value) < std::abs(best_value)) {
       best_z = e.z;
       best_tangent = e.tangent;
       best_s = s;
       best_value = e.tau.value;
+      best_jacobian = e.jacobian;
     }
+    chord.emplace(e.jacobian, null_cutoff());
   };
   // Every value seen, for the minimisation of |tau| (a dip, or a secant iteration whose
   // singular triplet stopped following the reference's).
@@ -162,15 +325,27 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
     // Illinois: regula falsi with the stale end's value halved.
     double sa = polyline[0].s, fa = polyline[0].tau.value;
     double sb = polyline[1].s, fb = polyline[1].tau.value;
-    while (steps < o.max_location_steps && std::abs(sb - sa) > o.location_tolerance) {
+    // A root brings |tau| down superlinearly; a sign change that is a jump of tau (the
+    // finite-difference Jacobian across a change of the contact sequence) does not: three
+    // evaluations in a row that do not halve the smallest |tau| end the iteration.
+    double smallest = std::min(std::abs(fa), std::abs(fb));
+    int stale = 0;
+    while (steps < o.max_location_steps && std::abs(sb - sa) > o.location_tolerance && stale < 3 &&
+           !(std::abs(best_value) <= located_value)) {
       double s = (sa * fb - sb * fa) / (fb - fa);
       const double lo = std::min(sa, sb), hi = std::max(sa, sb);
       if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
-      const Evaluation e = evaluate(polyline, s, reference);
+      Evaluation e = evaluate(polyline, s, reference, chord ? &*chord : nullptr);
       ++steps;
       if (!e.ok) break;
       keep(e, s);
       seen.emplace_back(s, std::abs(e.tau.value));
+      if (std::abs(e.tau.value) < 0.5 * smallest) {
+        smallest = std::abs(e.tau.value);
+        stale = 0;
+      } else {
+        ++stale;
+      }
       if (!e.tau.continued) break;
       if (e.tau.value == 0) {
         seen.clear();
@@ -185,7 +360,9 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       sb = s;
       fb = e.tau.value;
     }
-    if (std::abs(sb - sa) <= o.location_tolerance) seen.clear();
+    if (std::abs(sb - sa) <= o.location_tolerance || stale >= 3 ||
+        std::abs(best_value) <= located_value)
+      seen.clear();
   }
   // Minimise |tau| from the smallest value seen and its neighbours: |tau| ~ |s - s*| near a
   // simple crossing, so fit the V through the three (the steeper side's chord does not straddle
@@ -203,7 +380,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
     double previous_width = sc - sa, reference_value = fb;
     int without_progress = 0;
     bool golden = false;
-    while (steps < o.max_location_steps && sc - sa > o.location_tolerance && fb > 0 &&
+    while (steps < o.max_location_steps && sc - sa > o.location_tolerance && fb > located_value &&
            without_progress < 6) {
       double s;
       const bool right_larger = sc - sb > sb - sa;
@@ -216,7 +393,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
         if (std::abs(s - sb) < nudge) s = right_larger ? sb + nudge : sb - nudge;
         if (!(s > sa && s < sc)) s = right_larger ? 0.5 * (sb + sc) : 0.5 * (sa + sb);
       }
-      const Evaluation e = evaluate(polyline, s, reference);
+      Evaluation e = evaluate(polyline, s, reference, chord ? &*chord : nullptr);
       ++steps;
       if (!e.ok) break;
       keep(e, s);
@@ -257,19 +434,23 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
     if (p.s <= best_s) report.after_point = p.index;
   if (report.after_point == polyline.back().index && polyline.size() > 1)
     report.after_point = polyline[polyline.size() - 2].index;
-  verify(report, best_z, best_tangent);
+  verify(report, best_z, best_tangent, best_jacobian);
   report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   found_.push_back(std::move(report));
 }
 
 void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& z,
-                                 const core::Vector& tangent) {
-  report.x = problem_.to_unknowns(z);
-  report.observables = problem_.observables(z);
+                                 const core::Vector& tangent, core::Matrix J) {
+  // z, tangent and J in the unit scale; the loop's problem in its current units.
+  const core::Vector f = factor();
+  report.x = z.cwiseProduct(problem_.unit_scale());
+  report.observables = problem_.base().observables(report.x);
   report.tangent_angle = std::numeric_limits<double>::quiet_NaN();
-  core::Matrix J;
-  if (problem_.jacobian(z, J) != core::EvalStatus::ok) return;
+  if (J.size() == 0) {
+    if (problem_.jacobian(z.cwiseQuotient(f), J) != core::EvalStatus::ok) return;
+    J = in_unit_scale(J);
+  }
   // Thresholds relative to the branch's Jacobian scale, not to this point's sigma_max: J may
   // vanish at a branch point (x (z - 1) at z = 1), so its own largest singular value is the
   // location error, not a scale.
@@ -291,10 +472,14 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
   for (Eigen::Index i = 0; i < svd.singularValues().size(); ++i)
     if (svd.singularValues()[i] > 0.5) ++candidates;
   // One probe per candidate direction d: step by h along d and re-correct on the hyperplane
-  // through the stepped point orthogonal to d (the loop's corrector). A direction is real when the
-  // corrected point is a solution within h / drift_ratio of z: the hyperplane, which misses the
-  // traced branch near z, met another family near the stepped point. Its secant from z gives the
-  // angle to t.
+  // through the stepped point orthogonal to d. A direction is real when the corrected point is
+  // a solution within h / drift_ratio of z: the hyperplane, which misses the traced branch near
+  // z, met another family near the stepped point. Its secant from z gives the angle to t. Each
+  // probe first takes chord steps on J (one residual each; d is in J's null space, so the
+  // hyperplane row is met exactly), then, when they stall, the loop's corrector (its tolerance
+  // and iteration budget, fresh Jacobians; the verifier's 60 linear iterations made failed
+  // probes the main cost of a branch point, measured on the contact bar at 100 intervals).
+  const Chord chord(J, null_cutoff());
   const core::VerifyOptions& v = options_.verification;
   const double h = v.step;
   double smallest = std::numeric_limits<double>::infinity();
@@ -302,21 +487,26 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
   for (int i = 0; i < std::min(candidates, options_.branch_points.max_probes); ++i) {
     const core::Vector d = svd.matrixU().col(i);
     const core::Vector stepped = z + h * d;
-    const core::BorderedSystem on_plane(problem_, {core::BorderRow::hyperplane(d, stepped)});
     core::Vector y = stepped;
-    // The loop's corrector, tolerance and iteration budget: a probe converges like a step of
-    // the branch (the verifier's 60 linear iterations made failed probes the main cost of a
-    // branch point, measured on the contact bar at 100 intervals).
-    const core::NewtonSummary s = corrector_.solve(on_plane, y);
-    if (!s.converged() || !y.allFinite() || (y - z).norm() > h / v.drift_ratio) continue;
+    if (!chord_correct(chord, d, stepped, y) && !subspace_correct(chord, d, stepped, y, 4)) {
+      const core::BorderedSystem on_plane(
+          problem_,
+          {core::BorderRow::hyperplane(d.cwiseProduct(f).normalized(), stepped.cwiseQuotient(f))});
+      core::Vector y_local = y.cwiseQuotient(f);
+      const core::NewtonSummary s = probe_finisher_->solve(on_plane, y_local);
+      if (!s.converged() || !y_local.allFinite()) continue;
+      y = y_local.cwiseProduct(f);
+    }
+    if ((y - z).norm() > h / v.drift_ratio) continue;
     ++attached;
-    report.attached_points.push_back(problem_.to_unknowns(y));
+    const core::Vector x = y.cwiseProduct(problem_.unit_scale());
+    report.attached_points.push_back(x);
     const core::Vector secant = y - z;
     const double cosine = std::min(1.0, std::abs(secant.dot(t)) / secant.norm());
     const double angle = std::acos(cosine) * 180 / std::numbers::pi;
     if (angle < smallest) {
       smallest = angle;
-      report.attached_point = problem_.to_unknowns(y);
+      report.attached_point = x;
     }
   }
   report.attached_dimension = attached;

@@ -6,7 +6,9 @@
 // Jacobian at the branch's first point; scaled unknowns, so it has no units), signed by following
 // the singular vectors from point to point (analytic SVD): at a simple branch point it changes
 // sign. This also holds for a consistent overdetermined residual (least-squares shooting), where no
-// determinant exists.
+// determinant exists. J, t and the points are taken in the unit scale of the loop's problem
+// (ScaledProblem::unit_scale()): when the loop's units follow the point (LocalScale), J in the
+// point's units would change from sample to sample with the units alone.
 //
 // Detection, location, verification (continuation/README.md, section 'Branch points'):
 //   - a sign change between consecutive points, or a dip (|tau_k| below dip_ratio times both
@@ -15,11 +17,14 @@
 //   - it is located on the branch by an Illinois secant iteration on the signed test function
 //     (sign change) or by a safeguarded V-fit (|tau| ~ |s - s*| near a simple crossing) with
 //     golden-section fall-back (dip), each evaluation a point corrected on the hyperplane
-//     orthogonal to the bracket's polyline;
-//   - the located point is verified with the rank report and the probes of
-//     core::verify_null_directions: dimension = verified dimension - 1 (the directions beyond the
-//     traced tangent), and each extra direction is probed once more to find the attached family's
-//     secant, whose angle to the traced tangent is tangent_angle.
+//     orthogonal to the bracket's polyline (chord steps on the last Jacobian first, then
+//     Gauss-Newton that keeps its Jacobian while it contracts); it ends when |tau| is below a
+//     thousandth of the rank threshold, the bracket below location_tolerance, or |tau| stops
+//     falling;
+//   - the located point is verified with the rank report and probes on the located point's
+//     Jacobian: dimension = verified dimension - 1 (the directions beyond the traced tangent),
+//     and each extra direction is probed once more to find the attached family's secant, whose
+//     angle to the traced tangent is tangent_angle.
 //
 //   BranchPointDetector detector(scaled_problem, options, hooks, corrector);
 //   detector.add(index, z, tangent, J, arclength);   // after every accepted point
@@ -64,16 +69,18 @@ TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vect
 
 class BranchPointDetector {
  public:
-  // problem: the loop's problem in scaled unknowns; corrector: the loop's (locates points on
-  // the branch and corrects the probes). Uses options.branch_points, options.rank,
-  // options.verification (probe step and drift_ratio); hooks.describe_branch_point, when set,
-  // describes each verified point.
+  // problem: the loop's problem in scaled unknowns (its units may change between add() calls:
+  // set_factor); corrector: the loop's (kept for the interface; location and probes use the
+  // detector's own Gauss-Newton to the verifier's tolerance). Uses options.branch_points,
+  // options.rank, options.verification (probe step, drift_ratio, tolerance);
+  // hooks.describe_branch_point, when set, describes each verified point.
   BranchPointDetector(const ScaledProblem& problem, const ContinuationOptions& options,
                       const ContinuationHooks& hooks, core::Corrector& corrector);
   ~BranchPointDetector();
 
-  // After each accepted point z (scaled), its unit tangent, its Jacobian and arclength. May
-  // locate and verify a candidate bracketed by this and the previous points.
+  // After each accepted point z, its unit tangent and its Jacobian, all in the problem's current
+  // units, and its arclength. May locate and verify a candidate bracketed by this and the
+  // previous points.
   void add(int index, const core::Vector& z, const core::Vector& tangent, const core::Matrix& J,
            double arclength);
   // Located candidates so far (in the problem's own unknowns), in order; cleared.
@@ -81,7 +88,8 @@ class BranchPointDetector {
   // Test-function value at the last added point (NaN before the first).
   double last_value() const;
   // What add() remembers between points, for a restart that must continue bit for bit: the
-  // samples kept and the Jacobian scale (0 before the first point). restore() puts them back.
+  // samples kept (points and tangents in the unit scale) and the Jacobian scale (0 before the
+  // first point). restore() puts them back.
   const std::vector<TestFunctionSample>& samples() const { return samples_; }
   double jacobian_scale() const { return jacobian_scale_; }
   void restore(std::vector<TestFunctionSample> samples, double jacobian_scale);
@@ -89,9 +97,26 @@ class BranchPointDetector {
  private:
   using Sample = TestFunctionSample;
   struct Evaluation;
-  Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref);
+  struct Chord;
+  // The loop's units relative to the unit scale (ScaledProblem::scale() ./ unit_scale()).
+  core::Vector factor() const;
+  // J of the loop's problem (its current units) in the unit scale.
+  core::Matrix in_unit_scale(const core::Matrix& J) const;
+  // Singular values at most this count as zero (the rank report's threshold, verify()).
+  double null_cutoff() const;
+  // Chord steps (one residual each) onto F = 0 and normal . (y - anchor) = 0, unit scale; false
+  // when they do not converge to the verifier's corrector tolerance.
+  bool chord_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
+                     core::Vector& y) const;
+  // Gauss-Newton on J with its columns along J's null space N re-differenced at each iterate
+  // (N.cols() residuals per step instead of a Jacobian's n), onto the same constraints.
+  bool subspace_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
+                        core::Vector& y, int max_iterations) const;
+  Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref,
+                      const Chord* chord);
   void locate(const std::vector<Sample>& polyline, bool sign_change);
-  void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent);
+  void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,
+              core::Matrix J);
 
   const ScaledProblem& problem_;
   const ContinuationOptions& options_;
@@ -99,7 +124,9 @@ class BranchPointDetector {
   core::Corrector& corrector_;
   std::vector<Sample> samples_;  // the last three points
   std::vector<BranchPointReport> found_;
-  double jacobian_scale_ = 0;  // Frobenius norm of the first point's Jacobian
+  double jacobian_scale_ = 0;   // Frobenius norm of the first point's Jacobian (unit scale)
+  core::Matrix last_jacobian_;  // the last sample's, unit scale (empty after restore())
+  std::unique_ptr<core::Corrector> finisher_, probe_finisher_;  // after chord steps stall
 };
 
 }  // namespace backbone::continuation

@@ -73,8 +73,8 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
   // is recorded in the unit scale; every saved state is in the unit scale (z, tangent and
   // previous multiplied by the factor they were computed with), and the next step's vectors
   // are derived from it by the same operations in a resumed run, so a restart continues bit
-  // for bit. Off with branch-point detection, whose samples compare points in fixed units.
-  const bool follow_scale = problem.has_local_scale() && !detector;
+  // for bit. The branch-point detector keeps its samples in the unit scale (branch_points.hpp).
+  const bool follow_scale = problem.has_local_scale();
   core::Vector factor = core::Vector::Ones(problem.num_unknowns());
   const auto in_unit_scale = [&](const core::Vector& v) {
     return follow_scale && v.size() > 0 ? core::Vector(v.cwiseProduct(factor)) : v;

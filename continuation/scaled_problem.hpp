@@ -89,6 +89,9 @@ class ScaledProblem : public core::Problem {
   // Units s ./ w .* factor from now on, F divided by residual_factor (empty: as the base's);
   // the cached Jacobian is dropped.
   void set_factor(const core::Vector& factor, const core::Vector& residual_factor = {});
+  // The residual factor set last (empty: none), e.g. to convert a Jacobian back to the unit
+  // scale: J_unit = diag(residual_factor) J_z diag(1 ./ factor).
+  const core::Vector& residual_factor() const { return residual_factor_; }
   const core::Problem& base() const { return base_; }
 
  protected:

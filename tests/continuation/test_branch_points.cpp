@@ -7,6 +7,7 @@
 
 #include "continuation/branch_points.hpp"
 #include "continuation/pseudo_arclength.hpp"
+#include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
 #include "tests/continuation/test_support.hpp"
@@ -24,7 +25,81 @@ double largest_abs(const Branch& b, int coordinate) {
   return worst;
 }
 
+// The transcritical in units that grow along the branch (continuation::LocalScale): lambda and
+// the equation in units of 1 + lambda^2, x in fixed units. With them a step ds covers
+// (1 + lambda^2) ds of lambda, and J in the point's units has its lambda column multiplied and its
+// row divided by that factor.
+class TranscriticalInGrowingUnits : public algebraic::Transcritical,
+                                    public continuation::LocalScale {
+ public:
+  explicit TranscriticalInGrowingUnits(bool enabled) : enabled_(enabled) {}
+  bool local_scale_enabled() const override { return enabled_; }
+  core::Vector local_scale_factor(const core::Vector& x) const override {
+    return vec({1, 1 + x[1] * x[1]});
+  }
+  core::Vector local_residual_factor(const core::Vector& x) const override {
+    return vec({1 + x[1] * x[1]});
+  }
+
+ private:
+  bool enabled_;
+};
+
 }  // namespace
+
+// The detector keeps its samples in the unit scale: a point added in other units (the loop's,
+// when they follow the point) gives the same test-function value and the same stored point as in
+// fixed units. Here the second point's J in its units is [(lambda - 1) / 2, 0]: a value computed
+// from it directly would be half the fixed units' (the first point fixes the Jacobian scale).
+TEST(BranchPointDetector, SamplesDoNotDependOnTheLoopsUnits) {
+  const TranscriticalInGrowingUnits problem(true);
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  const continuation::ContinuationOptions options = detecting(0.1, 10);
+  const continuation::ContinuationHooks hooks;
+  const core::Vector t = vec({0, 1});
+  const core::Vector first = vec({0, 0.25}), second = vec({0, 0.5});
+  const auto add_both = [&](const core::Vector& factor, const core::Vector& residual_factor) {
+    continuation::ScaledProblem scaled(problem);
+    continuation::BranchPointDetector detector(scaled, options, hooks, *newton);
+    core::Matrix J;
+    scaled.jacobian(first, J);
+    detector.add(0, first, t, J, 0.0);
+    scaled.set_factor(factor, residual_factor);
+    const core::Vector z = scaled.to_scaled(second);
+    scaled.jacobian(z, J);
+    detector.add(1, z, t.cwiseQuotient(factor).normalized(), J, 0.25);
+    return std::make_pair(detector.last_value(), core::Vector(detector.samples().back().z));
+  };
+  const auto [fixed_value, fixed_z] = add_both(vec({1, 1}), core::Vector());
+  const auto [local_value, local_z] = add_both(vec({1, 1.25}), vec({2}));
+  EXPECT_NEAR(std::abs(fixed_value), 0.5 / 0.75, 1e-14);  // |lambda - 1| / |J_0|_F
+  EXPECT_NEAR(local_value, fixed_value, 1e-14);
+  EXPECT_LE((local_z - fixed_z).norm(), 1e-15);
+  EXPECT_LE((fixed_z - second).norm(), 1e-15);
+}
+
+// Detection along a branch whose units follow the point: the branch point at lambda = 1 is found,
+// located and verified as in fixed units, while the steps (ds in the point's units) cover more of
+// lambda (the units were followed).
+TEST(BranchPoints, LocatedInUnitsThatFollowThePoint) {
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  double last_lambda[2] = {0, 0};
+  for (bool follow : {false, true}) {
+    const TranscriticalInGrowingUnits problem(follow);
+    const Branch b = continuation::pseudo_arclength(problem, vec({0, 0}), vec({0, 1}), *newton,
+                                                    detecting(0.13, 10));
+    ASSERT_EQ(b.points.size(), 10u) << b.message;
+    EXPECT_LE(largest_abs(b, 0), 1e-12);
+    ASSERT_EQ(b.branch_points.size(), 1u) << follow;
+    const auto& r = b.branch_points[0];
+    EXPECT_NEAR(r.x[1], 1.0, 1e-9);  // the secant on a test function linear in lambda
+    EXPECT_EQ(r.attached_dimension, 1);
+    EXPECT_NEAR(r.tangent_angle, 45.0, 1e-3);  // as in TranscriticalLocatedVerifiedAndPassed
+    last_lambda[follow] = b.points.back().x[1];
+  }
+  EXPECT_NEAR(last_lambda[0], 9 * 0.13, 1e-12);
+  EXPECT_GT(last_lambda[1], 1.5 * last_lambda[0]);  // steps of (1 + lambda^2) ds
+}
 
 // [J/s; t^T] of the transcritical on x = 0 is diag((lambda - 1)/s, 1): the signed test function
 // is (lambda - 1)/s, up to an orientation fixed by the first point.
