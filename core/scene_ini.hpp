@@ -2,8 +2,10 @@
 //
 // Every key of a parsed core::Scene (defaults, scene file and command line merged) is written
 // as `key = value`, one per line, in the flat syntax read_scene reads; numbers in their
-// shortest round-trip form, so reading the file back gives the same values bit for bit. Keys named
-// in `omit` (driver options such as out, resume, help) are left out. Written atomically.
+// shortest round-trip form, so reading the file back gives the same values bit for bit. A key
+// at its default is written as a comment, `# key = value  (default)`: read back it is a default
+// again (same value, and still "not given"). Keys named in `omit` (driver options such as out,
+// resume, help) are left out. Written atomically.
 //
 //   core::write_scene_ini(scene, out / "scene.ini", {"out", "help"});
 //   // later: backbone trace out/scene.ini --out again   (the same run)

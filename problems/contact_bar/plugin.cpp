@@ -43,11 +43,6 @@ namespace backbone::contact_bar {
 
 namespace {
 
-// The gap units' defaults of ds, ds_max and newton_tolerance (amplitude units use their own,
-// setup_trace).
-constexpr double gap_units_step = 0.45;
-constexpr double gap_units_tolerance = 3e-9;
-
 namespace po = boost::program_options;
 
 po::options_description subharmonic_keys() {
@@ -105,13 +100,13 @@ po::options_description trace_keys() {
        "directions. Measured along the paper scene's branches (branch.csv sigma_zero, "
        "sigma_kept): the forward-difference Jacobian's null value reaches 2.8e-6 (kinks of "
        "the contact map), the smallest kept one is 5.6e-5; verify decides")  //
-      ("ds", po::value<double>()->default_value(gap_units_step),
+      ("ds", po::value<double>()->default_value(0.45),
        "first step, dimensionless: the L2 norm of the change of u0 / gap over the bar "
        "(independent of the grid), knot / L and T c / L; mode1 and mode2 in amplitude units "
        "default to 0.1 (10 % of the amplitude)")  //
-      ("ds_max", po::value<double>()->default_value(gap_units_step),
+      ("ds_max", po::value<double>()->default_value(0.45),
        "largest step (dimensionless; mode1, mode2 in amplitude units: 0.1)")  //
-      ("newton_tolerance", po::value<double>()->default_value(gap_units_tolerance),
+      ("newton_tolerance", po::value<double>()->default_value(3e-9),
        "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
        "residual's round-off grows with the amplitude: measured at shooting_elements 100 on "
        "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there). mode1 "
@@ -195,14 +190,9 @@ continuation::TraceSetup setup_trace(const core::Scene& scene, const std::string
     // to 1e4 J in 126; 0.45 gave 18 and 37, too few for the figures) and a tolerance of 1e-10
     // of the amplitude (closed-form error 4e-13 at 20 intervals and 1e-13 at 100, against 7e-12
     // with the gap units' 3e-9, at the same Jacobians per point).
-    // A key at its gap-units default counts as not given: the resolved scene.ini a run writes
-    // (and --resume reads) lists every key, so a resumed branch keeps its first run's settings.
-    const auto given = [&](const char* key, double gap_default) {
-      return !scene.values()[key].defaulted() && scene.number(key) != gap_default;
-    };
-    const bool ds_given = given("ds", gap_units_step);
-    const bool ds_max_given = given("ds_max", gap_units_step);
-    const bool tolerance_given = given("newton_tolerance", gap_units_tolerance);
+    const bool ds_given = !scene.values()["ds"].defaulted();
+    const bool ds_max_given = !scene.values()["ds_max"].defaulted();
+    const bool tolerance_given = !scene.values()["newton_tolerance"].defaulted();
     s.branch_options = [=](continuation::ContinuationOptions& o, core::NewtonOptions& newton) {
       if (!ds_max_given) o.ds_max = 0.1;
       if (!ds_given) o.ds = std::min(0.1, o.ds_max);

@@ -189,6 +189,32 @@ TEST(TraceCli, ResumeContinuesAnInterruptedBranch) {
   fs::remove(part.string() + ".log");
 }
 
+// A resumed run reads the resolved scene.ini, where keys left at their defaults are comments: in
+// the amplitude units (mode 1's default) newton_tolerance is then still "not given" and the
+// branch keeps its own 1e-10 (problems/contact_bar/README.md, 'Cost'). When scene.ini listed
+// the default 3e-9 as given, the resumed branch took the gap units' tolerance and left the
+// uninterrupted one's points after the restart.
+TEST(TraceCli, ResumeInTheAmplitudeUnitsKeepsTheBranchsOwnSettings) {
+  const fs::path full = cli::scratch("trace_cli", "full_amp"),
+                 part = cli::scratch("trace_cli", "part_amp");
+  ASSERT_EQ(cli::run("trace", small_mode1, full).code, 0);
+  ASSERT_EQ(cli::run("trace", small_mode1 + " --max_points 30", part).code, 0);
+  EXPECT_NE(file_text(part / "scene.ini").find("# newton_tolerance = 3e-09  (default)"),
+            std::string::npos)
+      << file_text(part / "scene.ini");
+  const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
+                             part.string() + "' --max_points 1000 > '" + part.string() +
+                             ".log' 2>&1";
+  ASSERT_EQ(std::system(resume.c_str()), 0) << file_text(part.string() + ".log");
+  const auto a = backbone::core::Table::read_csv(full / "branch.csv");
+  ASSERT_GE(a.rows(), 60u);  // the resumed part is most of the branch
+  expect_same_rows(a, backbone::core::Table::read_csv(part / "branch.csv"), 0, 0);
+  EXPECT_EQ(file_text(part / "unknowns.csv"), file_text(full / "unknowns.csv"));
+  fs::remove_all(full);
+  fs::remove_all(part);
+  fs::remove(part.string() + ".log");
+}
+
 // --start DIR/orbits.csv:K takes up the loop state saved with point K: the new folder holds
 // point K (recorded again: its Newton iterations and step are 0, it is the new branch's first
 // point) and then exactly the saved branch's points K + 1, ... to its end, bit for bit.
