@@ -230,6 +230,7 @@ int run_trace(const std::vector<std::string>& args_in) {
   progress.finish();
   cont::Branch& branch = result.branch;
   const bool complete = !branch.points.empty() && !branch.ended_early();
+  bool followed_complete = true;  // every followed branch reached its bound or budget
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
   if (!branch.points.empty()) {
     // The figure and the extra outputs show the whole branch, saved points included.
@@ -242,8 +243,10 @@ int run_trace(const std::vector<std::string>& args_in) {
                           setup.write_extra_outputs);
     for (const auto& f :
          cont::follow_branch_points(problem, branch, run.follow, *follow_corrector, options, hooks,
-                                    out, setup.write_extra_outputs, entry.units))
+                                    out, setup.write_extra_outputs, entry.units)) {
       fmt::print("  followed {}\n", cont::follow_line(f));
+      followed_complete = followed_complete && !f.branch.points.empty() && !f.branch.ended_early();
+    }
   }
   core::write_text_atomically(out / "summary.txt", summary(complete ? "complete" : "ended early",
                                                            &branch, rejected, result.switch_index));
@@ -255,9 +258,10 @@ int run_trace(const std::vector<std::string>& args_in) {
                static_cast<int>(stop_signal), writer.points(), out.string());
     return 128 + static_cast<int>(stop_signal);
   }
-  if (!complete) {
-    fmt::print(stderr, "backbone trace: the branch ended before its bound or point budget: {}\n",
-               branch.message);
+  if (!complete || !followed_complete) {
+    fmt::print(stderr, "backbone trace: {} ended before its bound or point budget{}\n",
+               complete ? "a followed branch (lines 'followed' above)" : "the branch",
+               complete ? "" : ": " + branch.message);
     return core::exit_numerical_failure;
   }
   return core::exit_ok;

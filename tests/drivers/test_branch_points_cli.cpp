@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <string>
 
+#include "core/errors.hpp"
 #include "core/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
@@ -85,10 +86,13 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
 }
 
 // --follow K names a row of branch_points.csv; an unverified row is not followed: its folder
-// holds only summary.txt, which says so (row 1 at 40 intervals: the unverified dip at T = 3.33).
+// holds only summary.txt, which says so (row 1 at 40 intervals: the unverified dip at T = 3.33),
+// and the run exits with the numerical-failure code (the branch asked for was not traced).
 TEST(BranchPointsCli, UnverifiedRowIsNotFollowed) {
   const fs::path out = cli::scratch("branch_points_cli", "unverified");
-  ASSERT_EQ(cli::run("trace", detecting + " --follow 1", out).code, 0);
+  const cli::Run r = cli::run("trace", detecting + " --follow 1", out);
+  EXPECT_EQ(r.code, backbone::core::exit_numerical_failure);
+  EXPECT_NE(r.err.find("a followed branch"), std::string::npos) << r.err;
   const Table t = Table::read_csv(out / "branch_points.csv");
   ASSERT_GE(t.rows(), 1u);
   ASSERT_EQ(t.column("verified")[0], 0);
