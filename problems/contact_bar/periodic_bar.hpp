@@ -136,7 +136,8 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continu
   // Sparsity of the residual's Jacobian (README.md, section 'Cost'), for the TD-BEM and exact
   // solvers: row i depends on u0 only near the images of its test support under x -> x +- c t
   // (t = T/2 regular, T paper; reflected at both ends, open or closed: contact instants and
-  // fronts travel on the same characteristics), widened by one test element. The period and
+  // fronts travel on the same characteristics), widened by one test element and, for the
+  // TD-BEM, one step c dt (its end histories are interpolated over a step). The period and
   // free-knot columns are dense, and for the paper formulation the columns at the source of
   // each contact release (found by one simulation at x). None (every column differenced) for
   // other solvers and with path rows (they are dense rows).
