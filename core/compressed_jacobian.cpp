@@ -220,7 +220,16 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
     out.check_error =
         std::max(out.check_error, tolerance > 0 ? error / tolerance : (error > 0 ? HUGE_VAL : 0.0));
   }
-  if (!(out.check_error <= 1)) return fall_back();
+  if (!(out.check_error <= 1)) {
+    if (!pattern.wider) return fall_back();
+    CompressedJacobianReport wider;
+    const EvalStatus ws =
+        compressed_finite_difference_jacobian(problem, x, *pattern.wider, J, options, &wider);
+    out.widened = true;
+    out.fell_back = wider.fell_back;
+    out.residuals += wider.residuals;
+    return ws;
+  }
   return EvalStatus::ok;
 }
 

@@ -11,7 +11,8 @@
 // Verification at each use: one more residual along a fixed pseudo-random direction p
 // (p_j = +-(1..2) h_j, the same for every x) compares J p with F(x + p) - F(x); a pattern that
 // misses an entry J_ij shows up there as |J_ij| h_j (the tolerance is in the .cpp). On failure
-// the Jacobian is recomputed column by column (report->fell_back).
+// the Jacobian is recomputed from pattern.wider when there is one (report->widened, checked
+// the same way), else column by column (report->fell_back).
 //
 //   JacobianPattern pattern;                 // tridiagonal 5 x 5: 3 colours instead of 5
 //   for (int i = 0; i < 5; ++i) for (int j = i - 1; j <= i + 1; ++j)
@@ -31,6 +32,7 @@ namespace backbone::core {
 struct CompressedJacobianReport {
   int colours = 0;         // residuals for the columns (dense columns included)
   int residuals = 0;       // all residuals this call took (F(x), colours, check, any fallback)
+  bool widened = false;    // the check failed and pattern.wider was used (checked the same way)
   bool fell_back = false;  // the check failed (or a coloured step could not be evaluated):
                            // J is the column-by-column finite-difference Jacobian
   double check_error = 0;  // max_i |(J p)_i - (F(x + p) - F(x))_i| / tolerance_i

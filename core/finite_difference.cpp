@@ -100,6 +100,7 @@ EvalStatus Problem::compute_jacobian(const Vector& x, Matrix& J) const {
   const EvalStatus s =
       compressed_finite_difference_jacobian(*this, x, *pattern, J, options, &report);
   counters_.compressed_jacobians++;
+  if (report.widened) counters_.jacobian_widenings++;
   if (report.fell_back) counters_.jacobian_fallbacks++;
   return s;
 }

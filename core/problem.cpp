@@ -22,6 +22,7 @@ void EvaluationCounters::reset() {
   residual_nanoseconds = 0;
   jacobian_nanoseconds = 0;
   compressed_jacobians = 0;
+  jacobian_widenings = 0;
   jacobian_fallbacks = 0;
 }
 

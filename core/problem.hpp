@@ -21,6 +21,7 @@
 #pragma once
 
 #include <atomic>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -44,9 +45,11 @@ struct EvaluationCounters {
   std::atomic<long> jacobians{0};
   std::atomic<long> residual_nanoseconds{0};
   std::atomic<long> jacobian_nanoseconds{0};
-  // Default (finite-difference) Jacobians computed compressed from a jacobian_pattern, and
-  // those whose pattern failed its verification and were recomputed column by column.
+  // Default (finite-difference) Jacobians computed compressed from a jacobian_pattern, those
+  // whose pattern failed its check and were recomputed from its wider pattern, and those
+  // recomputed column by column (every pattern tried failed).
   std::atomic<long> compressed_jacobians{0};
+  std::atomic<long> jacobian_widenings{0};
   std::atomic<long> jacobian_fallbacks{0};
   void reset();
 };
@@ -55,9 +58,12 @@ struct EvaluationCounters {
 // row_columns[i] lists the columns j with J_ij possibly != 0, beside the dense_columns, which
 // may be nonzero in every row. Every entry outside is taken as exactly 0 by the compressed
 // finite-difference Jacobian (compressed_jacobian.hpp), which verifies that claim at each use.
+// A pattern may name a wider one to try when its check fails, before column by column (e.g. a
+// pattern exact near the solutions and a structural bound everywhere).
 struct JacobianPattern {
   std::vector<std::vector<int>> row_columns;  // num_equations() rows
   std::vector<int> dense_columns;
+  std::shared_ptr<const JacobianPattern> wider;  // may be empty
 };
 
 // A named scalar derived from a solution point (period, energy, frequency...).

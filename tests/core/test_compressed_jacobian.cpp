@@ -152,6 +152,32 @@ TEST(CompressedJacobian, AWrongPatternIsCaughtAndTheJacobianRecomputedColumnByCo
   EXPECT_EQ(undeclared.counters().residuals, 1 + n + 1);
 }
 
+TEST(CompressedJacobian, AFailedCheckTriesTheWiderPatternBeforeColumnByColumn) {
+  const int n = 20;
+  Arrow wrong(n, /*drop_superdiagonal=*/true), right(n);
+  const Vector x = point(n);
+  JacobianPattern pattern = wrong.pattern();
+  pattern.wider = std::make_shared<const JacobianPattern>(right.pattern());
+  Matrix J, dense;
+  CompressedJacobianReport report;
+  ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, pattern, J, {}, &report),
+            EvalStatus::ok);
+  EXPECT_TRUE(report.widened);
+  EXPECT_FALSE(report.fell_back);
+  // Both tries: F(x), colours and check of each (the wrong pattern is bidiagonal: 2 + 1
+  // colours; the right one 3 + 1).
+  EXPECT_EQ(report.residuals, (1 + 3 + 1) + (1 + 4 + 1));
+  ASSERT_EQ(finite_difference_jacobian(wrong, x, dense), EvalStatus::ok);
+  EXPECT_EQ((J - dense).cwiseAbs().maxCoeff(), 0.0);
+  // A wider pattern that is wrong too ends column by column.
+  pattern.wider = std::make_shared<const JacobianPattern>(wrong.pattern());
+  ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, pattern, J, {}, &report),
+            EvalStatus::ok);
+  EXPECT_TRUE(report.widened);
+  EXPECT_TRUE(report.fell_back);
+  EXPECT_EQ((J - dense).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(CompressedJacobian, ColouringSeparatesColumnsThatShareARowAndRejectsBadPatterns) {
   Arrow arrow(30);
   const JacobianPattern pattern = arrow.pattern();
