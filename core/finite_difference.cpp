@@ -8,9 +8,25 @@
 #include <thread>
 #include <vector>
 
+#include "core/compressed_jacobian.hpp"
 #include "core/errors.hpp"
 
 namespace backbone::core {
+
+double relative_step(const FiniteDifferenceOptions& options) {
+  const bool central = options.scheme == FiniteDifferenceOptions::Scheme::central;
+  const double eps = std::numeric_limits<double>::epsilon();
+  return options.relative_step > 0 ? options.relative_step
+                                   : (central ? std::cbrt(eps) : std::sqrt(eps));
+}
+
+double finite_difference_step(double x_j, double scale_j, double relative_step) {
+  const double h0 =
+      relative_step * std::max(std::abs(x_j), std::abs(scale_j) > 0 ? std::abs(scale_j) : 1.0);
+  // Round the step so that x_j + h is exactly representable: the divisor is the step taken.
+  volatile double shifted = x_j + h0;
+  return shifted - x_j;
+}
 
 EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, Matrix& J,
                                       const FiniteDifferenceOptions& options) {
@@ -18,9 +34,7 @@ EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, M
   const int m = problem.num_equations();
   J.resize(m, n);
   const bool central = options.scheme == FiniteDifferenceOptions::Scheme::central;
-  const double eps = std::numeric_limits<double>::epsilon();
-  const double rel = options.relative_step > 0 ? options.relative_step
-                                               : (central ? std::cbrt(eps) : std::sqrt(eps));
+  const double rel = relative_step(options);
   const Vector scale = problem.typical_scale();
 
   Vector r0;
@@ -32,11 +46,7 @@ EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, M
   std::vector<EvalStatus> status(static_cast<std::size_t>(n), EvalStatus::ok);
   auto column = [&](int j) {
     Vector xp = x;
-    const double h0 =
-        rel * std::max(std::abs(x[j]), std::abs(scale[j]) > 0 ? std::abs(scale[j]) : 1.0);
-    // Round the step so that x_j + h is exactly representable: the divisor is the step taken.
-    volatile double shifted = x[j] + h0;
-    const double h = shifted - x[j];
+    const double h = finite_difference_step(x[j], scale[j], rel);
     Vector rp, rm;
     xp[j] = x[j] + h;
     EvalStatus s = problem.residual(xp, rp);
@@ -84,7 +94,15 @@ int default_jacobian_threads() {
 EvalStatus Problem::compute_jacobian(const Vector& x, Matrix& J) const {
   FiniteDifferenceOptions options;
   options.threads = default_jacobian_threads();
-  return finite_difference_jacobian(*this, x, J, options);
+  const std::optional<JacobianPattern> pattern = jacobian_pattern(x);
+  if (!pattern) return finite_difference_jacobian(*this, x, J, options);
+  CompressedJacobianReport report;
+  const EvalStatus s =
+      compressed_finite_difference_jacobian(*this, x, *pattern, J, options, &report);
+  counters_.compressed_jacobians++;
+  if (report.widened) counters_.jacobian_widenings++;
+  if (report.fell_back) counters_.jacobian_fallbacks++;
+  return s;
 }
 
 }  // namespace backbone::core

@@ -29,6 +29,11 @@ struct FiniteDifferenceOptions {
   int threads = 1;
 };
 
+// The step rule above for one unknown: relative_step(options) * max(|x_j|, |scale_j|) (1 when
+// scale_j is 0), rounded so that x_j + h is exactly x_j + h in floating point.
+double relative_step(const FiniteDifferenceOptions& options);
+double finite_difference_step(double x_j, double scale_j, double relative_step);
+
 EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, Matrix& J,
                                       const FiniteDifferenceOptions& options = {});
 

@@ -21,6 +21,9 @@ void EvaluationCounters::reset() {
   jacobians = 0;
   residual_nanoseconds = 0;
   jacobian_nanoseconds = 0;
+  compressed_jacobians = 0;
+  jacobian_widenings = 0;
+  jacobian_fallbacks = 0;
 }
 
 namespace {

@@ -1,7 +1,8 @@
 // A nonlinear system F(x) = 0 with m equations in n unknowns (m <= n is allowed).
 //
 // The interface is deliberately tiny (Ceres' CostFunction is the model): sizes and a residual.
-// The Jacobian defaults to finite differences (see finite_difference.hpp for the step rule);
+// The Jacobian defaults to finite differences (see finite_difference.hpp for the step rule),
+// compressed when the problem declares its sparsity (jacobian_pattern, compressed_jacobian.hpp);
 // a problem that knows its Jacobian overrides compute_jacobian. Public entry points are
 // non-virtual: they count evaluations, time them and check the output for NaN/Inf, so every
 // solver reports cost the same way. compute_residual must be safe to call concurrently on a
@@ -20,6 +21,8 @@
 #pragma once
 
 #include <atomic>
+#include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,7 +45,25 @@ struct EvaluationCounters {
   std::atomic<long> jacobians{0};
   std::atomic<long> residual_nanoseconds{0};
   std::atomic<long> jacobian_nanoseconds{0};
+  // Default (finite-difference) Jacobians computed compressed from a jacobian_pattern, those
+  // whose pattern failed its check and were recomputed from its wider pattern, and those
+  // recomputed column by column (every pattern tried failed).
+  std::atomic<long> compressed_jacobians{0};
+  std::atomic<long> jacobian_widenings{0};
+  std::atomic<long> jacobian_fallbacks{0};
   void reset();
+};
+
+// Which entries of J = dF/dx may be nonzero (core/README.md, section 'Compressed Jacobians'):
+// row_columns[i] lists the columns j with J_ij possibly != 0, beside the dense_columns, which
+// may be nonzero in every row. Every entry outside is taken as exactly 0 by the compressed
+// finite-difference Jacobian (compressed_jacobian.hpp), which verifies that claim at each use.
+// A pattern may name a wider one to try when its check fails, before column by column (e.g. a
+// pattern exact near the solutions and a structural bound everywhere).
+struct JacobianPattern {
+  std::vector<std::vector<int>> row_columns;  // num_equations() rows
+  std::vector<int> dense_columns;
+  std::shared_ptr<const JacobianPattern> wider;  // may be empty
 };
 
 // A named scalar derived from a solution point (period, energy, frequency...).
@@ -76,12 +97,25 @@ class Problem {
   // points at every resolution. Finite and > 0. Default: ones (the Euclidean norm).
   virtual Vector step_weights() const { return Vector::Ones(num_unknowns()); }
 
+  // Sparsity of the Jacobian at x, used by the default finite-difference Jacobian to perturb
+  // structurally independent columns together (one residual per colour instead of one per
+  // column). It must be a deterministic function of x alone (no state learnt at earlier
+  // points: a resumed run must reproduce an uninterrupted one bit for bit). A wrong pattern
+  // costs time, not accuracy: the compressed Jacobian is checked along one direction and
+  // recomputed column by column when the check fails (counters().jacobian_fallbacks).
+  // Default: none, every column is differenced on its own.
+  virtual std::optional<JacobianPattern> jacobian_pattern(const Vector& x) const {
+    return std::nullopt;
+  }
+
   const EvaluationCounters& counters() const { return counters_; }
   void reset_counters() const { counters_.reset(); }
 
  protected:
   virtual EvalStatus compute_residual(const Vector& x, Vector& r) const = 0;
-  // Default: forward finite differences (finite_difference_jacobian).
+  // Default: forward finite differences, default_jacobian_threads() threads: compressed
+  // (compressed_finite_difference_jacobian) when jacobian_pattern(x) gives a pattern, else
+  // column by column (finite_difference_jacobian).
   virtual EvalStatus compute_jacobian(const Vector& x, Matrix& J) const;
 
  private:
