@@ -65,6 +65,9 @@ po::options_description continuation_keys(const po::options_description& problem
       "direction (it landed on another family); 0: off");
   add("newton_tolerance", po::value<double>()->default_value(1e-10), "||F||_inf to converge");
   add("newton_max_iterations", po::value<long>()->default_value(25), "Newton iterations per point");
+  add("newton_reuse_jacobian", po::value<bool>()->default_value(false),
+      "eigen corrector: after a fresh Jacobian, take chord steps on its factorization while each "
+      "cuts ||F|| tenfold (one residual each), else a fresh Jacobian");
   add("natural_parameter", po::value<std::string>()->default_value("period"),
       "natural method: the period unknown or an observable name");
   add("natural_direction", po::value<long>()->default_value(1), "natural method: +1 or -1");
@@ -146,6 +149,7 @@ RunSettings read_run_settings(const core::Scene& scene) {
   o.verification.residual_tolerance =
       std::max(o.verification.residual_tolerance, run.newton_options.residual_tolerance);
   run.newton_options.max_iterations = static_cast<int>(scene.integer("newton_max_iterations", 1));
+  run.newton_options.reuse_jacobian = scene.flag("newton_reuse_jacobian");
   run.formulation = core::parse_formulation(scene.text("formulation"));
   run.natural_parameter = scene.text("natural_parameter");
   const long direction = scene.integer("natural_direction", -1);
