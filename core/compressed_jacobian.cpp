@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <thread>
 
 #include "core/errors.hpp"
 
@@ -146,17 +145,7 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
     }
     status[ts] = st;
   };
-  const int threads = std::max(1, std::min(options.threads, tasks));
-  if (threads == 1) {
-    for (int t = 0; t < tasks; ++t) task(t);
-  } else {
-    std::vector<std::thread> pool;
-    for (int k = 0; k < threads; ++k)
-      pool.emplace_back([&, k] {
-        for (int t = k; t < tasks; t += threads) task(t);
-      });
-    for (auto& th : pool) th.join();
-  }
+  run_striped(tasks, options.threads, task);
   out.residuals += tasks * (central ? 2 : 1);
   auto fall_back = [&] {
     out.fell_back = true;

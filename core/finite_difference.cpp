@@ -60,17 +60,7 @@ EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, M
     status[static_cast<std::size_t>(j)] = s;
   };
 
-  const int threads = std::max(1, std::min(options.threads, n));
-  if (threads == 1) {
-    for (int j = 0; j < n; ++j) column(j);
-  } else {
-    std::vector<std::thread> pool;
-    for (int t = 0; t < threads; ++t)
-      pool.emplace_back([&, t] {
-        for (int j = t; j < n; j += threads) column(j);
-      });
-    for (auto& th : pool) th.join();
-  }
+  run_striped(n, options.threads, column);
   for (EvalStatus s : status)
     if (s != EvalStatus::ok) return s;
   return EvalStatus::ok;
@@ -103,6 +93,20 @@ EvalStatus Problem::compute_jacobian(const Vector& x, Matrix& J) const {
   if (report.widened) counters_.jacobian_widenings++;
   if (report.fell_back) counters_.jacobian_fallbacks++;
   return s;
+}
+
+void run_striped(int tasks, int threads, const std::function<void(int)>& task) {
+  threads = std::max(1, std::min(threads, tasks));
+  if (threads == 1) {
+    for (int t = 0; t < tasks; ++t) task(t);
+    return;
+  }
+  std::vector<std::thread> pool;
+  for (int k = 0; k < threads; ++k)
+    pool.emplace_back([&, k] {
+      for (int t = k; t < tasks; t += threads) task(t);
+    });
+  for (auto& th : pool) th.join();
 }
 
 }  // namespace backbone::core

@@ -18,6 +18,8 @@
 //   set_default_jacobian_threads(2);    // problem.jacobian(x, J) now uses two threads
 #pragma once
 
+#include <functional>
+
 #include "core/problem.hpp"
 
 namespace backbone::core {
@@ -36,6 +38,11 @@ double finite_difference_step(double x_j, double scale_j, double relative_step);
 
 EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, Matrix& J,
                                       const FiniteDifferenceOptions& options = {});
+
+// Runs task(0), ..., task(tasks - 1) on min(threads, tasks) threads (at least 1), task t on
+// thread t mod threads: the striping of the Jacobian columns (and colours, compressed_jacobian).
+// Each task must write only its own outputs.
+void run_striped(int tasks, int threads, const std::function<void(int)>& task);
 
 // Threads of the default finite-difference Jacobian, 1 at start. Throws InputError("threads")
 // unless 1 <= threads <= max_jacobian_threads.

@@ -14,6 +14,7 @@
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
+#include "tests/problems/contact_bar/paper_setup.hpp"
 
 namespace {
 
@@ -23,12 +24,7 @@ using contact_bar::OrbitOptions;
 using core::ShootingFormulation;
 using core::Vector;
 
-bar::BarSetup paper_setup() {
-  bar::BarSetup s;  // E = rho = L = A = 1 (c = 1), wall at g0 = 1e-3
-  s.left = {bar::EndType::fixed, 0};
-  s.right = {bar::EndType::contact, 1e-3};
-  return s;
-}
+using test_support::paper_setup;
 
 OrbitOptions trace_grid(int n, int mode, int steps = 40) {
   OrbitOptions o;  // the trace's grid: 40 steps per period (its default), 2N test elements

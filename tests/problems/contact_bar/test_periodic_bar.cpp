@@ -17,6 +17,7 @@
 #include "problems/contact_bar/periodic_bar.hpp"
 #include "problems/contact_bar/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
+#include "tests/problems/contact_bar/paper_setup.hpp"
 
 namespace {
 
@@ -26,14 +27,8 @@ using contact_bar::OrbitOptions;
 using core::ShootingFormulation;
 using core::Vector;
 
-constexpr double kGap = 1e-3;
-
-bar::BarSetup paper_setup() {
-  bar::BarSetup s;  // E = rho = L = A = 1 (c = 1)
-  s.left = {bar::EndType::fixed, 0};
-  s.right = {bar::EndType::contact, kGap};
-  return s;
-}
+using test_support::kGap;
+using test_support::paper_setup;
 
 OrbitOptions grid(int elements, int steps, int free_knots = 0, int test_elements = 0) {
   OrbitOptions o;
