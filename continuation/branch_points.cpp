@@ -327,7 +327,10 @@ BranchPointDetector::Evaluation BranchPointDetector::evaluate(const std::vector<
   // A point on another family is not a point of the branch: it must stay near the chord.
   if ((e.z - through).norm() > 0.25 * segment.norm()) return e;
   core::Matrix J;
+  const long residuals_before = problem_.base().counters().residuals;
   if (problem_.jacobian(e.z.cwiseQuotient(f), J) != core::EvalStatus::ok) return e;
+  if (problem_.base().counters().residuals > residuals_before)
+    jacobian_residuals_ = problem_.base().counters().residuals - residuals_before;
   e.jacobian = in_unit_scale(J);
   if (tangent_from_jacobian(e.jacobian, normal, options_.rank.relative_threshold, e.tangent) !=
       core::EvalStatus::ok)
@@ -565,7 +568,11 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
     // The subspace stage is skipped once it has failed on at least two of this point's probes
     // and on more than two thirds of them (on the contact bar at 100 intervals it finished
     // 34 of 62 probes, 2 of 19 at T = 3.2).
-    const bool try_subspace = !(subspace_failed >= 2 && subspace_failed > 2 * subspace_done);
+    // Nor is it tried when a whole Jacobian costs no more residuals than one differencing along
+    // N (a compressed finite-difference Jacobian, core/README.md): the finisher is then as cheap.
+    const bool try_subspace =
+        !(subspace_failed >= 2 && subspace_failed > 2 * subspace_done) &&
+        !(jacobian_residuals_ > 0 && jacobian_residuals_ <= chord.null_space.cols() + 1);
     const bool oks = !okc && try_subspace && subspace_correct(chord, d, stepped, y, 4);
     if (!okc && try_subspace) ++(oks ? subspace_done : subspace_failed);
     if (!okc && !oks) {

@@ -129,8 +129,9 @@ class BranchPointDetector {
   core::Corrector& corrector_;
   std::vector<Sample> samples_;  // the last three points
   std::vector<BranchPointReport> found_;
-  double jacobian_scale_ = 0;   // Frobenius norm of the first point's Jacobian (unit scale)
-  core::Matrix last_jacobian_;  // the last sample's, unit scale (empty after restore())
+  double jacobian_scale_ = 0;    // Frobenius norm of the first point's Jacobian (unit scale)
+  core::Matrix last_jacobian_;   // the last sample's, unit scale (empty after restore())
+  long jacobian_residuals_ = 0;  // residuals the last Jacobian evaluate() computed took (0: none)
   std::unique_ptr<core::Corrector> finisher_, probe_finisher_;  // after chord steps stall
 };
 
