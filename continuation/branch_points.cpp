@@ -65,6 +65,7 @@ struct BranchPointDetector::Chord {
 
 struct BranchPointDetector::Evaluation {
   bool ok = false;
+  double s = 0;             // where on the bracket's polyline
   core::Vector z, tangent;  // unit scale
   core::Matrix jacobian;    // unit scale, at z
   TestFunctionValue tau;
@@ -194,7 +195,7 @@ void BranchPointDetector::add(int index, const core::Vector& z, const core::Vect
 
 bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vector& normal,
                                            const core::Vector& anchor, core::Vector& y_io,
-                                           int max_iterations) const {
+                                           int max_differences) const {
   // On failure y_io is left as it was.
   core::Vector y = y_io;
   const core::Matrix& N = chord.null_space;
@@ -208,36 +209,67 @@ bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vecto
     return r.allFinite();
   };
   const core::Matrix JN_chord = chord.jacobian * N;
-  double previous = std::numeric_limits<double>::infinity();  // a step must halve |F|
-  for (int iteration = 0; iteration <= max_iterations; ++iteration) {
-    core::Vector r;
-    if (!residual(y, r)) return false;
-    const double plane = normal.dot(y - anchor);
+  const auto converged = [&](const core::Vector& r, double plane) {
     const double local =
         rf.size() > 0 ? r.cwiseQuotient(rf).lpNorm<Eigen::Infinity>() : r.lpNorm<Eigen::Infinity>();
-    if (local <= tolerance && std::abs(plane) <= tolerance) {
-      y_io = y;
-      return true;
+    return local <= tolerance && std::abs(plane) <= tolerance;
+  };
+  core::Vector r;
+  if (!residual(y, r)) return false;
+  double plane = normal.dot(y - anchor);
+  if (converged(r, plane)) {
+    y_io = y;
+    return true;
+  }
+  // The matrix J + (JN - J N) N^T with the N columns differenced at an iterate is kept while
+  // its steps halve |F| (one residual each); a step that does not re-differences them at the
+  // iterate (N.cols() residuals); a step on fresh differences that does not halve |F| ends it.
+  core::Matrix bordered;
+  bool difference = true;
+  int differenced = 0;
+  for (int step = 0; step < 4 * max_differences; ++step) {
+    const bool fresh = difference;
+    if (difference) {
+      // (Re-)difference along N at y (one residual each).
+      if (differenced == max_differences) return false;
+      ++differenced;
+      const double h = 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
+      core::Matrix JN(r.size(), N.cols());
+      for (Eigen::Index k = 0; k < N.cols(); ++k) {
+        core::Vector rk;
+        if (!residual(y + h * N.col(k), rk)) return false;
+        JN.col(k) = (rk - r) / h;
+      }
+      bordered.resize(r.size() + 1, y.size());
+      bordered.topRows(r.size()) = chord.jacobian + (JN - JN_chord) * N.transpose();
+      bordered.row(r.size()) = normal.transpose();
+      difference = false;
     }
-    if (iteration == max_iterations || !(local <= 0.5 * previous)) return false;
-    previous = local;
-    // Forward differences along N at y (one residual each).
-    const double h = 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
-    core::Matrix JN(r.size(), N.cols());
-    for (Eigen::Index k = 0; k < N.cols(); ++k) {
-      core::Vector rk;
-      if (!residual(y + h * N.col(k), rk)) return false;
-      JN.col(k) = (rk - r) / h;
-    }
-    core::Matrix bordered(r.size() + 1, y.size());
-    bordered.topRows(r.size()) = chord.jacobian + (JN - JN_chord) * N.transpose();
-    bordered.row(r.size()) = normal.transpose();
     core::Vector rhs(r.size() + 1);
     rhs << -r, -plane;
     core::Vector dx;
     core::minimum_norm_solve(bordered, rhs, options_.rank.relative_threshold, dx);
     if (!dx.allFinite()) return false;
-    y += dx;
+    const core::Vector y_new = y + dx;
+    core::Vector r_new;
+    if (!residual(y_new, r_new)) return false;
+    const double plane_new = normal.dot(y_new - anchor);
+    if (converged(r_new, plane_new)) {
+      y_io = y_new;
+      return true;
+    }
+    const auto size = [&](const core::Vector& v) {
+      return rf.size() > 0 ? v.cwiseQuotient(rf).lpNorm<Eigen::Infinity>()
+                           : v.lpNorm<Eigen::Infinity>();
+    };
+    if (size(r_new) <= 0.5 * size(r)) {
+      y = y_new;
+      r = r_new;
+      plane = plane_new;
+      continue;
+    }
+    if (fresh) return false;
+    difference = true;
   }
   return false;
 }
@@ -245,7 +277,8 @@ bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vecto
 BranchPointDetector::Evaluation BranchPointDetector::evaluate(const std::vector<Sample>& polyline,
                                                               double s,
                                                               const TestFunctionValue& reference,
-                                                              const Chord* chord) {
+                                                              const Chord* chord,
+                                                              const Evaluation* near) {
   Evaluation e;
   std::size_t i = 0;
   while (i + 2 < polyline.size() && s > polyline[i + 1].s) ++i;
@@ -257,7 +290,31 @@ BranchPointDetector::Evaluation BranchPointDetector::evaluate(const std::vector<
   const core::Vector through = a.z + fraction * segment;
   const core::Vector normal = segment.normalized();
   const core::Vector f = factor();
-  e.z = through;
+  e.s = s;
+  // Start: the cubic Hermite interpolant of the two samples and their tangents (error O(L^4) in
+  // the chord length L, where the chord's own is O(L^2)), moved onto the hyperplane.
+  {
+    const double L = segment.norm(), t = fraction;
+    const core::Vector ta = a.tangent.dot(segment) < 0 ? core::Vector(-a.tangent) : a.tangent;
+    const core::Vector tb = b.tangent.dot(segment) < 0 ? core::Vector(-b.tangent) : b.tangent;
+    e.z = (2 * t * t * t - 3 * t * t + 1) * a.z + (t * t * t - 2 * t * t + t) * L * ta +
+          (-2 * t * t * t + 3 * t * t) * b.z + (t * t * t - t * t) * L * tb;
+    e.z += normal * normal.dot(through - e.z);
+    if (!e.z.allFinite() || a.tangent.size() != a.z.size() || b.tangent.size() != b.z.size())
+      e.z = through;
+  }
+  // From a corrected point of the location nearer than the polyline's samples, a tangent
+  // predictor onto the hyperplane and chord steps on that point's Jacobian: the bracket shrinks
+  // much faster than the polyline's interpolation error does.
+  std::optional<Chord> near_chord;
+  if (near && near->ok) {
+    const double along = normal.dot(near->tangent);
+    if (std::abs(along) >= 0.5) {
+      e.z = near->z + near->tangent * (normal.dot(through - near->z) / along);
+      near_chord.emplace(near->jacobian, null_cutoff());
+      chord = &*near_chord;
+    }
+  }
   if (!chord || !chord_correct(*chord, normal, through, e.z)) {
     // From where the chord steps got to, in the loop's units (fresh Jacobians).
     const core::BorderedSystem on_plane(
@@ -270,7 +327,10 @@ BranchPointDetector::Evaluation BranchPointDetector::evaluate(const std::vector<
   // A point on another family is not a point of the branch: it must stay near the chord.
   if ((e.z - through).norm() > 0.25 * segment.norm()) return e;
   core::Matrix J;
+  const long residuals_before = problem_.base().counters().residuals;
   if (problem_.jacobian(e.z.cwiseQuotient(f), J) != core::EvalStatus::ok) return e;
+  if (problem_.base().counters().residuals > residuals_before)
+    jacobian_residuals_ = problem_.base().counters().residuals - residuals_before;
   e.jacobian = in_unit_scale(J);
   if (tangent_from_jacobian(e.jacobian, normal, options_.rank.relative_threshold, e.tangent) !=
       core::EvalStatus::ok)
@@ -284,10 +344,11 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
   const auto started = std::chrono::steady_clock::now();
   const BranchPointOptions& o = options_.branch_points;
   const TestFunctionValue& reference = polyline.front().tau;
-  // Located when |tau| is a thousandth of the rank report's relative threshold: J is singular
-  // there at the resolution the verification uses, with a margin (further steps only refine the
-  // arclength, each at the price of a Jacobian).
-  const double located_value = 1e-3 * options_.rank.relative_threshold;
+  // Located when |tau| is 1e-4 of the rank report's relative threshold: J is singular there at
+  // the resolution the verification uses, with a margin, and the period of a contact-bar point
+  // within ~1e-8 (at 1e-3 of it, 1.9e-8 at T = 3.5 on 100 intervals). Near the root a step costs
+  // one Jacobian and a few residuals (tangent predictor from the nearest evaluation).
+  const double located_value = 1e-4 * options_.rank.relative_threshold;
   BranchPointReport report;
   report.sign_change = sign_change;
   // Each correction starts with chord steps on the last Jacobian evaluated (Chord): the
@@ -306,6 +367,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       best_value = p.tau.value;
       best_jacobian = &p == &polyline.back() ? last_jacobian_ : core::Matrix();
     }
+  std::vector<Evaluation> done;  // every corrected evaluation, for the next one's start
   const auto keep = [&](Evaluation& e, double s) {
     if (std::abs(e.tau.value) < std::abs(best_value)) {
       best_z = e.z;
@@ -315,6 +377,19 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       best_jacobian = e.jacobian;
     }
     chord.emplace(e.jacobian, null_cutoff());
+    done.push_back(e);
+  };
+  // The corrected evaluation nearest to s when it is nearer than every sample of the polyline.
+  const auto nearest = [&](double s) -> const Evaluation* {
+    double distance = std::numeric_limits<double>::infinity();
+    for (const Sample& p : polyline) distance = std::min(distance, std::abs(p.s - s));
+    const Evaluation* best = nullptr;
+    for (const Evaluation& e : done)
+      if (std::abs(e.s - s) < distance) {
+        distance = std::abs(e.s - s);
+        best = &e;
+      }
+    return best;
   };
   // Every value seen, for the minimisation of |tau| (a dip, or a secant iteration whose
   // singular triplet stopped following the reference's).
@@ -335,7 +410,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       double s = (sa * fb - sb * fa) / (fb - fa);
       const double lo = std::min(sa, sb), hi = std::max(sa, sb);
       if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
-      Evaluation e = evaluate(polyline, s, reference, chord ? &*chord : nullptr);
+      Evaluation e = evaluate(polyline, s, reference, chord ? &*chord : nullptr, nearest(s));
       ++steps;
       if (!e.ok) break;
       keep(e, s);
@@ -393,7 +468,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
         if (std::abs(s - sb) < nudge) s = right_larger ? sb + nudge : sb - nudge;
         if (!(s > sa && s < sc)) s = right_larger ? 0.5 * (sb + sc) : 0.5 * (sa + sb);
       }
-      Evaluation e = evaluate(polyline, s, reference, chord ? &*chord : nullptr);
+      Evaluation e = evaluate(polyline, s, reference, chord ? &*chord : nullptr, nearest(s));
       ++steps;
       if (!e.ok) break;
       keep(e, s);
@@ -484,11 +559,23 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
   const double h = v.step;
   double smallest = std::numeric_limits<double>::infinity();
   int attached = 0;
+  int subspace_done = 0, subspace_failed = 0;
   for (int i = 0; i < std::min(candidates, options_.branch_points.max_probes); ++i) {
     const core::Vector d = svd.matrixU().col(i);
     const core::Vector stepped = z + h * d;
     core::Vector y = stepped;
-    if (!chord_correct(chord, d, stepped, y) && !subspace_correct(chord, d, stepped, y, 4)) {
+    const bool okc = chord_correct(chord, d, stepped, y);
+    // The subspace stage is skipped once it has failed on at least two of this point's probes
+    // and on more than two thirds of them (on the contact bar at 100 intervals it finished
+    // 34 of 62 probes, 2 of 19 at T = 3.2).
+    // Nor is it tried when a whole Jacobian costs no more residuals than one differencing along
+    // N (a compressed finite-difference Jacobian, core/README.md): the finisher is then as cheap.
+    const bool try_subspace =
+        !(subspace_failed >= 2 && subspace_failed > 2 * subspace_done) &&
+        !(jacobian_residuals_ > 0 && jacobian_residuals_ <= chord.null_space.cols() + 1);
+    const bool oks = !okc && try_subspace && subspace_correct(chord, d, stepped, y, 4);
+    if (!okc && try_subspace) ++(oks ? subspace_done : subspace_failed);
+    if (!okc && !oks) {
       const core::BorderedSystem on_plane(
           problem_,
           {core::BorderRow::hyperplane(d.cwiseProduct(f).normalized(), stepped.cwiseQuotient(f))});

@@ -108,12 +108,17 @@ class BranchPointDetector {
   // when they do not converge to the verifier's corrector tolerance.
   bool chord_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
                      core::Vector& y) const;
-  // Gauss-Newton on J with its columns along J's null space N re-differenced at each iterate
-  // (N.cols() residuals per step instead of a Jacobian's n), onto the same constraints.
+  // Gauss-Newton on J with its columns along J's null space N re-differenced at an iterate
+  // (N.cols() residuals instead of a Jacobian's n), kept while its steps halve |F| (one residual
+  // each), onto the same constraints; at most max_differences differencings.
   bool subspace_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
-                        core::Vector& y, int max_iterations) const;
+                        core::Vector& y, int max_differences) const;
+  // The point on the hyperplane through the bracket's polyline at s, orthogonal to it, and its
+  // test function. Starts from near (a corrected evaluation nearer than the samples: tangent
+  // predictor, chord steps on its Jacobian) or else from the samples' cubic Hermite interpolant
+  // (chord steps on chord).
   Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref,
-                      const Chord* chord);
+                      const Chord* chord, const Evaluation* near);
   void locate(const std::vector<Sample>& polyline, bool sign_change);
   void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,
               core::Matrix J);
@@ -124,8 +129,9 @@ class BranchPointDetector {
   core::Corrector& corrector_;
   std::vector<Sample> samples_;  // the last three points
   std::vector<BranchPointReport> found_;
-  double jacobian_scale_ = 0;   // Frobenius norm of the first point's Jacobian (unit scale)
-  core::Matrix last_jacobian_;  // the last sample's, unit scale (empty after restore())
+  double jacobian_scale_ = 0;    // Frobenius norm of the first point's Jacobian (unit scale)
+  core::Matrix last_jacobian_;   // the last sample's, unit scale (empty after restore())
+  long jacobian_residuals_ = 0;  // residuals the last Jacobian evaluate() computed took (0: none)
   std::unique_ptr<core::Corrector> finisher_, probe_finisher_;  // after chord steps stall
 };
 
