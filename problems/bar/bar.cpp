@@ -55,13 +55,39 @@ PiecewiseLinear::PiecewiseLinear(std::vector<double> x, std::vector<double> y)
       throw InputError("knots",
                        fmt::format("knots must increase strictly ({} after {})", x_[i], x_[i - 1]));
   }
+  // Near uniform: every knot within a quarter spacing of its grid point, so that the guessed
+  // index is at most one off and the corrective walk is a step or two.
+  const std::size_t n = x_.size();
+  if (n >= 3) {
+    const double spacing = (x_.back() - x_.front()) / static_cast<double>(n - 1);
+    bool uniform = spacing > 0 && std::isfinite(1 / spacing);
+    for (std::size_t i = 1; uniform && i + 1 < n; ++i)
+      uniform = std::abs(x_[i] - (x_.front() + static_cast<double>(i) * spacing)) <= 0.25 * spacing;
+    if (uniform) inverse_spacing_ = 1 / spacing;
+  }
+}
+
+std::size_t PiecewiseLinear::first_knot_above(double x, bool or_equal) const {
+  const auto above = [&](double knot) { return or_equal ? knot >= x : knot > x; };
+  if (inverse_spacing_ == 0 || !(x > x_.front() && x < x_.back()))
+    return static_cast<std::size_t>((or_equal ? std::lower_bound(x_.begin(), x_.end(), x)
+                                              : std::upper_bound(x_.begin(), x_.end(), x)) -
+                                    x_.begin());
+  // x_front < x < x_back: the answer i is in [1, n - 1], with x_[i - 1] not above x and x_[i]
+  // above it. Guess from the grid, then walk down while x_[i - 1] is above x and up while x_[i]
+  // is not: the result is the binary search's from any start.
+  const std::size_t last = x_.size() - 1;
+  const double guess = (x - x_.front()) * inverse_spacing_;  // in (0, last] up to rounding
+  std::size_t i = guess < static_cast<double>(last) ? static_cast<std::size_t>(guess) + 1 : last;
+  while (i > 1 && above(x_[i - 1])) --i;
+  while (i < last && !above(x_[i])) ++i;
+  return i;
 }
 
 double PiecewiseLinear::operator()(double x) const {
   if (x <= x_.front()) return y_.front();
   if (x >= x_.back()) return y_.back();
-  auto it = std::upper_bound(x_.begin(), x_.end(), x);
-  const std::size_t i = static_cast<std::size_t>(it - x_.begin());  // x_[i-1] <= x < x_[i]
+  const std::size_t i = first_knot_above(x, false);  // x_[i-1] <= x < x_[i]
   const double w = (x - x_[i - 1]) / (x_[i] - x_[i - 1]);
   return (1 - w) * y_[i - 1] + w * y_[i];
 }
@@ -70,13 +96,7 @@ double PiecewiseLinear::slope(double x, int side) const {
   if (x_.size() < 2) return 0;
   if (x < x_.front() || (x == x_.front() && side < 0)) return 0;
   if (x > x_.back() || (x == x_.back() && side > 0)) return 0;
-  std::size_t i;
-  if (side > 0) {
-    i = static_cast<std::size_t>(std::upper_bound(x_.begin(), x_.end(), x) - x_.begin());
-  } else {
-    i = static_cast<std::size_t>(std::lower_bound(x_.begin(), x_.end(), x) - x_.begin());
-  }
-  i = std::clamp<std::size_t>(i, 1, x_.size() - 1);
+  const std::size_t i = std::clamp<std::size_t>(first_knot_above(x, side <= 0), 1, x_.size() - 1);
   return (y_[i] - y_[i - 1]) / (x_[i] - x_[i - 1]);
 }
 
@@ -87,8 +107,8 @@ double PiecewiseLinear::integral(double a, double b) const {
   double total = 0;
   double left = a;
   auto piece = [&](double l, double r) { total += 0.5 * ((*this)(l) + (*this)(r)) * (r - l); };
-  for (double k : x_) {
-    if (k <= left) continue;
+  for (std::size_t i = first_knot_above(a, false); i < x_.size(); ++i) {
+    const double k = x_[i];
     if (k >= b) break;
     piece(left, k);
     left = k;

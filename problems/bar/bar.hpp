@@ -47,6 +47,9 @@ struct Material {
 };
 
 // Continuous piecewise-linear function on sorted knots (constant extrapolation outside).
+// Knots close to a uniform grid (a shooting state's u0 on N equal elements) are found by index
+// arithmetic, floor((x - x_0) / dx) corrected by a walk to the exact search's answer; other
+// knots by binary search. Values are the same either way.
 class PiecewiseLinear {
  public:
   PiecewiseLinear() : x_{0.0}, y_{0.0} {}
@@ -59,7 +62,11 @@ class PiecewiseLinear {
   const std::vector<double>& values() const { return y_; }
 
  private:
+  // Index of the first knot > x (or_equal: >= x), as std::upper_bound (std::lower_bound).
+  std::size_t first_knot_above(double x, bool or_equal) const;
+
   std::vector<double> x_, y_;
+  double inverse_spacing_ = 0;  // (knots - 1) / (x_back - x_front) when near uniform, else 0
 };
 
 struct BarSetup {

@@ -45,10 +45,22 @@ constexpr double root_snap_steps = 1e-9;
 
 }  // namespace
 
+namespace {
+
+// std::llround(v) for v in [0, 2^62] (a fraction of a step in ticks), without the library
+// call: v - trunc(v) is exact, and a half rounds up as in llround. Anything else goes to llround.
+std::int64_t round_ticks(double v) {
+  if (!(v >= 0 && v <= 0x1p62)) return std::llround(v);
+  const auto whole = static_cast<std::int64_t>(v);
+  return v - static_cast<double>(whole) >= 0.5 ? whole + 1 : whole;
+}
+
+}  // namespace
+
 TdbemMarch::GridTime TdbemMarch::normalized(std::int64_t step, double frac) {
   const double whole = std::floor(frac);
   GridTime t{step + static_cast<std::int64_t>(whole),
-             std::llround((frac - whole) * static_cast<double>(ticks_per_step))};
+             round_ticks((frac - whole) * static_cast<double>(ticks_per_step))};
   if (t.tick >= ticks_per_step) {  // rounded up to a whole step
     t.tick -= ticks_per_step;
     t.step += 1;
@@ -131,7 +143,9 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
     if (E.end.type == bar::EndType::fixed && u != 0)
       throw InputError("u0", fmt::format("u0 must vanish at the fixed end x = {} (got {})",
                                          e == 0 ? 0.0 : L_, u));
-    E.knots.push_back({GridTime{}, u, 0.0, 0.5 * u, false});
+    // The window holds about tau / dt knots plus the sub-step instants (kinks, contact events).
+    E.knots.reserve(static_cast<std::size_t>(2 * tau_grid_.step) + 64);
+    E.knots.push_back({GridTime{}, u, 0.0, 0.5 * u, 0.0, false});
     E.closed = E.end.type == bar::EndType::contact && E.normal * (u - E.wall) >= 0;
     if (E.closed) {
       // A state that starts on the wall (a subharmonic member at the centre of a contact
@@ -188,9 +202,7 @@ double TdbemMarch::q_slope(int e, GridTime s, std::size_t* hint) const {
   std::size_t i = knot_index(e, s, hint);
   if (i == k.size()) i = k.size() - 1;
   if (i == 0) i = 1;
-  const Knot& prev = k[i - 1];
-  const Knot& next = k[i];
-  return (next.q - prev.q) / seconds_between(next.t, prev.t);
+  return k[i].slope;  // (k[i].q - k[i - 1].q) / seconds_between(k[i].t, k[i - 1].t)
 }
 
 double TdbemMarch::r_end(int e, GridTime t) const {
@@ -226,12 +238,18 @@ void TdbemMarch::push_knot(int e, GridTime t, double u, double s, bool kink) {
       k1.kink = false;
       auto& pending = ends_[1 - e].pending;
       const GridTime echo = plus(k1.t, tau_grid_);
-      auto it = std::lower_bound(pending.begin(), pending.end(), later(echo, -merge_steps_));
+      // std::lower_bound, searched from the back: the echo was scheduled a step or so ago, as
+      // the latest pending time or near it.
+      const GridTime from = later(echo, -merge_steps_);
+      const GridTime* it = pending.end();
+      while (it != pending.begin() && !(*(it - 1) < from)) --it;
       if (it != pending.end() && std::abs(steps_between(*it, echo)) <= merge_steps_)
         pending.erase(it);
     }
   }
-  E.knots.push_back({t, u, s, q, false});
+  const Knot& last = E.knots.back();
+  const double slope = (q - last.q) / seconds_between(t, last.t);
+  E.knots.push_back({t, u, s, q, slope, false});
   if (!std::isfinite(u) || !std::isfinite(s)) ok_ = false;
   if (kink) mark_kink(e);
 }
@@ -249,7 +267,10 @@ void TdbemMarch::mark_kink(int e) {
     if (ahead >= -merge_steps_) mark_kink(1 - e);
     return;
   }
-  other.pending.insert(std::upper_bound(other.pending.begin(), other.pending.end(), echo), echo);
+  // std::upper_bound, searched from the back: an echo is tau after now, mostly the latest.
+  const GridTime* at = other.pending.end();
+  while (at != other.pending.begin() && echo < *(at - 1)) --at;
+  other.pending.insert(at, echo);
 }
 
 void TdbemMarch::step_end(int e, GridTime ta, GridTime tb) {
@@ -291,7 +312,8 @@ void TdbemMarch::step_end(int e, GridTime ta, GridTime tb) {
     return;
   }
   // Event method: split the step at the kinks of R_e that fall inside it.
-  std::vector<GridTime> cuts;
+  std::vector<GridTime>& cuts = cuts_;
+  cuts.clear();
   bool kink_at_end = false;
   while (!E.pending.empty() && steps_between(E.pending.front(), tb) <= merge_steps_) {
     const GridTime p = E.pending.front();
@@ -350,10 +372,11 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   const double h = steps_between(tb, ta);
   const double n = E.normal;
   auto gap_violation = [&](GridTime t) { return n * (2 * r_end(e, t) + c_ * a.s - E.wall); };
-  const double pb = gap_violation(tb);
+  const double r_b = r_end(e, tb);  // R_e(tb), used below (a pure function of the history)
+  const double pb = n * (2 * r_b + c_ * a.s - E.wall);
   if (!(pb > 0)) {
     E.force = 0;
-    push_knot(e, tb, 2 * r_end(e, tb) + c_ * a.s, a.s, kink_at_end);
+    push_knot(e, tb, 2 * r_b + c_ * a.s, a.s, kink_at_end);
     return;
   }
   // Crossing: the free displacement is linear in t (quadratic with a body force).
@@ -383,13 +406,13 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
     E.contact_u = a.u;
     mark_kink(e);
     events_.push_back({seconds(ta), e == 1, true});
-    const double s = (E.contact_u - 2 * r_end(e, tb)) / c_;
+    const double s = (E.contact_u - 2 * r_b) / c_;
     E.force = -ea_ * n * (s - a.s) / seconds_between(tb, ta);
     push_knot(e, tb, E.contact_u, s, kink_at_end);
     return;
   }
   if (h - root <= root_snap_steps) {  // open up to tb, closed from tb
-    E.contact_u = 2 * r_end(e, tb) + c_ * a.s;
+    E.contact_u = 2 * r_b + c_ * a.s;
     E.force = 0;
     events_.push_back({seconds(tb), e == 1, true});
     push_knot(e, tb, E.contact_u, a.s, true);
@@ -413,11 +436,12 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
   auto gap_violation = [&](GridTime t) { return n * (2 * r_end(e, t) + c_ * a.s - E.contact_u); };
   // gap_violation(ta) = 0 on the wall; the force over [ta, t] is EA * violation(t) / (c (t-ta)).
   const double pm = gap_violation(later(ta, 0.5 * h));
-  const double pb = gap_violation(tb);
+  const double r_b = r_end(e, tb);  // R_e(tb), used again by a step closed up to tb
+  const double pb = n * (2 * r_b + c_ * a.s - E.contact_u);
   const double alpha = (4 * pm - pb) / h;  // the force at ta+ is EA alpha / (c step)
   const double beta = 2 * (pb - 2 * pm) / (h * h);
   auto closed_step = [&](GridTime t_end, bool kink) {
-    const double s = (E.contact_u - 2 * r_end(e, t_end)) / c_;
+    const double s = (E.contact_u - 2 * (t_end == tb ? r_b : r_end(e, t_end))) / c_;
     E.force = -ea_ * n * (s - a.s) / seconds_between(t_end, ta);
     push_knot(e, t_end, E.contact_u, s, kink);
   };
@@ -459,10 +483,13 @@ void TdbemMarch::regauge() {
   const double shift = 0.5 * (ends_[0].knots.back().q - ends_[1].knots.back().q);
   for (int e = 0; e < 2; ++e) {
     const double dq = e == 0 ? -shift : shift, ds = 2 * dq / c_;
-    for (Knot& k : ends_[e].knots) {
+    auto& knots = ends_[e].knots;
+    for (Knot& k : knots) {
       k.q += dq;
       k.s += ds;
     }
+    for (std::size_t i = 1; i < knots.size(); ++i)
+      knots[i].slope = (knots[i].q - knots[i - 1].q) / seconds_between(knots[i].t, knots[i - 1].t);
   }
 }
 
@@ -604,7 +631,8 @@ std::vector<double> TdbemMarch::breakpoints(int elements) const {
   std::vector<double> from0, from1;  // both increasing in x
   from0.reserve(ends_[0].knots.size());
   from1.reserve(ends_[1].knots.size());
-  for (auto k = ends_[0].knots.rbegin(); k != ends_[0].knots.rend(); ++k)
+  for (auto k = std::make_reverse_iterator(ends_[0].knots.end());
+       k != std::make_reverse_iterator(ends_[0].knots.begin()); ++k)
     if (const double p = c_ * seconds_between(now_, k->t); inside(p)) from0.push_back(p);
   for (const auto& k : ends_[1].knots)
     if (const double p = L_ - c_ * seconds_between(now_, k.t); inside(p)) from1.push_back(p);
@@ -678,15 +706,14 @@ double TdbemMarch::window_energy() const {
   const auto& m = setup_.material;
   const auto& k0 = ends_[0].knots;
   const auto& k1 = ends_[1].knots;
-  const auto slope = [&](const Knot& a, const Knot& b) {
-    return (b.q - a.q) / seconds_between(b.t, a.t);
-  };
+  // (b.q - a.q) / seconds_between(b.t, a.t), b the knot after a.
+  const auto slope = [](const Knot&, const Knot& b) { return b.slope; };
   const double inf = std::numeric_limits<double>::infinity();
   // End 0, interval (knot j - 1, knot j) covers x in [c (t - t_j), c (t - t_{j-1})]: walking up
   // in x walks j down from the newest knot. End 1, interval (j - 1, j) covers [L - c (t -
   // t_{j-1}), L - c (t - t_j)]: j walks up from the oldest. The oldest interval of end 0 and the
   // newest of end 1 extend to the far end (the window holds a knot at or before t - tau; beyond
-  // it the slope is that of the last interval). Deque iterators: indexing costs more.
+  // it the slope is that of the last interval).
   auto hi0 = std::prev(k0.end()), hi1 = std::next(k1.begin());  // knot j of each end
   const auto lowest0 = std::next(k0.begin()), highest1 = std::prev(k1.end());
   const auto end0_upper = [&] {

@@ -34,8 +34,8 @@
 #pragma once
 
 #include <compare>
+#include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <string>
 #include <vector>
 
@@ -128,15 +128,67 @@ class TdbemMarch {
   struct Knot {
     GridTime t;
     double u, s, q;  // U, S, Q = (c/2) S + U/2
-    bool kink;       // a slope change whose echo must be tracked (event method)
+    // dQ/dt [m/s] over (previous knot, this knot): (q - q_prev) / (t - t_prev), formed once
+    // when the knot is pushed (and again after regauge()); 0 for the first knot.
+    double slope;
+    bool kink;  // a slope change whose echo must be tracked (event method)
+  };
+  // A first-in first-out sequence in one contiguous array (a vector and the index of its first
+  // live element): the knot searches index the window on every query, which a std::deque turns
+  // into a division per access. pop_front is O(1); the dead prefix is dropped when it is as
+  // long as the live part and the array is full (amortized O(1) per element).
+  template <class T>
+  class Fifo {
+   public:
+    std::size_t size() const { return data_.size() - head_; }
+    bool empty() const { return data_.size() == head_; }
+    T& operator[](std::size_t i) { return data_[head_ + i]; }
+    const T& operator[](std::size_t i) const { return data_[head_ + i]; }
+    T& front() { return data_[head_]; }
+    const T& front() const { return data_[head_]; }
+    T& back() { return data_.back(); }
+    const T& back() const { return data_.back(); }
+    T* begin() { return data_.data() + head_; }
+    T* end() { return data_.data() + data_.size(); }
+    const T* begin() const { return data_.data() + head_; }
+    const T* end() const { return data_.data() + data_.size(); }
+    void reserve(std::size_t n) { data_.reserve(n); }
+    void push_back(const T& value) {
+      if (data_.size() == data_.capacity() && head_ >= size()) drop_dead();
+      data_.push_back(value);
+    }
+    void pop_front() {
+      if (++head_ == data_.size()) {
+        data_.clear();
+        head_ = 0;
+      }
+    }
+    T* insert(const T* at, const T& value) {
+      const auto offset = at - data_.data();
+      return &*data_.insert(data_.begin() + offset, value);
+    }
+    void erase(const T* at) { data_.erase(data_.begin() + (at - data_.data())); }
+    template <class It>
+    void assign(It first, It last) {
+      data_.assign(first, last);
+      head_ = 0;
+    }
+
+   private:
+    void drop_dead() {
+      data_.erase(data_.begin(), data_.begin() + static_cast<std::ptrdiff_t>(head_));
+      head_ = 0;
+    }
+    std::vector<T> data_;
+    std::size_t head_ = 0;
   };
   struct EndState {
     bar::End end;
     double normal = 1;     // outward normal
     double wall = 0;       // wall position n * gap
     double contact_u = 0;  // U held while closed: the wall, or a round-off off it (solve_open)
-    std::deque<Knot> knots;
-    std::deque<GridTime> pending;  // times of kinks of R_e still ahead (event method)
+    Fifo<Knot> knots;
+    Fifo<GridTime> pending;  // times of kinks of R_e still ahead (event method)
     double force = 0;
     bool closed = false;
   };
@@ -181,6 +233,7 @@ class TdbemMarch {
   // Knot index of the last retarded-time query of each end's R (r_end reads the OTHER end's
   // history at t - tau, increasing over the march). Only the march itself updates it.
   mutable std::size_t retarded_hint_[2] = {0, 0};
+  std::vector<GridTime> cuts_;  // step_end's sub-step instants (kept to reuse its storage)
   std::vector<ContactEvent> events_;
 };
 
