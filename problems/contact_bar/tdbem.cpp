@@ -45,22 +45,21 @@ constexpr double root_snap_steps = 1e-9;
 
 }  // namespace
 
-namespace {
-
-// std::llround(v) for v in [0, 2^62] (a fraction of a step in ticks), without the library
-// call: v - trunc(v) is exact, and a half rounds up as in llround. Anything else goes to llround.
-std::int64_t round_ticks(double v) {
-  if (!(v >= 0 && v <= 0x1p62)) return std::llround(v);
-  const auto whole = static_cast<std::int64_t>(v);
-  return v - static_cast<double>(whole) >= 0.5 ? whole + 1 : whole;
-}
-
-}  // namespace
-
 TdbemMarch::GridTime TdbemMarch::normalized(std::int64_t step, double frac) {
-  const double whole = std::floor(frac);
-  GridTime t{step + static_cast<std::int64_t>(whole),
-             round_ticks((frac - whole) * static_cast<double>(ticks_per_step))};
+  GridTime t;
+  if (frac >= 0 && frac < 0x1p52) {
+    // The general branch below without library calls (every retarded time and sub-step comes
+    // here): truncation is the floor, frac - whole is exact, and a half rounds up as in
+    // llround.
+    const auto whole = static_cast<std::int64_t>(frac);
+    const double ticks = (frac - static_cast<double>(whole)) * static_cast<double>(ticks_per_step);
+    const auto tick = static_cast<std::int64_t>(ticks);
+    t = {step + whole, ticks - static_cast<double>(tick) >= 0.5 ? tick + 1 : tick};
+  } else {
+    const double whole = std::floor(frac);
+    t = {step + static_cast<std::int64_t>(whole),
+         std::llround((frac - whole) * static_cast<double>(ticks_per_step))};
+  }
   if (t.tick >= ticks_per_step) {  // rounded up to a whole step
     t.tick -= ticks_per_step;
     t.step += 1;
@@ -83,7 +82,7 @@ TdbemMarch::GridTime TdbemMarch::grid_time(double t) const {
   return g;
 }
 
-TdbemMarch::GridTime TdbemMarch::retarded(double t_seconds_before) const {
+inline TdbemMarch::GridTime TdbemMarch::retarded(double t_seconds_before) const {
   return minus(now_, normalized(0, t_seconds_before / step_));
 }
 
@@ -96,6 +95,9 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
   ea_ = setup_.material.axial_stiffness();
   body_coef_ = setup_.body_force / setup_.material.density / (2 * c_);
   v0_total_ = setup_.v0.integral(0, L_);
+  // v0 = +0 everywhere (a shooting state): every integral of it is +0, so r_end adds +0.
+  v0_is_zero_ = std::all_of(setup_.v0.values().begin(), setup_.v0.values().end(),
+                            [](double v) { return v == 0 && !std::signbit(v); });
   if (!std::isfinite(dt) || !(dt > 0))
     throw InputError("dt", fmt::format("must be > 0 (got {})", dt));
   if (dt > tau_ * (1 + 1e-12))
@@ -144,7 +146,8 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
       throw InputError("u0", fmt::format("u0 must vanish at the fixed end x = {} (got {})",
                                          e == 0 ? 0.0 : L_, u));
     // The window holds about tau / dt knots plus the sub-step instants (kinks, contact events).
-    E.knots.reserve(static_cast<std::size_t>(2 * tau_grid_.step) + 64);
+    E.knots.reserve(static_cast<std::size_t>(2 * tau_grid_.step) + setup_.u0.knots().size() +
+                    setup_.v0.knots().size() + 64);
     E.knots.push_back({GridTime{}, u, 0.0, 0.5 * u, 0.0, false});
     E.closed = E.end.type == bar::EndType::contact && E.normal * (u - E.wall) >= 0;
     if (E.closed) {
@@ -156,20 +159,30 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
     E.contact_u = E.wall;
     if (method_ == ContactMethod::event) {
       // Kinks of R_e inside (0, tau]: data knots reaching the end, and the end of the IC term.
-      std::vector<GridTime> times{tau_grid_};
-      for (const auto* f : {&setup_.u0, &setup_.v0})
-        for (double x : f->knots()) {
+      // Each function's arrival times increase along its knots (from x = 0 for end 0, from
+      // x = L for end 1) and grid_time is monotone: two sorted runs, merged, and tau put in its
+      // place give the sorted list without a sort.
+      std::vector<GridTime> runs[2];
+      for (int j = 0; j < 2; ++j) {
+        const std::vector<double>& knots = (j == 0 ? setup_.u0 : setup_.v0).knots();
+        for (std::size_t i = 0; i < knots.size(); ++i) {
+          const double x = e == 0 ? knots[i] : knots[knots.size() - 1 - i];
           const double time = (e == 0 ? x : L_ - x) / c_;
-          if (time > 0 && time < tau_) times.push_back(grid_time(time));
+          if (time > 0 && time < tau_) runs[j].push_back(grid_time(time));
         }
-      std::sort(times.begin(), times.end());
+      }
+      std::vector<GridTime> times(runs[0].size() + runs[1].size() + 1);
+      const auto merged_end =
+          std::merge(runs[0].begin(), runs[0].end(), runs[1].begin(), runs[1].end(), times.begin());
+      *merged_end = tau_grid_;
+      std::inplace_merge(times.begin(), merged_end, times.end());
       times.erase(std::unique(times.begin(), times.end()), times.end());
       E.pending.assign(times.begin(), times.end());
     }
   }
 }
 
-std::size_t TdbemMarch::knot_index(int e, GridTime s, std::size_t* hint) const {
+inline std::size_t TdbemMarch::knot_index(int e, GridTime s, std::size_t* hint) const {
   const auto& k = ends_[e].knots;
   if (!hint)
     return static_cast<std::size_t>(
@@ -196,7 +209,7 @@ double TdbemMarch::q_at(int e, GridTime s, std::size_t* hint) const {
   return prev.q + w * (next.q - prev.q);
 }
 
-double TdbemMarch::q_slope(int e, GridTime s, std::size_t* hint) const {
+inline double TdbemMarch::q_slope(int e, GridTime s, std::size_t* hint) const {
   const auto& k = ends_[e].knots;
   if (k.size() < 2) return 0;
   std::size_t i = knot_index(e, s, hint);
@@ -213,10 +226,10 @@ double TdbemMarch::r_end(int e, GridTime t) const {
     const double ct = c_ * seconds(t);
     if (e == 1) {
       value += 0.5 * setup_.u0(std::max(L_ - ct, 0.0));
-      value += setup_.v0.integral(std::max(L_ - ct, 0.0), L_) / (2 * c_);
+      value += v0_is_zero_ ? 0.0 : setup_.v0.integral(std::max(L_ - ct, 0.0), L_) / (2 * c_);
     } else {
       value += 0.5 * setup_.u0(std::min(ct, L_));
-      value += setup_.v0.integral(0.0, std::min(ct, L_)) / (2 * c_);
+      value += v0_is_zero_ ? 0.0 : setup_.v0.integral(0.0, std::min(ct, L_)) / (2 * c_);
     }
   } else {
     value += v0_total_ / (2 * c_) + q_at(1 - e, retarded_time, &retarded_hint_[1 - e]);

@@ -221,7 +221,8 @@ class TdbemMarch {
   bar::BarSetup setup_;
   ContactMethod method_;
   double dt_, L_, c_, tau_, ea_, body_coef_, v0_total_;
-  double step_ = 0;  // grid step [s]: dt, or tau / m when tau is m dt to round-off
+  bool v0_is_zero_ = false;  // every value of v0 is +0
+  double step_ = 0;          // grid step [s]: dt, or tau / m when tau is m dt to round-off
   GridTime tau_grid_;
   double merge_steps_ = 0;  // sub-step instants closer than this (in steps) are one       // tau on
                             // the grid (m steps exactly in that case)
