@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 
 #include "core/eigen_newton.hpp"
 #include "core/errors.hpp"
@@ -36,6 +37,33 @@ TEST(RankReport, DiagonalMatrixWithAClearGap) {
   EXPECT_LT(r.null_directions.topRows(2).norm(), 1e-14);
   EXPECT_EQ(r.verified_dimension, -1);
   EXPECT_NE(r.summary().find("rank 2/4, nullity 2"), std::string::npos) << r.summary();
+}
+
+// A tall matrix (m = 2n - 2, the contact bar's shape) with known singular values: J = U S V^T
+// from orthonormal U, V (QR of fixed pseudo-random matrices), two of the values zero.
+TEST(RankReport, TallMatrixHasItsKnownSingularValuesAndNullSpace) {
+  const int n = 41, m = 2 * n - 2;
+  std::srand(3);
+  const Matrix U = Eigen::HouseholderQR<Matrix>(Matrix::Random(m, m)).householderQ();
+  const Matrix V = Eigen::HouseholderQR<Matrix>(Matrix::Random(n, n)).householderQ();
+  Vector s(n);
+  for (int i = 0; i < n; ++i) s[i] = i < n - 2 ? std::pow(10.0, -6.0 * i / (n - 3)) : 0.0;
+  const Matrix J = U.leftCols(n) * s.asDiagonal() * V.transpose();
+  const RankReport r = rank_report(J, RankOptions{});  // threshold 1e-8, sigma_{n-2} = 1e-6
+  EXPECT_EQ(r.rank, n - 2);
+  EXPECT_EQ(r.nullity, 2);
+  // A backward-stable SVD of J (rounded from U S V^T with ||J|| = 1): every value within a
+  // small multiple of eps ||J|| of the exact one (measured 1e-15; 1e-14 leaves a margin).
+  ASSERT_EQ(r.singular_values.size(), n);
+  for (int i = 0; i < n; ++i) EXPECT_NEAR(r.singular_values[i], s[i], 1e-14) << i;
+  // The null space is span of V's last two columns: the projectors agree to eps / gap, the
+  // gap being sigma_{n-2} = 1e-6 (1e-9 allows the eps ||J|| / gap perturbation bound).
+  const Matrix& N = r.null_directions;
+  ASSERT_EQ(N.rows(), n);
+  ASSERT_EQ(N.cols(), 2);
+  EXPECT_LT((N.transpose() * N - Matrix::Identity(2, 2)).norm(), 1e-14);
+  const Matrix exact = V.rightCols(2) * V.rightCols(2).transpose();
+  EXPECT_LT((N * N.transpose() - exact).norm(), 1e-9);
 }
 
 TEST(RankReport, ThresholdIsRelative) {
