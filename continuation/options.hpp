@@ -78,6 +78,11 @@ struct ContinuationOptions {
   double grow_factor = 1.5;    // > 1
   double shrink_factor = 0.5;  // in (0, 1); also used after a failed correction
   int max_points = 100;        // including the first (corrected guess)
+  // Pseudo-arclength: each correction starts with chord steps on the factorization of the
+  // previous point's Jacobian (bordered with the step direction), and each verification probe
+  // with chord steps on the probed point's Jacobian; a fresh Jacobian only when a chord step
+  // contracts too slowly (core/newton.hpp). The answer is judged by F alone.
+  bool chord_corrections = true;
   // Both loops in z = x ./ typical_scale() (see scaled_problem.hpp): pseudo-arclength's ds and
   // both arclength columns in those units, natural steps of an unknown in units of its typical
   // scale; false: raw unknowns.

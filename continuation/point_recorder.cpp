@@ -30,17 +30,20 @@ void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_dir
   core::Matrix J;
   if (problem_.jacobian(point.x, J) != core::EvalStatus::ok) return;
   core::RankReport report = core::rank_report(J, options_.rank);
+  const core::Matrix* nearby = options_.chord_corrections ? &J : nullptr;
   if (verifier_) {
-    core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, report);
+    core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, report,
+                                 nearby);
     point.dimension = report.verified_dimension;
   } else {
     point.dimension = report.nullity;
   }
   point.rank = std::move(report);
-  recheck_dimension(point, curve_direction);
+  recheck_dimension(point, curve_direction, nearby);
 }
 
-void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& curve_direction) {
+void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,
+                                      const core::Matrix* jacobian) {
   if (!verifier_ || !point.rank || point.rank->verified_dimension < 0 || point.dimension >= 1)
     return;
   point.dimension_flag = DimensionFlag::unconfirmed;
@@ -48,7 +51,8 @@ void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& cu
   if (curve_direction.size() != point.x.size() || !(norm > 0) || !std::isfinite(norm)) return;
   core::RankReport along;
   along.null_directions = curve_direction / norm;
-  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, along);
+  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, along,
+                               jacobian);
   if (along.verified_dimension != 1) return;
   // The curve is there. The rest of the candidate null space, orthogonal to it: the columns of
   // an orthonormal basis of span(D) after the curve direction's component in it.
@@ -63,7 +67,8 @@ void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& cu
   const core::Matrix Q = qr.householderQ();
   core::RankReport others;
   others.null_directions = D * Q.rightCols(k - 1);
-  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, others);
+  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, others,
+                               jacobian);
   point.dimension += std::max(others.verified_dimension, 0);
 }
 

@@ -44,7 +44,10 @@ class PointRecorder {
   // With a verified dimension below 1 and a verifier: probes curve_direction; when it is real,
   // the dimension is 1 plus the verified candidate directions orthogonal to it (flag
   // rechecked), else the flag says unconfirmed. Nothing happens at a point of dimension >= 1.
-  void recheck_dimension(BranchPoint& point, const core::Vector& curve_direction);
+  // jacobian: J at point.x when the caller has it (the probes then start with chord steps on
+  // it, ContinuationOptions::chord_corrections).
+  void recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,
+                         const core::Matrix* jacobian = nullptr);
   // First bound the point violates, or nullptr; `value` receives the bound value crossed.
   const Bound* violated_bound(const BranchPoint& point, double& value) const;
   double elapsed_seconds() const;

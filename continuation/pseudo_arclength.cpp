@@ -67,6 +67,32 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
   if (options.branch_points.detect) detector.emplace(problem, options, hooks, corrector);
   core::Vector x, tangent, previous;
   core::Matrix J;
+  // Chord corrections (options.chord_corrections): the Jacobian at x in the units of x, which
+  // the next correction starts from, and where (the problem's unknowns) it was computed. The
+  // same point's Jacobian, not a new one: ScaledProblem keeps the base's Jacobian per point.
+  core::Matrix nearby, nearby_base;  // in the units of x; the base's
+  core::Vector nearby_at;
+  // Corrections since the last whose chord steps on the nearby Jacobian helped: after two
+  // misses the chord is tried only every eighth point. Measured on the contact bar's mode 1
+  // below E = 5e-3: the tangent predictor's residual is 2e-2 to 0.5 and a chord step on J(x_k)
+  // does not reduce it even at ds = 0.02 (the contact structure moves the Jacobian), so each
+  // try costs a factorization and a residual for nothing; at high energy it pays.
+  int chord_misses = 0;
+  // The base's Jacobian at nearby_at (a copy right after J was computed there).
+  const auto keep_base = [&]() {
+    if (nearby_at.size() == 0 ||
+        problem.base_jacobian(nearby_at, nearby_base) != core::EvalStatus::ok) {
+      nearby_at.resize(0);
+      nearby_base.resize(0, 0);
+    }
+  };
+  // It in the units just adopted.
+  const auto take_nearby = [&]() {
+    if (nearby_base.size() > 0)
+      nearby = problem.in_current_units(nearby_base);
+    else
+      nearby.resize(0, 0);
+  };
   double ds = options.ds;
   // Units that follow the point (scaled_problem.hpp, LocalScale): after each point the units
   // are those of that point, factor = local_factor_at(x). The first point (or a resumed one)
@@ -96,6 +122,10 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
     steps.resume(*from, record_from);
     adopt_units_of(*from);
     ds = from->ds;
+    if (options.chord_corrections) nearby_at = from->jacobian_point;
+    chord_misses = from->chord_misses;
+    keep_base();
+    take_nearby();
     if (detector) {
       // The detector is restored as it was before the saved point was added, then the point is
       // added again from its Jacobian (the same bits: the same z).
@@ -123,11 +153,14 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
                                    start.index, steps.describe(x)));
     }
     if (options.start_along_direction) tangent = hint;
+    if (options.chord_corrections) nearby_at = problem.to_unknowns(x);
+    keep_base();
     auto state = std::make_shared<LoopState>();
     state->method = Method::arclength;
     state->z = x;
     state->tangent = tangent;
     state->ds = ds;
+    state->jacobian_point = nearby_at;
     const std::shared_ptr<const LoopState> first_state = state;
     steps.report_first(std::move(state));
     if (detector) {
@@ -135,6 +168,7 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
       for (BranchPointReport& report : detector->take()) steps.add_branch_point(std::move(report));
     }
     adopt_units_of(*first_state);
+    take_nearby();
   }
   core::BorderedSystem system(problem, {core::BorderRow::linear(tangent, x, 0.0, "arclength")});
   // Passing an attached family: a correction that turns away from the predictor direction by
@@ -152,13 +186,18 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
     }
     system.set_anchor(0, x);
     system.set_direction(0, step_direction);
+    core::Matrix bordered_nearby;
+    const bool try_chord = nearby.size() > 0 && (chord_misses < 2 || chord_misses % 8 == 0);
+    if (try_chord && system.jacobian_with_base(x, nearby, bordered_nearby) != core::EvalStatus::ok)
+      bordered_nearby.resize(0, 0);
     core::Vector y;
     const CorrectedStep corrected = steps.correct(
         ds, y,
         [&](double ds_try, core::Vector& predicted) {
           predicted = x + ds_try * step_direction;
           system.set_value(0, ds_try);
-          return corrector.solve(system, predicted);
+          return bordered_nearby.size() > 0 ? corrector.solve(system, predicted, bordered_nearby)
+                                            : corrector.solve(system, predicted);
         },
         [&](const core::Vector& corrected_point) {
           if (max_turn <= 0) return std::string();
@@ -182,8 +221,14 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
                       index, options.ds_min, steps.describe(x),
                       core::to_string(corrected.last_failure), corrected.last_message));
     const int iterations = corrected.summary.iterations;
+    chord_misses =
+        bordered_nearby.size() > 0 && corrected.summary.chord_steps > 0 ? 0 : chord_misses + 1;
     core::Vector next_tangent;
     core::EvalStatus tangent_status = problem.jacobian(y, J);
+    nearby_at = options.chord_corrections && tangent_status == core::EvalStatus::ok
+                    ? problem.to_unknowns(y)
+                    : core::Vector();
+    keep_base();
     if (tangent_status == core::EvalStatus::ok)
       tangent_status = tangent_from_jacobian(J, step_direction, threshold, next_tangent);
     // A tangent that turns from the accepted chord x -> y by more than max_turn_degrees
@@ -211,7 +256,9 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
       state->z = in_unit_scale(y);
       state->tangent = in_unit_scale(next_tangent);
       if (options.predictor == Predictor::secant) state->previous = in_unit_scale(x);
-      state->ds = adapted_step(ds, iterations, options);
+      state->jacobian_point = nearby_at;
+      state->chord_misses = chord_misses;
+      state->ds = adapted_step(ds, corrected.summary.equivalent_iterations(), options);
       if (detector) {
         state->samples = detector->samples();
         state->jacobian_scale = detector->jacobian_scale();
@@ -231,11 +278,13 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
     ds = state->ds;
     if (follow_scale) {
       adopt_units_of(*state);
+      take_nearby();
       continue;
     }
     if (options.predictor == Predictor::secant) previous = x;
     x = y;
     tangent = next_tangent;
+    take_nearby();
   }
   return steps.take();
 }

@@ -52,6 +52,7 @@ class StateReader {
     if (it == fields_.end()) fail(fmt::format("the loop state has no '{}'", name));
     return it->second;
   }
+  bool has(const std::string& name) const { return fields_.count(name) > 0; }
   double value(const std::string& name) const { return parse(text(name), name); }
   int whole(const std::string& name) const {
     const double v = value(name);
@@ -88,10 +89,12 @@ class StateReader {
 std::string format_state(const LoopState& s) {
   std::string line = fmt::format(
       "method={} index={} arclength={} ds={} lambda={} previous_step={} switch_index={} "
-      "jacobian_scale={} scale={} z={} tangent={} previous={} samples={}",
+      "jacobian_scale={} scale={} z={} tangent={} previous={} jacobian_point={} chord_misses={} "
+      "samples={}",
       to_string(s.method), s.index, number(s.arclength), number(s.ds), number(s.lambda),
       number(s.previous_step), s.switch_index, number(s.jacobian_scale), numbers(s.scale),
-      numbers(s.z), numbers(s.tangent), numbers(s.previous), s.samples.size());
+      numbers(s.z), numbers(s.tangent), numbers(s.previous), numbers(s.jacobian_point),
+      s.chord_misses, s.samples.size());
   for (std::size_t k = 0; k < s.samples.size(); ++k) {
     const TestFunctionSample& a = s.samples[k];
     line += fmt::format(
@@ -121,6 +124,10 @@ LoopState parse_state(const std::string& line, const std::string& key, const std
   s.z = in.vector("z");
   s.tangent = in.vector("tangent");
   s.previous = in.vector("previous");
+  // Absent from states written before chord corrections: the first step then corrects with a
+  // fresh Jacobian.
+  if (in.has("jacobian_point")) s.jacobian_point = in.vector("jacobian_point");
+  if (in.has("chord_misses")) s.chord_misses = in.whole("chord_misses");
   const int samples = in.whole("samples");
   if (samples < 0 || samples > 3) in.fail(fmt::format("{} detector samples (at most 3)", samples));
   for (int k = 0; k < samples; ++k) {
@@ -140,6 +147,7 @@ LoopState parse_state(const std::string& line, const std::string& key, const std
   const bool sizes_agree =
       n > 0 && s.scale.size() == n && (s.tangent.size() == n || s.tangent.size() == 0) &&
       (s.previous.size() == n || s.previous.size() == 0) &&
+      (s.jacobian_point.size() == n || s.jacobian_point.size() == 0) &&
       std::all_of(s.samples.begin(), s.samples.end(), [&](const TestFunctionSample& a) {
         return a.z.size() == n && a.tangent.size() == n && a.tau.right.size() == n;
       });

@@ -47,9 +47,14 @@ struct LoopState {
   // ScaledProblem::scale() of the run (z = x ./ scale): a state is taken up only by a run with
   // the same scale, bit for bit (same scene and grid); x = z .* scale.
   core::Vector scale;
-  core::Vector z;             // the point, scaled unknowns
-  core::Vector tangent;       // arclength: unit tangent at z, oriented along the branch
-  core::Vector previous;      // the point before z (secant predictors); empty when unused
+  core::Vector z;         // the point, scaled unknowns
+  core::Vector tangent;   // arclength: unit tangent at z, oriented along the branch
+  core::Vector previous;  // the point before z (secant predictors); empty when unused
+  // Arclength with chord corrections: the problem's unknowns (not z) where the Jacobian the
+  // next correction starts from was computed; empty: a fresh Jacobian (scaled_problem.hpp,
+  // jacobian_at_unknowns).
+  core::Vector jacobian_point;
+  int chord_misses = 0;       // corrections since a chord on it last helped (pseudo_arclength.cpp)
   double ds = 0;              // the step the next point is tried with
   double lambda = 0;          // natural: the parameter's value at z (its row's value)
   double previous_step = 0;   // natural: the parameter step that reached z (0: none)

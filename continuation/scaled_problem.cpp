@@ -56,8 +56,6 @@ void ScaledProblem::set_factor(const core::Vector& factor, const core::Vector& r
     check_positive("residual_factor", residual_factor, num_equations());
   scale_ = unit_scale_.cwiseProduct(factor);
   residual_factor_ = residual_factor;
-  const std::lock_guard<std::mutex> lock(cache_mutex_);
-  cached_z_.resize(0);
 }
 
 core::EvalStatus ScaledProblem::compute_residual(const core::Vector& z, core::Vector& r) const {
@@ -68,22 +66,32 @@ core::EvalStatus ScaledProblem::compute_residual(const core::Vector& z, core::Ve
 }
 
 core::EvalStatus ScaledProblem::compute_jacobian(const core::Vector& z, core::Matrix& J) const {
+  const core::EvalStatus s = base_jacobian(to_unknowns(z), J);
+  if (s == core::EvalStatus::ok) J = in_current_units(J);
+  return s;
+}
+
+core::EvalStatus ScaledProblem::base_jacobian(const core::Vector& x, core::Matrix& J_x) const {
   {
     const std::lock_guard<std::mutex> lock(cache_mutex_);
     // Exact equality: the same point, so the base would return the same matrix.
-    if (cached_z_.size() == z.size() && cached_z_ == z) {
-      J = cached_jacobian_;
+    if (cached_x_.size() == x.size() && cached_x_ == x) {
+      J_x = cached_base_jacobian_;
       return core::EvalStatus::ok;
     }
   }
-  const core::EvalStatus s = base_.jacobian(to_unknowns(z), J);
+  const core::EvalStatus s = base_.jacobian(x, J_x);
   if (s != core::EvalStatus::ok) return s;
-  J = J * scale_.asDiagonal();
-  if (residual_factor_.size() > 0) J = residual_factor_.cwiseInverse().asDiagonal() * J;
   const std::lock_guard<std::mutex> lock(cache_mutex_);
-  cached_z_ = z;
-  cached_jacobian_ = J;
+  cached_x_ = x;
+  cached_base_jacobian_ = J_x;
   return s;
+}
+
+core::Matrix ScaledProblem::in_current_units(const core::Matrix& J_x) const {
+  core::Matrix J = J_x * scale_.asDiagonal();
+  if (residual_factor_.size() > 0) J = residual_factor_.cwiseInverse().asDiagonal() * J;
+  return J;
 }
 
 }  // namespace backbone::continuation

@@ -86,12 +86,18 @@ class ScaledProblem : public core::Problem {
   core::Vector local_factor_at(const core::Vector& x) const;
   // The same for the equations (empty without LocalScale or a residual factor).
   core::Vector local_residual_factor_at(const core::Vector& x) const;
-  // Units s ./ w .* factor from now on, F divided by residual_factor (empty: as the base's);
-  // the cached Jacobian is dropped.
+  // Units s ./ w .* factor from now on, F divided by residual_factor (empty: as the base's).
   void set_factor(const core::Vector& factor, const core::Vector& residual_factor = {});
   // The residual factor set last (empty: none), e.g. to convert a Jacobian back to the unit
   // scale: J_unit = diag(residual_factor) J_z diag(1 ./ factor).
   const core::Vector& residual_factor() const { return residual_factor_; }
+  // The base's Jacobian J_x at its unknowns x (not z), a copy when x is the last point asked
+  // for in any units, and J_x in the units set now: diag(1 ./ residual factor) J_x diag(scale()),
+  // what jacobian(z) returns. A point's Jacobian carried into the next point's units (the
+  // nearby Jacobian of its chord correction, continuation/README.md 'Chord corrections') is
+  // thus the same bits in an uninterrupted and in a resumed run.
+  core::EvalStatus base_jacobian(const core::Vector& x, core::Matrix& J_x) const;
+  core::Matrix in_current_units(const core::Matrix& J_x) const;
   const core::Problem& base() const { return base_; }
 
  protected:
@@ -107,8 +113,8 @@ class ScaledProblem : public core::Problem {
   core::Vector scale_;
   core::Vector residual_factor_;    // empty: F as the base's
   mutable std::mutex cache_mutex_;  // compute_jacobian may be called from several threads
-  mutable core::Vector cached_z_;   // empty: nothing cached
-  mutable core::Matrix cached_jacobian_;
+  mutable core::Vector cached_x_;   // the base's unknowns; empty: nothing cached
+  mutable core::Matrix cached_base_jacobian_;
 };
 
 }  // namespace backbone::continuation

@@ -68,6 +68,9 @@ po::options_description continuation_keys(const po::options_description& problem
   add("newton_reuse_jacobian", po::value<bool>()->default_value(false),
       "eigen corrector: after a fresh Jacobian, take chord steps on its factorization while each "
       "cuts ||F|| tenfold (one residual each), else a fresh Jacobian");
+  add("chord_corrections", po::value<bool>()->default_value(true),
+      "arclength: start each correction (and each rank-verification probe) with chord steps on "
+      "the previous point's Jacobian, a fresh Jacobian only when they contract too slowly");
   add("natural_parameter", po::value<std::string>()->default_value("period"),
       "natural method: the period unknown or an observable name");
   add("natural_direction", po::value<long>()->default_value(1), "natural method: +1 or -1");
@@ -150,6 +153,7 @@ RunSettings read_run_settings(const core::Scene& scene) {
       std::max(o.verification.residual_tolerance, run.newton_options.residual_tolerance);
   run.newton_options.max_iterations = static_cast<int>(scene.integer("newton_max_iterations", 1));
   run.newton_options.reuse_jacobian = scene.flag("newton_reuse_jacobian");
+  o.chord_corrections = scene.flag("chord_corrections");
   run.formulation = core::parse_formulation(scene.text("formulation"));
   run.natural_parameter = scene.text("natural_parameter");
   const long direction = scene.integer("natural_direction", -1);

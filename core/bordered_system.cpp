@@ -146,6 +146,18 @@ EvalStatus BorderedSystem::compute_jacobian(const Vector& x, Matrix& J) const {
   Matrix base_jacobian;
   const EvalStatus s = base_.jacobian(x, base_jacobian);
   if (s != EvalStatus::ok) return s;
+  return jacobian_with_base(x, base_jacobian, J);
+}
+
+EvalStatus BorderedSystem::jacobian_with_base(const Vector& x, const Matrix& base_jacobian,
+                                              Matrix& J) const {
+  if (base_jacobian.rows() != base_.num_equations() || base_jacobian.cols() != num_unknowns() ||
+      x.size() != num_unknowns())
+    throw InputError("bordered_system",
+                     fmt::format("jacobian_with_base: a {} x {} base Jacobian at a point of {} "
+                                 "entries, the base has {} equations and {} unknowns",
+                                 base_jacobian.rows(), base_jacobian.cols(), x.size(),
+                                 base_.num_equations(), num_unknowns()));
   const Eigen::Index m = base_jacobian.rows();
   const Eigen::Index n = base_jacobian.cols();
   J.resize(m + num_rows(), n);

@@ -72,6 +72,9 @@ class BorderedSystem : public Problem {
   void set_direction(int i, Vector direction);
   // Divisor of row i: 1 for a linear row, |value| (1 when 0 or not finite) for an observable.
   double row_scale(int i) const;
+  // This system's Jacobian at x assembled on a given Jacobian of the base (at x or near it:
+  // the nearby Jacobian of a chord correction, newton.hpp), the rows' gradients at x.
+  EvalStatus jacobian_with_base(const Vector& x, const Matrix& base_jacobian, Matrix& J) const;
 
  protected:
   // An observable row that cannot be evaluated (observable not reported, NaN) gives failed.

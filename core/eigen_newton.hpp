@@ -1,8 +1,8 @@
 // Dense Gauss-Newton corrector with Moore-Penrose minimum-norm steps (backend "eigen").
 //
-// Each iteration solves J dx = -F in the minimum-norm least-squares sense through a singular
-// value decomposition of the m x n Jacobian, singular values below rank_cutoff * sigma_max
-// being treated as zero. It therefore works unchanged for square, under-determined (m < n:
+// Each iteration solves J dx = -F in the minimum-norm least-squares sense through a complete
+// orthogonal decomposition of the m x n Jacobian, pivots below rank_cutoff * |R_11| being
+// treated as zero. It therefore works unchanged for square, under-determined (m < n:
 // the step is the shortest one onto the linearised solution set) and rank-deficient systems.
 // With line_search, the step is halved until ||F||_2 decreases sufficiently (Armijo, c = 1e-4).
 // Numerical failure is a status in the summary; bad options throw at construction.
@@ -25,9 +25,12 @@ class EigenNewton : public Corrector {
   explicit EigenNewton(const NewtonOptions& options);  // validates: throws InputError
   std::string name() const override { return "eigen"; }
   NewtonSummary solve(const Problem& problem, Vector& x) override;
+  // Chord steps on nearby_jacobian's factorization first (newton.hpp).
+  NewtonSummary solve(const Problem& problem, Vector& x, const Matrix& nearby_jacobian) override;
   const NewtonOptions& options() const { return options_; }
 
  private:
+  NewtonSummary solve_from(const Problem& problem, Vector& x, const Matrix* nearby_jacobian);
   NewtonOptions options_;
 };
 

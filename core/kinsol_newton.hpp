@@ -25,6 +25,7 @@ class KinsolNewton : public Corrector {
  public:
   explicit KinsolNewton(const NewtonOptions& options);  // validates: throws InputError
   std::string name() const override { return "kinsol"; }
+  using Corrector::solve;  // the nearby Jacobian is ignored: KINSOL forms its own
   NewtonSummary solve(const Problem& problem, Vector& x) override;
   const NewtonOptions& options() const { return options_; }
 

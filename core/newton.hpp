@@ -31,7 +31,8 @@ struct NewtonOptions {
   double rank_cutoff = 1e-12;
   // Eigen backend: after an iteration with a fresh Jacobian, try the next steps with its
   // factorization (chord steps, one residual each) and keep a chord step when it reduces
-  // ||F||_2 by at least 1 / reuse_contraction; else compute a fresh Jacobian at once.
+  // ||F||_2 by at least 1 / reuse_contraction (or by half when six more steps at its rate
+  // would reach residual_tolerance); else compute a fresh Jacobian at once.
   bool reuse_jacobian = false;
   double reuse_contraction = 0.1;  // in (0, 1)
   void validate() const;  // throws InputError naming the field, e.g. "newton.max_iterations"
@@ -53,12 +54,22 @@ struct NewtonSummary {
   std::vector<double> residual_history;  // ||F||_inf at the start and after each iteration
   long residual_evaluations = 0;
   long jacobian_evaluations = 0;
+  // Of `iterations`, those that used an earlier factorization (chord steps, one residual each)
+  // instead of a fresh Jacobian.
+  int chord_steps = 0;
   double seconds = 0;
   std::string message;  // backend's own words (KINSOL's flag text) plus context
   bool converged() const { return status == NewtonStatus::converged; }
   double final_residual() const {
     return residual_history.empty() ? -1.0 : residual_history.back();
   }
+  // The iterations a step-size rule should see: each fresh-Jacobian iteration counts one, and
+  // every four chord steps count one. A chord step contracts ||F|| by at least 1 /
+  // reuse_contraction (10x by default) where a Newton step near the solution squares it: a
+  // correction from 1e-4 to 1e-12 takes 2-3 Newton iterations or 8 chord steps, so a pure
+  // chord correction of up to 12 steps still reads as a fast one (continuation/README.md,
+  // 'Chord corrections').
+  int equivalent_iterations() const { return iterations - chord_steps + (chord_steps + 3) / 4; }
 };
 
 class Corrector {
@@ -67,6 +78,15 @@ class Corrector {
   virtual std::string name() const = 0;
   // Solves problem(x) = 0 starting from x; x holds the last iterate on return.
   virtual NewtonSummary solve(const Problem& problem, Vector& x) = 0;
+  // The same, given a Jacobian of `problem` at a nearby point (a branch's previous point, the
+  // point a probe steps from): a backend with chord steps starts with its factorization and
+  // computes a fresh Jacobian only once a chord step contracts ||F||_2 by less than
+  // 1 / reuse_contraction. The answer is judged by F alone, so a poor nearby Jacobian costs
+  // one residual, never accuracy. The default ignores it.
+  virtual NewtonSummary solve(const Problem& problem, Vector& x, const Matrix& nearby_jacobian) {
+    (void)nearby_jacobian;
+    return solve(problem, x);
+  }
 };
 
 // Bookkeeping shared by every corrector: from construction on, counts the problem's

@@ -92,12 +92,16 @@ struct Probe {
 
 // Steps from x by h along d, re-corrects on the hyperplane through the stepped point.
 Probe probe(const Problem& problem, const Vector& x, const Vector& d, double h,
-            Corrector& corrector, const VerifyOptions& options) {
+            Corrector& corrector, const VerifyOptions& options, const Matrix* jacobian_at_x) {
   Probe result;
   const Vector stepped = x + h * d;
   const BorderedSystem constrained(problem, {BorderRow::hyperplane(d, stepped)});
   Vector y = stepped;
-  const NewtonSummary s = corrector.solve(constrained, y);
+  Matrix nearby;
+  const NewtonSummary s = jacobian_at_x && constrained.jacobian_with_base(stepped, *jacobian_at_x,
+                                                                          nearby) == EvalStatus::ok
+                              ? corrector.solve(constrained, y, nearby)
+                              : corrector.solve(constrained, y);
   if (!y.allFinite()) return result;
   Vector f;
   // Judge the corrected point by F itself (the corrector's own tolerance may be looser).
@@ -118,17 +122,19 @@ bool found_neighbour(const Probe& p, const VerifyOptions& options) {
 // Probes along +d, and along -d when +d finds no neighbour: at a point on the boundary of a
 // manifold (a grazing limit of a continuum) only one side holds solutions.
 Probe probe_either_side(const Problem& problem, const Vector& x, const Vector& d, double h,
-                        Corrector& corrector, const VerifyOptions& options) {
-  Probe forward = probe(problem, x, d, h, corrector, options);
+                        Corrector& corrector, const VerifyOptions& options,
+                        const Matrix* jacobian_at_x) {
+  Probe forward = probe(problem, x, d, h, corrector, options, jacobian_at_x);
   if (found_neighbour(forward, options)) return forward;
-  Probe backward = probe(problem, x, d, -h, corrector, options);
+  Probe backward = probe(problem, x, d, -h, corrector, options, jacobian_at_x);
   return found_neighbour(backward, options) ? backward : forward;
 }
 
 }  // namespace
 
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
-                            const VerifyOptions& options, RankReport& report) {
+                            const VerifyOptions& options, RankReport& report,
+                            const Matrix* jacobian_at_x) {
   options.validate();
   const int n = problem.num_unknowns();
   if (x.size() != n || report.null_directions.rows() != n)
@@ -153,7 +159,8 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
   bool all_verified = true;
   for (int i = 0; i < k; ++i) {
     auto& p = first[static_cast<std::size_t>(i)];
-    p = probe_either_side(problem, x, D.col(i), step_along(D.col(i)), corrector, options);
+    p = probe_either_side(problem, x, D.col(i), step_along(D.col(i)), corrector, options,
+                          jacobian_at_x);
     all_verified = all_verified && found_neighbour(p, options);
   }
   if (all_verified) {
@@ -181,8 +188,8 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
   }
   int verified = 0;
   for (int i = 0; i < k; ++i) {
-    const Probe p =
-        probe_either_side(problem, x, D.col(i), step_along(D.col(i)), corrector, options);
+    const Probe p = probe_either_side(problem, x, D.col(i), step_along(D.col(i)), corrector,
+                                      options, jacobian_at_x);
     const bool real = found_neighbour(p, options);
     report.direction_verified[static_cast<std::size_t>(i)] = real;
     verified += real ? 1 : 0;

@@ -82,8 +82,12 @@ RankReport rank_report(const Matrix& J, const RankOptions& options);
 // because the SVD basis need not be aligned with the solution set (J = 0 at a double root):
 // null_directions is then replaced by the rotated basis, and direction_verified refers to it.
 // The corrector must handle m + 1 equations in n unknowns: KINSOL only when m + 1 == n.
+// jacobian_at_x (J of problem at x, when the caller has it) starts every probe's correction
+// with chord steps on its factorization (core/newton.hpp): a probe steps by `step`, so J(x) is
+// as good as a fresh one there, and a probe costs a few residuals instead of a Jacobian.
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
-                            const VerifyOptions& options, RankReport& report);
+                            const VerifyOptions& options, RankReport& report,
+                            const Matrix* jacobian_at_x = nullptr);
 
 // The candidates where J(x) cannot give them: at a point where F is not differentiable (the
 // grazing limit of a contact family, where a contact phase vanishes, forward differences mix

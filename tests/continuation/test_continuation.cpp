@@ -540,6 +540,36 @@ class WeightedCircle : public core::Problem {
 
 }  // namespace
 
+// Chord corrections (continuation/README.md 'Chord corrections') change the cost, not the
+// curve: on the unit circle at ds 0.05 a chord step on the previous point's Jacobian contracts
+// by about ds * curvature = 0.05, so every correction is chord steps only and the points are
+// the ones a fresh-Jacobian run finds, within the Newton tolerance (|F| <= 1e-10 and
+// |grad F| = 2: 5e-11 from the curve each, 1e-9 allows the difference to accumulate along the
+// arclength). Each point then costs one Jacobian (its tangent) instead of one per iteration.
+TEST(PseudoArclength, ChordCorrectionsGiveTheSameCurveWithFewerJacobians) {
+  const WeightedCircle circle(vec(1, 1));
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(30);
+  opt.ds = opt.ds_max = 0.05;
+  opt.chord_corrections = false;
+  const long fresh_before = circle.counters().jacobians;
+  const Branch fresh = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  const long fresh_jacobians = circle.counters().jacobians - fresh_before;
+  opt.chord_corrections = true;
+  const long chord_before = circle.counters().jacobians;
+  const Branch chord = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  const long chord_jacobians = circle.counters().jacobians - chord_before;
+  ASSERT_EQ(fresh.points.size(), 30u) << fresh.message;
+  ASSERT_EQ(chord.points.size(), 30u) << chord.message;
+  for (std::size_t i = 0; i < fresh.points.size(); ++i) {
+    EXPECT_NEAR((fresh.points[i].x - chord.points[i].x).norm(), 0, 1e-9) << i;
+    EXPECT_NEAR(chord.points[i].x.norm(), 1, 1e-10) << i;
+  }
+  EXPECT_LT(chord_jacobians, fresh_jacobians);
+  // One per point (tangent; the rank report reuses it) beyond the first point's correction.
+  EXPECT_LE(chord_jacobians, 30 + 5);
+}
+
 // Step weights change the norm, not the problem: with weights 2 a step of 0.1 is a step of 0.05
 // with weights 1, so both runs visit the same points and the weighted arclength is twice the
 // other. Not bit for bit: the bordered residual [F; arclength row] is not scaled uniformly, so

@@ -96,6 +96,8 @@ TEST(LoopState, TextFormReadsBackBitForBit) {
   s.scale = vec(1e-300, 7.0 / 3.0);
   s.z = vec(std::nextafter(1.0, 2.0), -1e-310);
   s.tangent = vec(0.6, -0.8);
+  s.jacobian_point = vec(-2.0 / 3.0, 1e300);
+  s.chord_misses = 11;
   continuation::TestFunctionSample a;
   a.index = 16;
   a.s = 2.0 / 7.0;
@@ -119,6 +121,8 @@ TEST(LoopState, TextFormReadsBackBitForBit) {
   EXPECT_EQ(b.switch_index, 9);
   EXPECT_TRUE(b.scale == s.scale && b.z == s.z && b.tangent == s.tangent);
   EXPECT_EQ(b.previous.size(), 0);
+  EXPECT_TRUE(b.jacobian_point == s.jacobian_point);
+  EXPECT_EQ(b.chord_misses, 11);
   ASSERT_EQ(b.samples.size(), 2u);
   EXPECT_EQ(b.samples[1].index, 16);
   EXPECT_EQ(b.samples[1].s, a.s);
@@ -126,6 +130,28 @@ TEST(LoopState, TextFormReadsBackBitForBit) {
   EXPECT_FALSE(b.samples[1].tau.continued);
   EXPECT_TRUE(b.samples[1].tau.left == a.tau.left && b.samples[1].tau.right == a.tau.right);
   EXPECT_TRUE(b.samples[1].z == a.z && b.samples[1].tangent == a.tangent);
+}
+
+// A state written before chord corrections (no jacobian_point, no chord_misses) still reads:
+// the next correction then starts with a fresh Jacobian.
+TEST(LoopState, StateWithoutTheChordFieldsReads) {
+  LoopState s;
+  s.z = vec(1, 2);
+  s.scale = vec(1, 1);
+  s.tangent = vec(1, 0);
+  s.ds = 0.1;
+  s.jacobian_point = vec(3, 4);
+  s.chord_misses = 5;
+  std::string line = continuation::format_state(s);
+  for (const std::string field : {" jacobian_point=3,4", " chord_misses=5"}) {
+    const auto at = line.find(field);
+    ASSERT_NE(at, std::string::npos) << line;
+    line.erase(at, field.size());
+  }
+  const LoopState b = continuation::parse_state(line, "resume", "test");
+  EXPECT_EQ(b.jacobian_point.size(), 0);
+  EXPECT_EQ(b.chord_misses, 0);
+  EXPECT_TRUE(b.z == s.z);
 }
 
 TEST(LoopState, DefectsAreInputErrorsNamingTheKey) {
@@ -138,7 +164,7 @@ TEST(LoopState, DefectsAreInputErrorsNamingTheKey) {
   EXPECT_NO_THROW(continuation::parse_state(good, "resume", "test"));
   for (const std::string& bad :
        {std::string("method=arclength"), good + " z=1,x", good + " tangent=1", good + " ds=0",
-        good + " samples=4", good + " junk"}) {
+        good + " samples=4", good + " junk", good + " jacobian_point=1,2,3"}) {
     try {
       continuation::parse_state(bad, "resume", "test");
       ADD_FAILURE() << bad;

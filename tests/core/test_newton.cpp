@@ -268,5 +268,83 @@ TEST(EigenNewton, ZeroJacobianWithoutRootStalls) {
   EXPECT_EQ(s.iterations, 1);
 }
 
+// Chord steps on a nearby Jacobian (newton.hpp, Corrector::solve with nearby_jacobian).
+
+TEST(EigenNewton, NearbyJacobianGivesChordStepsAndTheSameRoot) {
+  // Circle-line from (0.8, 0.6): the exact Jacobian at the root (sqrt(1/2), sqrt(1/2)) is the
+  // nearby one. Chord steps contract by |J(root)^-1 (J(x) - J(root))| ~ |x - root| ~ 0.01
+  // per step, so the solve needs no fresh Jacobian; the root is the same to 1e-13 (the
+  // tolerance 1e-14 on F, whose Jacobian is O(1) here).
+  NewtonOptions o;
+  o.residual_tolerance = 1e-14;
+  EigenNewton newton(o);
+  CircleLine p;
+  const double r = std::sqrt(0.5);
+  Matrix at_root(2, 2);
+  at_root << 2 * r, 2 * r, -1, 1;
+  Vector x(2);
+  x << 0.72, 0.70;
+  const long jacobians_before = p.counters().jacobians;
+  const NewtonSummary s = newton.solve(p, x, at_root);
+  ASSERT_TRUE(s.converged()) << s.message;
+  EXPECT_NEAR(x[0], r, 1e-13);
+  EXPECT_NEAR(x[1], r, 1e-13);
+  EXPECT_GT(s.chord_steps, 0);
+  EXPECT_EQ(s.chord_steps, s.iterations);
+  EXPECT_EQ(p.counters().jacobians, jacobians_before);
+  // Each chord step counts a quarter for the step control.
+  EXPECT_EQ(s.equivalent_iterations(), (s.chord_steps + 3) / 4);
+}
+
+TEST(EigenNewton, APoorNearbyJacobianCostsOneResidualNotTheAnswer) {
+  // A nearby Jacobian with the wrong sign of a row: the first chord step grows ||F||, so the
+  // solve takes a fresh Jacobian at once and converges quadratically to the same root as a
+  // solve without one.
+  NewtonOptions o;
+  o.residual_tolerance = 1e-14;
+  EigenNewton newton(o);
+  CircleLine p;
+  Matrix wrong(2, 2);
+  wrong << 2.0, 2.0, 1.0, -1.0;
+  Vector x(2), plain(2);
+  x << 3.0, 0.2;
+  plain = x;
+  const NewtonSummary seeded = newton.solve(p, x, wrong);
+  const NewtonSummary fresh = newton.solve(p, plain);
+  ASSERT_TRUE(seeded.converged()) << seeded.message;
+  EXPECT_EQ(seeded.chord_steps, 0);
+  EXPECT_NEAR(x[0], plain[0], 1e-14);
+  EXPECT_NEAR(x[1], plain[1], 1e-14);
+  // The rejected chord step is the only extra residual.
+  EXPECT_EQ(seeded.residual_evaluations, fresh.residual_evaluations + 1);
+  EXPECT_EQ(seeded.jacobian_evaluations, fresh.jacobian_evaluations);
+}
+
+TEST(EigenNewton, NearbyJacobianOfTheWrongSizeIsIgnored) {
+  EigenNewton newton({});
+  CircleLine p;
+  Vector x(2), plain(2);
+  x << 3.0, 0.2;
+  plain = x;
+  const NewtonSummary seeded = newton.solve(p, x, Matrix::Identity(3, 2));
+  const NewtonSummary fresh = newton.solve(p, plain);
+  EXPECT_EQ(seeded.chord_steps, 0);
+  EXPECT_EQ(seeded.residual_evaluations, fresh.residual_evaluations);
+  EXPECT_EQ(x, plain);
+}
+
+TEST(KinsolNewton, IgnoresANearbyJacobian) {
+  KinsolNewton newton({});
+  CircleLine p;
+  Vector x(2), plain(2);
+  x << 3.0, 0.2;
+  plain = x;
+  Corrector& corrector = newton;
+  const NewtonSummary seeded = corrector.solve(p, x, Matrix::Identity(2, 2));
+  const NewtonSummary fresh = corrector.solve(p, plain);
+  EXPECT_EQ(seeded.residual_evaluations, fresh.residual_evaluations);
+  EXPECT_EQ(x, plain);
+}
+
 }  // namespace
 }  // namespace backbone::core
