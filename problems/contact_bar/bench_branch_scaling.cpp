@@ -265,6 +265,20 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
     grid_runs.push_back(run(s));
     if (!grid_runs.back().complete) status = 1;
   }
+  // The same grids at steps_per_period = 2 N (Courant number c dt / dx = T / 2L, about 1.75):
+  // a row of the shooting residual then depends on u0 over a few elements about each
+  // characteristic image, so the compressed Jacobian needs about 15 colours at every N where
+  // the trace's 40 steps need about N / 2 (problems/contact_bar/README.md, 'Cost').
+  std::vector<Mode1BranchCost> fine_runs;
+  for (int n : grids) {
+    if (2 * n <= 40) continue;  // that grid row is this setting already
+    Mode1BranchSettings s;
+    s.study = "grid_2N";
+    s.elements = n;
+    s.steps_per_period = 2 * n;
+    fine_runs.push_back(run(s));
+    if (!fine_runs.back().complete) status = 1;
+  }
   const auto grid_run = [&](int n) -> Mode1BranchCost {
     for (const Mode1BranchCost& c : grid_runs)
       if (c.settings.elements == n) return c;
@@ -405,6 +419,7 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
       "median error |\n|---|---|---|---|---|---|---|\n";
   std::string grid_rows, variant_rows;
   for (const Mode1BranchCost& c : grid_runs) grid_rows += row(c);
+  for (const Mode1BranchCost& c : fine_runs) grid_rows += row(c);
   for (const Mode1BranchCost* c :
        {&base, &spp80, &paper_run, &eigen_square, &kinsol_square, &threads_base, &threads_run})
     variant_rows += row(*c);
@@ -419,6 +434,21 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
       largest.settings.elements, point_ratio,
       largest.settings.elements < 640 ? "640 not run here" : (point_ratio <= 2 ? "met" : "not met"),
       base.jacobians_per_point(), largest.jacobians_per_point(), largest.settings.elements);
+  std::string fine_verdict;
+  if (std::count_if(fine_runs.begin(), fine_runs.end(),
+                    [](const Mode1BranchCost& c) { return c.settings.elements >= 40; }) >= 2) {
+    const Mode1BranchCost* fine160 = nullptr;
+    for (const Mode1BranchCost& c : fine_runs)
+      if (c.settings.elements == 160) fine160 = &c;
+    fine_verdict = fmt::format(
+        " At steps_per_period = 2 N, ms per point grows like N^{:.2f} over N >= 40{}, with {:.3g} "
+        "Jacobians per point at N = {}.",
+        time_per_point_exponent(fine_runs, 40),
+        fine160 ? fmt::format(" and N = 160 costs {} ms per point",
+                              significant(fine160->ms_per_point()))
+                : std::string(),
+        fine_runs.back().jacobians_per_point(), fine_runs.back().settings.elements);
+  }
   const std::string variant_verdict = fmt::format(
       "at N = 40, 80 steps per period cost {:.2g}x the CPU of 40 for a worst error of {} against "
       "{}; the paper formulation {}; the square system costs {:.2g}x (eigen) and {:.2g}x "
@@ -471,7 +501,7 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
           "| threads | wall s | process CPU s |\n|---|---|---|\n| 1 | {6:.4g} | {7:.4g} |\n"
           "| 2 | {8:.4g} | {9:.4g} |\n\n**Where backbone stands:** {10}\n\n"
           "![Mode 1 cost per point and work-precision](mode1_scaling.png)\n",
-          header, grid_rows, grid_verdict, variant_rows, variant_verdict, jacobian_n,
+          header, grid_rows, grid_verdict + fine_verdict, variant_rows, variant_verdict, jacobian_n,
           jt.one_thread_seconds, jt.one_thread_cpu, jt.two_thread_seconds, jt.two_thread_cpu,
           jacobian_verdict));
   return status;
