@@ -120,8 +120,9 @@ class BranchPointDetector {
   Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref,
                       const Chord* chord, const Evaluation* near);
   void locate(const std::vector<Sample>& polyline, bool sign_change);
+  // chord_of_j: J's Chord when the location made it (nullptr: made here).
   void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,
-              core::Matrix J);
+              core::Matrix J, const Chord* chord_of_j = nullptr);
 
   const ScaledProblem& problem_;
   const ContinuationOptions& options_;
