@@ -206,7 +206,11 @@ bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vecto
   if (N.cols() == 0) return false;
   const core::Vector f = factor();
   const core::Vector& rf = problem_.residual_factor();
-  const double tolerance = options_.verification.corrector_options().residual_tolerance;
+  // The verification's own standard (a probe is a solution like a point of the branch), not the
+  // corrector's tenth of it: the residual is evaluated at the point returned, so no margin is
+  // needed, and the differenced matrix stalls at 1e-9..2e-8 (the finite-difference noise of the
+  // near-null directions), just above a tenth of 3e-9 (the contact bar at 100 intervals).
+  const double tolerance = options_.verification.residual_tolerance;
   const auto residual = [&](const core::Vector& at, core::Vector& r) {
     if (problem_.residual(at.cwiseQuotient(f), r) != core::EvalStatus::ok) return false;
     if (rf.size() > 0) r = r.cwiseProduct(rf);
