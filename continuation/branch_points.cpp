@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 
 #include "continuation/pseudo_arclength.hpp"
@@ -69,6 +70,9 @@ struct BranchPointDetector::Evaluation {
   core::Vector z, tangent;  // unit scale
   core::Matrix jacobian;    // unit scale, at z
   TestFunctionValue tau;
+  // The chord of `jacobian` (its SVD), made once when the evaluation is kept: the next
+  // evaluation's start and, at the best one, the verification use the same one.
+  std::shared_ptr<const Chord> chord;
 };
 
 core::Vector BranchPointDetector::factor() const {
@@ -202,7 +206,11 @@ bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vecto
   if (N.cols() == 0) return false;
   const core::Vector f = factor();
   const core::Vector& rf = problem_.residual_factor();
-  const double tolerance = options_.verification.corrector_options().residual_tolerance;
+  // The verification's own standard (a probe is a solution like a point of the branch), not the
+  // corrector's tenth of it: the residual is evaluated at the point returned, so no margin is
+  // needed, and the differenced matrix stalls at 1e-9..2e-8 (the finite-difference noise of the
+  // near-null directions), just above a tenth of 3e-9 (the contact bar at 100 intervals).
+  const double tolerance = options_.verification.residual_tolerance;
   const auto residual = [&](const core::Vector& at, core::Vector& r) {
     if (problem_.residual(at.cwiseQuotient(f), r) != core::EvalStatus::ok) return false;
     if (rf.size() > 0) r = r.cwiseProduct(rf);
@@ -306,13 +314,14 @@ BranchPointDetector::Evaluation BranchPointDetector::evaluate(const std::vector<
   // From a corrected point of the location nearer than the polyline's samples, a tangent
   // predictor onto the hyperplane and chord steps on that point's Jacobian: the bracket shrinks
   // much faster than the polyline's interpolation error does.
-  std::optional<Chord> near_chord;
+  std::shared_ptr<const Chord> near_chord;
   if (near && near->ok) {
     const double along = normal.dot(near->tangent);
     if (std::abs(along) >= 0.5) {
       e.z = near->z + near->tangent * (normal.dot(through - near->z) / along);
-      near_chord.emplace(near->jacobian, null_cutoff());
-      chord = &*near_chord;
+      near_chord =
+          near->chord ? near->chord : std::make_shared<const Chord>(near->jacobian, null_cutoff());
+      chord = near_chord.get();
     }
   }
   if (!chord || !chord_correct(*chord, normal, through, e.z)) {
@@ -353,11 +362,13 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
   report.sign_change = sign_change;
   // Each correction starts with chord steps on the last Jacobian evaluated (Chord): the
   // bracket is short, so it is close; the loop's corrector takes over when they stall.
-  std::optional<Chord> chord;
-  if (last_jacobian_.size() > 0) chord.emplace(last_jacobian_, null_cutoff());
+  std::shared_ptr<const Chord> chord;
+  if (last_jacobian_.size() > 0)
+    chord = std::make_shared<const Chord>(last_jacobian_, null_cutoff());
   // The best point so far: the sampled one with the smallest |tau|.
   core::Vector best_z, best_tangent;
-  core::Matrix best_jacobian;  // empty: not kept (a sample before the last)
+  core::Matrix best_jacobian;               // empty: not kept (a sample before the last)
+  std::shared_ptr<const Chord> best_chord;  // of best_jacobian
   double best_s = 0, best_value = std::numeric_limits<double>::infinity();
   for (const Sample& p : polyline)
     if (std::abs(p.tau.value) < std::abs(best_value)) {
@@ -365,18 +376,22 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       best_tangent = p.tangent;
       best_s = p.s;
       best_value = p.tau.value;
-      best_jacobian = &p == &polyline.back() ? last_jacobian_ : core::Matrix();
+      const bool last = &p == &polyline.back();
+      best_jacobian = last ? last_jacobian_ : core::Matrix();
+      best_chord = last ? chord : nullptr;
     }
   std::vector<Evaluation> done;  // every corrected evaluation, for the next one's start
   const auto keep = [&](Evaluation& e, double s) {
+    e.chord = std::make_shared<const Chord>(e.jacobian, null_cutoff());
     if (std::abs(e.tau.value) < std::abs(best_value)) {
       best_z = e.z;
       best_tangent = e.tangent;
       best_s = s;
       best_value = e.tau.value;
       best_jacobian = e.jacobian;
+      best_chord = e.chord;
     }
-    chord.emplace(e.jacobian, null_cutoff());
+    chord = e.chord;
     done.push_back(e);
   };
   // The corrected evaluation nearest to s when it is nearer than every sample of the polyline.
@@ -410,7 +425,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
       double s = (sa * fb - sb * fa) / (fb - fa);
       const double lo = std::min(sa, sb), hi = std::max(sa, sb);
       if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
-      Evaluation e = evaluate(polyline, s, reference, chord ? &*chord : nullptr, nearest(s));
+      Evaluation e = evaluate(polyline, s, reference, chord.get(), nearest(s));
       ++steps;
       if (!e.ok) break;
       keep(e, s);
@@ -468,7 +483,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
         if (std::abs(s - sb) < nudge) s = right_larger ? sb + nudge : sb - nudge;
         if (!(s > sa && s < sc)) s = right_larger ? 0.5 * (sb + sc) : 0.5 * (sa + sb);
       }
-      Evaluation e = evaluate(polyline, s, reference, chord ? &*chord : nullptr, nearest(s));
+      Evaluation e = evaluate(polyline, s, reference, chord.get(), nearest(s));
       ++steps;
       if (!e.ok) break;
       keep(e, s);
@@ -509,14 +524,15 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
     if (p.s <= best_s) report.after_point = p.index;
   if (report.after_point == polyline.back().index && polyline.size() > 1)
     report.after_point = polyline[polyline.size() - 2].index;
-  verify(report, best_z, best_tangent, best_jacobian);
+  verify(report, best_z, best_tangent, best_jacobian, best_chord.get());
   report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   found_.push_back(std::move(report));
 }
 
 void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& z,
-                                 const core::Vector& tangent, core::Matrix J) {
+                                 const core::Vector& tangent, core::Matrix J,
+                                 const Chord* chord_of_j) {
   // z, tangent and J in the unit scale; the loop's problem in its current units.
   const core::Vector f = factor();
   report.x = z.cwiseProduct(problem_.unit_scale());
@@ -525,6 +541,7 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
   if (J.size() == 0) {
     if (problem_.jacobian(z.cwiseQuotient(f), J) != core::EvalStatus::ok) return;
     J = in_unit_scale(J);
+    chord_of_j = nullptr;
   }
   // Thresholds relative to the branch's Jacobian scale, not to this point's sigma_max: J may
   // vanish at a branch point (x (z - 1) at z = 1), so its own largest singular value is the
@@ -554,7 +571,9 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
   // hyperplane row is met exactly), then, when they stall, the loop's corrector (its tolerance
   // and iteration budget, fresh Jacobians; the verifier's 60 linear iterations made failed
   // probes the main cost of a branch point, measured on the contact bar at 100 intervals).
-  const Chord chord(J, null_cutoff());
+  std::optional<Chord> own_chord;
+  if (!chord_of_j) own_chord.emplace(J, null_cutoff());
+  const Chord& chord = chord_of_j ? *chord_of_j : *own_chord;
   const core::VerifyOptions& v = options_.verification;
   const double h = v.step;
   double smallest = std::numeric_limits<double>::infinity();

@@ -18,8 +18,8 @@
 //     (sign change) or by a safeguarded V-fit (|tau| ~ |s - s*| near a simple crossing) with
 //     golden-section fall-back (dip), each evaluation a point corrected on the hyperplane
 //     orthogonal to the bracket's polyline (chord steps on the last Jacobian first, then
-//     Gauss-Newton that keeps its Jacobian while it contracts); it ends when |tau| is below a
-//     thousandth of the rank threshold, the bracket below location_tolerance, or |tau| stops
+//     Gauss-Newton that keeps its Jacobian while it contracts); it ends when |tau| is below 1e-4
+//     of the rank threshold, the bracket below location_tolerance, or |tau| stops
 //     falling;
 //   - the located point is verified with the rank report and probes on the located point's
 //     Jacobian: dimension = verified dimension - 1 (the directions beyond the traced tangent),
@@ -120,8 +120,9 @@ class BranchPointDetector {
   Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref,
                       const Chord* chord, const Evaluation* near);
   void locate(const std::vector<Sample>& polyline, bool sign_change);
+  // chord_of_j: J's Chord when the location made it (nullptr: made here).
   void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,
-              core::Matrix J);
+              core::Matrix J, const Chord* chord_of_j = nullptr);
 
   const ScaledProblem& problem_;
   const ContinuationOptions& options_;

@@ -88,6 +88,9 @@ FollowedBranch follow_attached(const core::Problem& problem, const BranchPointRe
   ContinuationOptions o = options;
   o.method = Method::arclength;
   o.branch_points.detect = false;
+  if (o.branch_points.max_turn_degrees > 0)
+    o.branch_points.max_turn_degrees =
+        std::max(o.branch_points.max_turn_degrees, follow_max_turn_degrees);
   f.branch = pseudo_arclength(problem, f.start->guess, f.start->direction, corrector, o, hooks);
   f.message = f.branch.message;
   return f;

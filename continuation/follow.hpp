@@ -72,9 +72,21 @@ struct FollowedBranch {
   int attempts = 1;     // starts tried (follow_branch_points retries a branch that ended early)
 };
 
+// The turn check of a followed branch (ContinuationOptions::branch_points.max_turn_degrees is
+// raised to it; 0, off, stays off). An attached family may have corners: the contact bar's are
+// piecewise affine in u0 for a fixed contact sequence, and where the path meets an edge the
+// forward-difference Jacobian straddles it, so every retried step turns by the corner's angle
+// whatever ds is (measured at 100 intervals, T = 3.5 L/c: 20.5-22.4 degrees down to ds_min, the
+// followed branch ended at the step floor; the traced branch's 20 degrees refused them). The
+// steps that jump across the family turn by 75-90 degrees (measured on the same branches): 45
+// degrees, a correction as long as the step, keeps those refused and lets the path turn a
+// corner.
+inline constexpr double follow_max_turn_degrees = 45;
+
 // Pseudo-arclength (detection off) from attached_start(report) with `options` (bounds, step
-// control, turn check, the max_points budget) and `hooks` (reject_point: the per-point check
-// applies to every orbit of the followed branch). Never throws on numerical failure.
+// control, the max_points budget; the turn check raised to follow_max_turn_degrees) and `hooks`
+// (reject_point: the per-point check applies to every orbit of the followed branch). Never throws
+// on numerical failure.
 FollowedBranch follow_attached(const core::Problem& problem, const BranchPointReport& report,
                                const std::string& observable, core::Corrector& corrector,
                                const ContinuationOptions& options,

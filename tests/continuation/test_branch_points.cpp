@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "continuation/branch_points.hpp"
+#include "continuation/follow.hpp"
 #include "continuation/pseudo_arclength.hpp"
 #include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
@@ -211,6 +213,80 @@ TEST(BranchPoints, TurnCheckShrinksSteepSteps) {
   EXPECT_DOUBLE_EQ(unchecked.points[1].step_size, 1.0);
   o.branch_points.max_turn_degrees = 180;
   EXPECT_THROW(o.validate(), core::InputError);
+}
+
+namespace {
+
+// x (lambda - 1 - g(x)) = 0: the line x = 0 and, attached at (0, 1), the polyline lambda = 1 + g(x)
+// with a corner at x = c: g(x) = x up to c (45 degrees), then slope tan 15 degrees, a turn of
+// 30 degrees. The analytic Jacobian at the corner is the incoming piece's, as a forward-
+// difference Jacobian that straddles an edge of a piecewise-affine family is neither piece's (the
+// contact bar's attached families at 100 intervals, continuation/follow.hpp): the tangent there
+// points along the incoming piece, and every step from the corner turns by 30 degrees, whatever
+// ds is.
+class CorneredAttachedLine : public core::Problem {
+ public:
+  static constexpr double corner = 0.5;
+  static double g(double x) { return x <= corner ? x : corner + slope * (x - corner); }
+  static inline const double slope = std::tan(15.0 * std::numbers::pi / 180);
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 1; }
+  std::string name() const override { return "cornered_attached_line"; }
+  core::Observables observables(const core::Vector& x) const override {
+    return {{"x", x[0]}, {"lambda", x[1]}};
+  }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    r.resize(1);
+    r[0] = x[0] * (x[1] - 1 - g(x[0]));
+    return core::EvalStatus::ok;
+  }
+  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override {
+    J.resize(1, 2);
+    J(0, 0) = x[1] - 1 - g(x[0]) - x[0] * (x[0] <= corner ? 1.0 : slope);
+    J(0, 1) = x[0];
+    return core::EvalStatus::ok;
+  }
+};
+
+}  // namespace
+
+// A followed branch turns the corners of its family: started at the corner of
+// CorneredAttachedLine (a probe point there, attached to (0, 1)), the 30-degree turn exceeds the
+// traced branch's max_turn_degrees (20), which would refuse every step down to ds_min; the
+// followed branch's turn check (follow_max_turn_degrees) lets it through, and every point lies on
+// the polyline up to the bound x <= 2 (Newton stops at |x (lambda - 1 - g)| <= 1e-10, so
+// |lambda - 1 - g(x)| <= 1e-10 / x, with x >= c).
+TEST(BranchPoints, FollowedBranchTurnsACornerOfItsFamily) {
+  const CorneredAttachedLine problem;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  continuation::BranchPointReport report;
+  report.x = vec({0, 1});
+  const double c = CorneredAttachedLine::corner;
+  report.attached_points = {vec({c, 1 + c})};
+  report.attached_point = report.attached_points[0];
+  report.attached_dimension = 1;
+  report.verified_dimension = 2;
+  continuation::ContinuationOptions options;
+  options.ds = options.ds_max = 0.1;
+  options.max_points = 60;
+  options.rank_check_every = 0;
+  options.bounds.push_back({"x", -1.0, 2.0});
+  ASSERT_EQ(options.branch_points.max_turn_degrees, 20);
+  ASSERT_GT(continuation::follow_max_turn_degrees, 30);
+  const auto f = continuation::follow_attached(problem, report, "x", *newton, options);
+  ASSERT_GE(f.branch.points.size(), 5u) << f.message;
+  EXPECT_EQ(f.branch.reason, continuation::StopReason::bound_reached) << f.message;
+  EXPECT_NEAR(f.branch.points.front().x[0], c, 1e-12);
+  EXPECT_NEAR(f.branch.points.back().x[0], 2.0, 1e-9);
+  double previous = 0;
+  for (const auto& p : f.branch.points) {
+    const double x = p.x[0], lambda = p.x[1];
+    EXPECT_GE(x, previous);
+    EXPECT_LE(std::abs(lambda - 1 - CorneredAttachedLine::g(x)), 1e-10 / x) << "x " << x;
+    previous = x;
+  }
 }
 
 // branch_points.csv: the observables, dimension, the problem's description columns, the angle.
