@@ -132,14 +132,20 @@ TEST(LoopState, TextFormReadsBackBitForBit) {
   EXPECT_TRUE(b.samples[1].z == a.z && b.samples[1].tangent == a.tangent);
 }
 
-// A state written before chord corrections (no jacobian_point, no chord_misses) still reads:
-// the next correction then starts with a fresh Jacobian.
-TEST(LoopState, StateWithoutTheChordFieldsReads) {
+// The smallest valid arclength state: a point, its scale, tangent and step.
+static LoopState minimal_state() {
   LoopState s;
   s.z = vec(1, 2);
   s.scale = vec(1, 1);
   s.tangent = vec(1, 0);
   s.ds = 0.1;
+  return s;
+}
+
+// A state written before chord corrections (no jacobian_point, no chord_misses) still reads:
+// the next correction then starts with a fresh Jacobian.
+TEST(LoopState, StateWithoutTheChordFieldsReads) {
+  LoopState s = minimal_state();
   s.jacobian_point = vec(3, 4);
   s.chord_misses = 5;
   std::string line = continuation::format_state(s);
@@ -155,11 +161,7 @@ TEST(LoopState, StateWithoutTheChordFieldsReads) {
 }
 
 TEST(LoopState, DefectsAreInputErrorsNamingTheKey) {
-  LoopState s;
-  s.z = vec(1, 2);
-  s.scale = vec(1, 1);
-  s.tangent = vec(1, 0);
-  s.ds = 0.1;
+  const LoopState s = minimal_state();
   const std::string good = continuation::format_state(s);
   EXPECT_NO_THROW(continuation::parse_state(good, "resume", "test"));
   for (const std::string& bad :
