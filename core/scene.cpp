@@ -42,14 +42,29 @@ std::string message_of(const po::error& e) {
   throw InputError("", where.empty() ? message : where + ": " + message);
 }
 
+// A relative path that names no file here is looked up in the source tree the binary was built
+// from, so that the shipped scenes (`problems/contact_bar/scenes/paper.ini`, and the steps of
+// `backbone reproduce`) work from any directory (core/README.md, 'Scenes, tables, plots').
+std::string locate_scene(const std::string& ini_path) {
+  std::error_code error;
+  const std::filesystem::path path(ini_path);
+  if (path.empty() || path.is_absolute() || std::filesystem::exists(path, error)) return ini_path;
+  const std::filesystem::path shipped = std::filesystem::path(BACKBONE_SOURCE_DIR) / path;
+  return std::filesystem::is_regular_file(shipped, error) ? shipped.string() : ini_path;
+}
+
 // The file's text without a leading UTF-8 byte-order mark (Boost would read it as part of the
 // first key: "unrecognised option '\ufeffproblem'").
-std::istringstream open_scene(const std::string& ini_path) {
+std::istringstream open_scene(const std::string& given_path) {
+  const std::string ini_path = locate_scene(given_path);
   std::error_code error;
   if (std::filesystem::is_directory(ini_path, error))
     throw InputError("scene", fmt::format("'{}' is a directory, not a scene file", ini_path));
   std::ifstream in(ini_path);
-  if (!in) throw InputError("scene", fmt::format("cannot read scene file '{}'", ini_path));
+  if (!in)
+    throw InputError("scene", fmt::format("cannot read scene file '{}' (nor in the source tree "
+                                          "{})",
+                                          ini_path, BACKBONE_SOURCE_DIR));
   std::stringstream text;
   text << in.rdbuf();
   std::string content = text.str();

@@ -78,6 +78,27 @@ TEST_F(SceneInput, IntegerAboveIntMaxNamesTheKeyAndTheBound) {
             std::string::npos);
 }
 
+// A shipped scene named relative to the source tree reads from any working directory; a
+// relative path found in neither place is still an InputError naming the scene.
+TEST_F(SceneInput, ShippedSceneReadsFromAnyDirectory) {
+  const fs::path here = fs::current_path();
+  fs::current_path(dir_);
+  ASSERT_FALSE(fs::exists("problems/duffing/scenes/duffing.ini"));
+  ASSERT_TRUE(fs::exists(fs::path(BACKBONE_SOURCE_DIR) / "problems/duffing/scenes/duffing.ini"));
+  std::string name;
+  try {
+    name = scene_problem_name("problems/duffing/scenes/duffing.ini");
+  } catch (...) {
+    fs::current_path(here);
+    throw;
+  }
+  const std::string message =
+      input_error([] { scene_problem_name("problems/duffing/scenes/no_such.ini"); }, "scene");
+  fs::current_path(here);
+  EXPECT_EQ(name, "duffing");
+  EXPECT_NE(message.find("cannot read scene file"), std::string::npos) << message;
+}
+
 TEST_F(SceneInput, DirectoryAsSceneIsRefused) {
   const std::string message =
       input_error([&] { read_scene(keys(), dir_.string(), {}, {}); }, "scene");
