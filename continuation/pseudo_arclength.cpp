@@ -67,10 +67,11 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
   if (options.branch_points.detect) detector.emplace(problem, options, hooks, corrector);
   core::Vector x, tangent, previous;
   core::Matrix J;
-  // Chord corrections (options.chord_corrections): the Jacobian at x in the units of x, which
-  // the next correction starts from, and where (the problem's unknowns) it was computed. The
-  // same point's Jacobian, not a new one: ScaledProblem keeps the base's Jacobian per point.
-  core::Matrix nearby, nearby_base;  // in the units of x; the base's
+  // Chord corrections (options.chord_corrections): the base's Jacobian at x, which the next
+  // correction starts from (in the units of x), and where (the problem's unknowns) it was
+  // computed; empty when the next correction does not try it. The same point's Jacobian, not a
+  // new one: ScaledProblem keeps the base's Jacobian per point.
+  core::Matrix nearby_base;
   core::Vector nearby_at;
   // Corrections since the last whose chord steps on the nearby Jacobian helped: after two
   // misses the chord is tried only every eighth point. Measured on the contact bar's mode 1
@@ -78,20 +79,18 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
   // does not reduce it even at ds = 0.02 (the contact structure moves the Jacobian), so each
   // try costs a factorization and a residual for nothing; at high energy it pays.
   int chord_misses = 0;
-  // The base's Jacobian at nearby_at (a copy right after J was computed there).
-  const auto keep_base = [&]() {
-    if (nearby_at.size() == 0 ||
-        problem.base_jacobian(nearby_at, nearby_base) != core::EvalStatus::ok) {
-      nearby_at.resize(0);
-      nearby_base.resize(0, 0);
-    }
-  };
-  // It in the units just adopted.
-  const auto take_nearby = [&]() {
-    if (nearby_base.size() > 0)
-      nearby = problem.in_current_units(nearby_base);
+  // Keeps the base's Jacobian at `at` (a copy right after J was computed there) when the next
+  // correction tries the chord.
+  const auto keep_base = [&](core::Vector at) {
+    nearby_at.resize(0);
+    nearby_base.resize(0, 0);
+    const bool tried =
+        options.chord_corrections && at.size() > 0 && (chord_misses < 2 || chord_misses % 8 == 0);
+    if (!tried) return;
+    if (problem.base_jacobian(at, nearby_base) == core::EvalStatus::ok)
+      nearby_at = std::move(at);
     else
-      nearby.resize(0, 0);
+      nearby_base.resize(0, 0);
   };
   double ds = options.ds;
   // Units that follow the point (scaled_problem.hpp, LocalScale): after each point the units
@@ -122,10 +121,8 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
     steps.resume(*from, record_from);
     adopt_units_of(*from);
     ds = from->ds;
-    if (options.chord_corrections) nearby_at = from->jacobian_point;
     chord_misses = from->chord_misses;
-    keep_base();
-    take_nearby();
+    keep_base(from->jacobian_point);
     if (detector) {
       // The detector is restored as it was before the saved point was added, then the point is
       // added again from its Jacobian (the same bits: the same z).
@@ -153,8 +150,7 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
                                    start.index, steps.describe(x)));
     }
     if (options.start_along_direction) tangent = hint;
-    if (options.chord_corrections) nearby_at = problem.to_unknowns(x);
-    keep_base();
+    keep_base(problem.to_unknowns(x));
     auto state = std::make_shared<LoopState>();
     state->method = Method::arclength;
     state->z = x;
@@ -168,7 +164,6 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
       for (BranchPointReport& report : detector->take()) steps.add_branch_point(std::move(report));
     }
     adopt_units_of(*first_state);
-    take_nearby();
   }
   core::BorderedSystem system(problem, {core::BorderRow::linear(tangent, x, 0.0, "arclength")});
   // Passing an attached family: a correction that turns away from the predictor direction by
@@ -187,8 +182,9 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
     system.set_anchor(0, x);
     system.set_direction(0, step_direction);
     core::Matrix bordered_nearby;
-    const bool try_chord = nearby.size() > 0 && (chord_misses < 2 || chord_misses % 8 == 0);
-    if (try_chord && system.jacobian_with_base(x, nearby, bordered_nearby) != core::EvalStatus::ok)
+    if (nearby_base.size() > 0 &&
+        system.jacobian_with_base(x, problem.in_current_units(nearby_base), bordered_nearby) !=
+            core::EvalStatus::ok)
       bordered_nearby.resize(0, 0);
     core::Vector y;
     const CorrectedStep corrected = steps.correct(
@@ -225,10 +221,7 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
         bordered_nearby.size() > 0 && corrected.summary.chord_steps > 0 ? 0 : chord_misses + 1;
     core::Vector next_tangent;
     core::EvalStatus tangent_status = problem.jacobian(y, J);
-    nearby_at = options.chord_corrections && tangent_status == core::EvalStatus::ok
-                    ? problem.to_unknowns(y)
-                    : core::Vector();
-    keep_base();
+    keep_base(tangent_status == core::EvalStatus::ok ? problem.to_unknowns(y) : core::Vector());
     if (tangent_status == core::EvalStatus::ok)
       tangent_status = tangent_from_jacobian(J, step_direction, threshold, next_tangent);
     // A tangent that turns from the accepted chord x -> y by more than max_turn_degrees
@@ -278,13 +271,11 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
     ds = state->ds;
     if (follow_scale) {
       adopt_units_of(*state);
-      take_nearby();
       continue;
     }
     if (options.predictor == Predictor::secant) previous = x;
     x = y;
     tangent = next_tangent;
-    take_nearby();
   }
   return steps.take();
 }
