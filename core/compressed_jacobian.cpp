@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -83,6 +84,35 @@ double check_weight(int j) {
   return (z & 1) ? 1 + u : -(1 + u);
 }
 
+// The colouring of the last pattern seen on this thread: a trace asks for the same pattern
+// at Jacobian after Jacobian (the contact bar's depends on x only through its contact phases),
+// and colouring costs O(entries x row width), about a tenth of a mode-1 trace at N = 160
+// (perf record); comparing the pattern costs O(entries). The colouring is a function of the
+// pattern alone, so the cache changes no result.
+Colouring cached_colour(const JacobianPattern& pattern, int m, int n) {
+  struct Entry {
+    std::vector<std::vector<int>> row_columns;
+    std::vector<int> dense_columns;
+    int m = -1, n = -1;
+    Colouring colouring;
+  };
+  // Two entries, the most recent first: a narrow pattern and the `wider` one behind it.
+  thread_local std::array<Entry, 2> cache;
+  for (std::size_t e = 0; e < cache.size(); ++e) {
+    const Entry& entry = cache[e];
+    if (entry.m == m && entry.n == n && entry.row_columns == pattern.row_columns &&
+        entry.dense_columns == pattern.dense_columns) {
+      if (e > 0) std::swap(cache[0], cache[e]);
+      return cache[0].colouring;
+    }
+  }
+  Entry fresh{pattern.row_columns, pattern.dense_columns, m, n,
+              colour(pattern, m, n)};  // throws on a malformed pattern: nothing cached
+  cache[1] = std::move(cache[0]);
+  cache[0] = std::move(fresh);
+  return cache[0].colouring;
+}
+
 }  // namespace
 
 std::vector<int> colour_columns(const JacobianPattern& pattern, int m, int n) {
@@ -98,7 +128,7 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
   out = {};
   const int n = problem.num_unknowns();
   const int m = problem.num_equations();
-  const Colouring c = colour(pattern, m, n);
+  const Colouring c = cached_colour(pattern, m, n);  // a copy: a wider pattern recolours
   out.colours = c.colours;
   const bool central = options.scheme == FiniteDifferenceOptions::Scheme::central;
   const double rel = relative_step(options);
@@ -201,7 +231,8 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
       }
     }
   }
-  constexpr double tau = 1e-3, sigma = 1e-2;
+  const double tau = pattern.check_tolerance;
+  constexpr double sigma = 1e-2;
   const double floor = sigma * (m > 0 ? size.maxCoeff() : 0.0);
   for (int i = 0; i < m; ++i) {
     const double tolerance = tau * (size[i] + floor);

@@ -64,6 +64,11 @@ struct JacobianPattern {
   std::vector<std::vector<int>> row_columns;  // num_equations() rows
   std::vector<int> dense_columns;
   std::shared_ptr<const JacobianPattern> wider;  // may be empty
+  // The check's relative tolerance tau (compressed_jacobian.cpp): entries this pattern drops
+  // pass unnoticed up to about tau of their row's size. A narrow pattern with a `wider` one
+  // behind it can ask for less than the default 1e-3, so that what it drops is negligible
+  // wherever J matters beyond Newton's convergence (rank tests, branch points).
+  double check_tolerance = 1e-3;
 };
 
 // A named scalar derived from a solution point (period, energy, frequency...).

@@ -178,6 +178,47 @@ TEST(CompressedJacobian, AFailedCheckTriesTheWiderPatternBeforeColumnByColumn) {
   EXPECT_EQ((J - dense).cwiseAbs().maxCoeff(), 0.0);
 }
 
+// F_i = 2 x_i + c x_{i+1}, declared diagonal: the dropped entries are c / 2 of their row's
+// diagonal. With the check direction's weights +-(1..2) the check sees them at c / 4 to c of
+// the row's first-order size (plus the floor's 1 %), so c = 1e-4 passes the default tolerance
+// 1e-3 unnoticed (J without them) and is caught at a pattern's check_tolerance 1e-5 (< c / 4.04);
+// the function is linear, so the finite differences' own error is round-off, ~1e-8 of a row.
+class WeaklyCoupled : public Problem {
+ public:
+  int num_unknowns() const override { return 8; }
+  int num_equations() const override { return 8; }
+  JacobianPattern diagonal() const {
+    JacobianPattern p;
+    p.row_columns.resize(8);
+    for (int i = 0; i < 8; ++i) p.row_columns[static_cast<std::size_t>(i)] = {i};
+    return p;
+  }
+
+ protected:
+  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
+    for (int i = 0; i < 8; ++i) r[i] = 2 * x[i] + (i + 1 < 8 ? 1e-4 * x[i + 1] : 0.0);
+    return EvalStatus::ok;
+  }
+};
+
+TEST(CompressedJacobian, APatternsCheckToleranceBoundsWhatItMayDropUnnoticed) {
+  const WeaklyCoupled problem;
+  const Vector x = Vector::LinSpaced(8, 0.5, 1.5);
+  Matrix J, dense;
+  ASSERT_EQ(finite_difference_jacobian(problem, x, dense), EvalStatus::ok);
+  JacobianPattern pattern = problem.diagonal();
+  CompressedJacobianReport report;
+  ASSERT_EQ(compressed_finite_difference_jacobian(problem, x, pattern, J, {}, &report),
+            EvalStatus::ok);
+  EXPECT_FALSE(report.fell_back);
+  EXPECT_EQ(J(0, 1), 0.0);  // dropped, below the default tolerance
+  pattern.check_tolerance = 1e-5;
+  ASSERT_EQ(compressed_finite_difference_jacobian(problem, x, pattern, J, {}, &report),
+            EvalStatus::ok);
+  EXPECT_TRUE(report.fell_back);
+  EXPECT_EQ((J - dense).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(CompressedJacobian, ColouringSeparatesColumnsThatShareARowAndRejectsBadPatterns) {
   Arrow arrow(30);
   const JacobianPattern pattern = arrow.pattern();
