@@ -29,7 +29,9 @@ double PointRecorder::elapsed_seconds() const {
 void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_direction) {
   core::Matrix J;
   if (problem_.jacobian(point.x, J) != core::EvalStatus::ok) return;
-  core::RankReport report = core::rank_report(J, options_.rank);
+  core::RankOptions rank = options_.rank;
+  rank.full_spectrum = false;  // sigma_max and the values around the threshold suffice here
+  core::RankReport report = core::rank_report(J, rank);
   const core::Matrix* nearby = options_.chord_corrections ? &J : nullptr;
   if (verifier_) {
     core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, report,

@@ -11,6 +11,7 @@
 #include "continuation/loop_steps.hpp"
 #include "continuation/scaled_problem.hpp"
 #include "core/bordered_system.hpp"
+#include "core/eigen_newton.hpp"
 #include "core/errors.hpp"
 
 namespace backbone::continuation {
@@ -33,12 +34,10 @@ core::EvalStatus tangent_from_jacobian(const core::Matrix& J, const core::Vector
   bordered.row(m) = orientation.normalized().transpose();
   core::Vector rhs = core::Vector::Zero(m + 1);
   rhs[m] = 1.0;
-  // Complete orthogonal decomposition: rank-revealing, minimum-norm solution. The threshold is
-  // relative to the largest pivot, like the rank report's.
-  Eigen::CompleteOrthogonalDecomposition<core::Matrix> cod;
-  cod.setThreshold(relative_threshold);
-  cod.compute(bordered);
-  tangent = cod.solve(rhs);
+  // The minimum-norm solution (core::minimum_norm_solve: a plain QR where the bordered matrix
+  // has full rank by a wide margin, else the rank-revealing complete orthogonal decomposition,
+  // its threshold relative to the largest pivot, like the rank report's).
+  core::minimum_norm_solve(bordered, rhs, relative_threshold, tangent);
   const double norm = tangent.norm();
   if (!std::isfinite(norm) || norm == 0) return core::EvalStatus::non_finite;
   tangent /= norm;

@@ -10,26 +10,73 @@
 namespace backbone::core {
 
 namespace {
-// A complete orthogonal decomposition (pivoted QR, then QR of R^T's leading rows) gives the
-// Moore-Penrose minimum-norm least-squares solution at a fraction of an SVD's cost; its rank
-// cut-off is relative to the largest pivot |R_11|, which is within a factor sqrt(n) of
-// sigma_max (Golub & Van Loan 5.4.1), the same scale the SVD cut-off used.
-void factorize(const Matrix& J, double rank_cutoff,
-               Eigen::CompleteOrthogonalDecomposition<Matrix>& cod) {
-  cod.setThreshold(rank_cutoff > 0 ? rank_cutoff : std::numeric_limits<double>::epsilon());
-  cod.compute(J);
-}
-
-int solve_factorized(const Eigen::CompleteOrthogonalDecomposition<Matrix>& cod, const Vector& rhs,
-                     Vector& dx) {
-  const Eigen::Index rank = cod.rank();
-  if (rank == 0) {
-    dx = Vector::Zero(cod.cols());
-    return 0;
+// The least-squares factorisation of J (m x n). The Moore-Penrose minimum-norm solution is
+// what a rank-deficient J needs; a complete orthogonal decomposition (pivoted QR, then QR of
+// R^T's leading rows) gives it at a fraction of an SVD's cost, its rank cut-off relative to the
+// largest pivot |R_11|, within a factor sqrt(n) of sigma_max (Golub & Van Loan 5.4.1), the
+// scale the SVD cut-off used. Where J has full column rank by a wide margin the minimum-norm
+// solution is the plain least-squares one, and a Householder QR without pivoting (blocked,
+// 3.4x cheaper than the COD at 321 x 161: core/README.md, 'Newton correctors') gives it. The
+// margin is checked on R: two steps of inverse iteration on R^T R from a fixed start estimate
+// sigma_min(R) from above (||R^-1 R^-T z|| / ||z|| <= 1 / sigma_min^2), quickly where it
+// matters (a sigma_min far below the next is found in one step); QR is kept when that estimate
+// is above 1e3 times the cut-off of |R|'s largest diagonal entry, else J is factorised again by
+// the COD. The two give the same solution up to round-off (cond(J) eps).
+class LeastSquares {
+ public:
+  void compute(const Matrix& J, double rank_cutoff) {
+    const double cutoff = rank_cutoff > 0 ? rank_cutoff : std::numeric_limits<double>::epsilon();
+    use_qr_ = false;
+    if (J.rows() >= J.cols() && J.cols() > 0) {
+      qr_.compute(J);
+      use_qr_ = well_conditioned(cutoff);
+    }
+    if (!use_qr_) {
+      cod_.setThreshold(cutoff);
+      cod_.compute(J);
+    }
   }
-  dx = cod.solve(rhs);
-  return static_cast<int>(rank);
-}
+  int rank() const {
+    return use_qr_ ? static_cast<int>(qr_.cols()) : static_cast<int>(cod_.rank());
+  }
+  int cols() const { return static_cast<int>(use_qr_ ? qr_.cols() : cod_.cols()); }
+  // Least-squares solution of J dx = rhs (minimum norm for a rank-deficient J). Returns the
+  // rank used.
+  int solve(const Vector& rhs, Vector& dx) const {
+    const int r = rank();
+    if (r == 0) {
+      dx = Vector::Zero(cols());
+      return 0;
+    }
+    dx = use_qr_ ? Vector(qr_.solve(rhs)) : Vector(cod_.solve(rhs));
+    return r;
+  }
+
+ private:
+  bool well_conditioned(double cutoff) const {
+    const Eigen::Index n = qr_.cols();
+    const auto R = qr_.matrixQR().topRows(n).template triangularView<Eigen::Upper>();
+    const double largest = qr_.matrixQR().topRows(n).diagonal().cwiseAbs().maxCoeff();
+    if (!(largest > 0) || !std::isfinite(largest)) return false;
+    Vector z = Vector::Ones(n);
+    double estimate = largest;
+    for (int step = 0; step < 2; ++step) {
+      const double before = z.norm();
+      Vector y = R.transpose().solve(z);
+      y = R.solve(y);
+      const double grow = y.norm() / before;  // <= 1 / sigma_min^2
+      if (!std::isfinite(grow) || !(grow > 0)) return false;
+      estimate = std::min(estimate, 1.0 / std::sqrt(grow));
+      z = y / y.norm();
+    }
+    return estimate > 1e3 * cutoff * largest;
+  }
+
+  bool use_qr_ = false;
+  Eigen::HouseholderQR<Matrix> qr_;
+  Eigen::CompleteOrthogonalDecomposition<Matrix> cod_;
+};
+
 // A chord step is kept when it cuts ||F||_2 by 1 / reuse_contraction, or, more slowly but still
 // by half, when at its rate six more such steps reach the tolerance: a fresh Jacobian costs a
 // residual per column (or per colour), a chord step one. Measured on the contact bar's
@@ -44,9 +91,9 @@ bool chord_step_pays(double norm2, const Vector& trial_r, const NewtonOptions& o
 }  // namespace
 
 int minimum_norm_solve(const Matrix& J, const Vector& rhs, double rank_cutoff, Vector& dx) {
-  Eigen::CompleteOrthogonalDecomposition<Matrix> cod;
-  factorize(J, rank_cutoff, cod);
-  return solve_factorized(cod, rhs, dx);
+  LeastSquares ls;
+  ls.compute(J, rank_cutoff);
+  return ls.solve(rhs, dx);
 }
 
 EigenNewton::EigenNewton(const NewtonOptions& options) : options_(options) {
@@ -87,15 +134,15 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
 
   const Vector scale = problem.typical_scale().cwiseAbs();
   Matrix J;
-  Eigen::CompleteOrthogonalDecomposition<Matrix> cod;
-  // cod holds the factorization of a Jacobian of this solve, or of the nearby one; chord steps
-  // on a nearby Jacobian are tried until the first fresh one, later ones only with
+  LeastSquares factorization;
+  // factorization holds the factorization of a Jacobian of this solve, or of the nearby one; chord
+  // steps on a nearby Jacobian are tried until the first fresh one, later ones only with
   // reuse_jacobian.
   bool have_factorization = false;
   bool chord = options_.reuse_jacobian;
   if (nearby_jacobian && nearby_jacobian->rows() == r.size() &&
       nearby_jacobian->cols() == x.size() && nearby_jacobian->allFinite()) {
-    factorize(*nearby_jacobian, options_.rank_cutoff, cod);
+    factorization.compute(*nearby_jacobian, options_.rank_cutoff);
     have_factorization = true;
     chord = true;
   }
@@ -108,7 +155,7 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     const double norm2 = r.norm();
     // Chord step: the factorization of an earlier Jacobian, kept while it contracts.
     if (have_factorization && chord) {
-      const int rank = solve_factorized(cod, -r, dx);
+      const int rank = factorization.solve(-r, dx);
       trial_x = x + dx;
       if (rank > 0 && dx.allFinite() && problem.residual(trial_x, trial_r) == EvalStatus::ok &&
           chord_step_pays(norm2, trial_r, options_)) {
@@ -139,10 +186,10 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     if (eval != EvalStatus::ok)
       return finish(NewtonStatus::evaluation_failed,
                     fmt::format("eigen: Jacobian at iteration {}: {}", iteration, to_string(eval)));
-    factorize(J, options_.rank_cutoff, cod);
+    factorization.compute(J, options_.rank_cutoff);
     have_factorization = true;
     chord = options_.reuse_jacobian;
-    const int rank = solve_factorized(cod, -r, dx);
+    const int rank = factorization.solve(-r, dx);
     if (!dx.allFinite())
       return finish(NewtonStatus::linear_solver_failed,
                     fmt::format("eigen: non-finite Newton step at iteration {}", iteration));

@@ -34,6 +34,11 @@ struct RankOptions {
   // relative threshold would count that noise as rank; set this to the Jacobian's noise level
   // there. Default 0: relative only.
   double absolute_threshold = 0;
+  // false: compute sigma_max and only the smallest singular values up to one beyond the
+  // threshold, with their right vectors (rank_report, core/README.md 'Rank reports'); the
+  // other entries of RankReport::singular_values are NaN. For a report at every point of a
+  // branch, where the full SVD cost a third of the trace at N = 160.
+  bool full_spectrum = true;
   void validate() const;
 };
 
@@ -59,7 +64,7 @@ struct VerifyOptions {
 std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options);
 
 struct RankReport {
-  Vector singular_values;  // descending
+  Vector singular_values;  // descending (NaN where not computed: RankOptions::full_spectrum)
   double threshold = 0;    // value used: max(relative_threshold * sigma_max, absolute_threshold)
   double relative_threshold = 0;
   int rank = 0;

@@ -3,6 +3,7 @@
 // numerical failure as a status.
 #include <gtest/gtest.h>
 
+#include <Eigen/SVD>
 #include <cmath>
 
 #include "core/eigen_newton.hpp"
@@ -241,6 +242,29 @@ TEST(EigenNewton, RankDeficientJacobianStillSteps) {
   const NewtonSummary s = newton.solve(p, x);
   ASSERT_TRUE(s.converged()) << s.message;
   EXPECT_NEAR(x.norm(), 1.0, 1e-10);
+}
+
+// minimum_norm_solve: the plain QR where J has full column rank by a margin, the COD where it
+// has not; either way the Moore-Penrose solution, here against the exact one from the
+// normal equations (full rank, cond 1e3: agreement to cond eps ~ 1e-13, 1e-11 allowed) and
+// from the SVD with the tiny value dropped (rank 2 of 3: the minimum-norm solution, 1e-12).
+TEST(EigenNewton, MinimumNormSolveIsTheLeastSquaresSolutionAtFullAndLowerRank) {
+  Matrix J(5, 3);
+  J << 1, 2, 0, 0, 1, 1, 3, 0, 1, 1, 1, 1, 0, 2, 5e-3;
+  const Vector b = (Vector(5) << 1, -2, 0.5, 3, 1).finished();
+  Vector dx;
+  EXPECT_EQ(minimum_norm_solve(J, b, 1e-12, dx), 3);
+  const Vector normal = (J.transpose() * J).ldlt().solve(J.transpose() * b);
+  EXPECT_LT((dx - normal).norm(), 1e-11 * normal.norm());
+  // Column 3 = column 1 + column 2 up to 1e-14: rank 2 at a cut-off of 1e-10.
+  Matrix deficient = J;
+  deficient.col(2) = J.col(0) + J.col(1) + Vector::Constant(5, 1e-14);
+  EXPECT_EQ(minimum_norm_solve(deficient, b, 1e-10, dx), 2);
+  const Eigen::JacobiSVD<Matrix> svd(deficient, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  Vector inverse = svd.singularValues().cwiseInverse();
+  inverse[2] = 0;
+  const Vector pinv = svd.matrixV() * inverse.asDiagonal() * svd.matrixU().transpose() * b;
+  EXPECT_LT((dx - pinv).norm(), 1e-12 * pinv.norm());
 }
 
 TEST(EigenNewton, ZeroJacobianWithoutRootStalls) {

@@ -66,6 +66,40 @@ TEST(RankReport, TallMatrixHasItsKnownSingularValuesAndNullSpace) {
   EXPECT_LT((N * N.transpose() - exact).norm(), 1e-9);
 }
 
+// The report from the smallest values only (RankOptions::full_spectrum = false) against the
+// exact decomposition J = U S V^T: tall (the contact bar's shape), a spectrum spread over six
+// decades and a null space of `zeros` values at 1e-12; zeros = 9 fills the first block of
+// eight, which must grow. sigma_max by Lanczos to 1e-10 (tolerance 1e-9 of it), the smallest
+// values by inverse iteration on R^T R from a backward-stable QR (each within a small multiple
+// of eps ||J|| = 1e-16; 1e-13 leaves a margin), the null span to eps / gap (gap 1e-6: 1e-9).
+TEST(RankReport, SmallestValuesOnlyAgreeWithTheExactDecomposition) {
+  const int n = 61, m = 2 * n - 2;
+  std::srand(5);
+  const Matrix U = Eigen::HouseholderQR<Matrix>(Matrix::Random(m, m)).householderQ();
+  const Matrix V = Eigen::HouseholderQR<Matrix>(Matrix::Random(n, n)).householderQ();
+  for (const int zeros : {1, 3, 9}) {
+    Vector s(n);
+    for (int i = 0; i < n; ++i)
+      s[i] = i < n - zeros ? std::pow(10.0, -6.0 * i / (n - zeros - 1)) : 1e-12;
+    const Matrix J = U.leftCols(n) * s.asDiagonal() * V.transpose();
+    RankOptions options;
+    options.full_spectrum = false;
+    const RankReport r = rank_report(J, options);
+    EXPECT_EQ(r.rank, n - zeros) << zeros;
+    EXPECT_EQ(r.nullity, zeros);
+    ASSERT_EQ(r.singular_values.size(), n);
+    EXPECT_NEAR(r.singular_values[0], 1.0, 1e-9);
+    EXPECT_TRUE(std::isnan(r.singular_values[n / 2])) << "not computed: NaN";
+    for (int i = n - zeros - 1; i < n; ++i) EXPECT_NEAR(r.singular_values[i], s[i], 1e-13) << i;
+    EXPECT_NEAR(r.gap, s[n - zeros - 1] / 1e-12, 1e-3 * r.gap);
+    const Matrix& N = r.null_directions;
+    ASSERT_EQ(N.cols(), zeros);
+    EXPECT_LT((N.transpose() * N - Matrix::Identity(zeros, zeros)).norm(), 1e-12);
+    const Matrix exact = V.rightCols(zeros) * V.rightCols(zeros).transpose();
+    EXPECT_LT((N * N.transpose() - exact).norm(), 1e-9) << zeros;
+  }
+}
+
 TEST(RankReport, ThresholdIsRelative) {
   // Same matrix scaled by 1e-6: the count must not change (a relative threshold).
   Matrix J(2, 3);

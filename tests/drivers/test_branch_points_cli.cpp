@@ -119,7 +119,11 @@ TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
   const Table t = Table::read_csv(out / "branch_points.csv");
   const int row = verified_row_near(t, 3.5);
   ASSERT_EQ(row, 2) << "row 3 (followed): T = 3.5 after a dip near 3.67 and T = 3.6";
-  EXPECT_NEAR(t.column("period")[static_cast<std::size_t>(row)], 3.5, 1e-8);
+  // 1e-7: in this trace (gap units) T = 3.5 shows as a dip, located by the V-fit of |tau| to
+  // |tau| ~ 1e-8, where the test function's finite-difference noise stops it. Under changes of
+  // the Jacobian's rounding only (its pattern, its factorisation) the located period measured
+  // 3.5 - 6.8e-10, + 2.2e-9, - 2.7e-10 and + 7.0e-8 (|tau| 9.9e-9); a wrong point is 1e-3 away.
+  EXPECT_NEAR(t.column("period")[static_cast<std::size_t>(row)], 3.5, 1e-7);
   const fs::path dir = out / ("branch_point_" + std::to_string(row + 1));
   const Table b = Table::read_csv(dir / "branch.csv");
   EXPECT_EQ(b.rows(), 10u) << "ended early: " << r.err;
