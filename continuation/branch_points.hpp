@@ -65,7 +65,8 @@ struct TestFunctionSample {
 // [J / scale; t^T]. With a reference (the previous point's value), the singular vectors are
 // oriented like the reference's and the value is signed; without one it is positive.
 TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vector& tangent,
-                                         double scale, const TestFunctionValue* reference);
+                                         double scale, const TestFunctionValue* reference,
+                                         bool iterate = false);
 
 class BranchPointDetector {
  public:
@@ -116,9 +117,13 @@ class BranchPointDetector {
   // The point on the hyperplane through the bracket's polyline at s, orthogonal to it, and its
   // test function. Starts from near (a corrected evaluation nearer than the samples: tangent
   // predictor, chord steps on its Jacobian) or else from the samples' cubic Hermite interpolant
-  // (chord steps on chord).
+  // (chord steps on the last evaluation's Jacobian, or on initial before the first).
+  // initial: the chord of the last sample's Jacobian, used until a first evaluation (last) is
+  // made.
   Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref,
-                      const Chord* chord, const Evaluation* near);
+                      const Chord* initial, const Evaluation* last, const Evaluation* near);
+  // The chord of e's Jacobian, made on first use.
+  const Chord& chord_of(const Evaluation& e) const;
   void locate(const std::vector<Sample>& polyline, bool sign_change);
   // chord_of_j: J's Chord when the location made it (nullptr: made here).
   void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,

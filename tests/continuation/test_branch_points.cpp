@@ -3,8 +3,11 @@
 // the attached family, angle between the branches) and passing through on the traced curve.
 #include <gtest/gtest.h>
 
+#include <Eigen/QR>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
+#include <utility>
 
 #include "continuation/branch_points.hpp"
 #include "continuation/follow.hpp"
@@ -116,6 +119,47 @@ TEST(BorderedTestFunction, ChangesSignAcrossASimpleBranchPoint) {
   EXPECT_NEAR(std::abs(before.value), 0.5, 1e-14);
   EXPECT_NEAR(after.value, -before.value * 0.5, 1e-14);  // |0.25| with the opposite sign
   EXPECT_TRUE(after.continued);
+}
+
+// The accepted points' test function comes from inverse iteration on a QR factor (iterate =
+// true), the location's from the SVD; the SVD is the oracle. Matrices [J; t^T] of 41 x 20 with
+// chosen singular values: a regular point (smallest 1e-2, gap 10), one at a located branch
+// point (1e-9) and a cluster (1e-6 and 1.000001e-6, where the iteration falls back to the SVD or
+// converges to the same value). Both are backward stable, so the values agree to a few
+// round-offs of |A| ~ 1 (1e-13 allows ~500 eps); the right vectors, where the gap separates
+// them (>= 1e-2), to round-off over the gap (1 - |v . v'| <= 1e-10).
+TEST(BorderedTestFunction, InverseIterationAgreesWithTheSvd) {
+  const Eigen::Index m = 40, n = 20;
+  std::srand(7);
+  const core::Matrix U = Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(m + 1, n))
+                             .householderQ() *
+                         core::Matrix::Identity(m + 1, n);
+  const core::Matrix V =
+      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(n, n)).householderQ();
+  for (const auto& [smallest, second] :
+       {std::pair{1e-2, 1e-1}, std::pair{1e-9, 1e-1}, std::pair{1e-6, 1.000001e-6}}) {
+    core::Vector sigma = core::Vector::LinSpaced(n, 1.0, 0.2);
+    sigma[n - 2] = second;
+    sigma[n - 1] = smallest;
+    const core::Matrix bordered = U * sigma.asDiagonal() * V.transpose();
+    // Split into J and t so that bordered_test_function rebuilds [J; t^T] (t is normalised
+    // there: scale the whole matrix by |t| first).
+    const double t_norm = bordered.row(m).norm();
+    const core::Matrix J = bordered.topRows(m) / t_norm;
+    const core::Vector t = bordered.row(m).transpose() / t_norm;
+    const auto svd = continuation::bordered_test_function(J, t, 0.0, nullptr, false);
+    const auto iterated = continuation::bordered_test_function(J, t, 0.0, nullptr, true);
+    EXPECT_NEAR(iterated.value, svd.value, 1e-13) << smallest;
+    EXPECT_NEAR(svd.value, smallest / t_norm, 1e-13) << smallest;
+    if (second / smallest >= 10) {
+      EXPECT_LE(1 - std::abs(iterated.right.dot(svd.right)), 1e-10) << smallest;
+      EXPECT_LE(1 - std::abs(iterated.left.dot(svd.left)), 1e-10) << smallest;
+    }
+    // From a reference (the previous point's triplet), signed and oriented alike.
+    const auto svd_ref = continuation::bordered_test_function(J, t, 0.0, &svd, false);
+    const auto iterated_ref = continuation::bordered_test_function(J, t, 0.0, &svd, true);
+    EXPECT_NEAR(iterated_ref.value, svd_ref.value, 1e-13) << smallest;
+  }
 }
 
 // The line x = 0 traced upwards in lambda crosses x = lambda - 1 at (0, 1): one candidate,
