@@ -241,10 +241,10 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
         std::max(out.check_error, tolerance > 0 ? error / tolerance : (error > 0 ? HUGE_VAL : 0.0));
   }
   if (!(out.check_error <= 1)) {
-    if (!pattern.wider) return fall_back();
+    if (!pattern.wider && !pattern.make_wider) return fall_back();
     CompressedJacobianReport wider;
-    const EvalStatus ws =
-        compressed_finite_difference_jacobian(problem, x, *pattern.wider, J, options, &wider);
+    const EvalStatus ws = compressed_finite_difference_jacobian(
+        problem, x, pattern.wider ? *pattern.wider : pattern.make_wider(), J, options, &wider);
     out.widened = true;
     out.fell_back = wider.fell_back;
     out.residuals += wider.residuals;

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -64,6 +65,10 @@ struct JacobianPattern {
   std::vector<std::vector<int>> row_columns;  // num_equations() rows
   std::vector<int> dense_columns;
   std::shared_ptr<const JacobianPattern> wider;  // may be empty
+  // Or the wider pattern built only when the check fails, for one that costs as much to build
+  // as a residual (used when `wider` is empty; may be empty). Called before the Jacobian call
+  // that asked for the pattern returns: it may refer to the problem.
+  std::function<JacobianPattern()> make_wider;
   // The check's relative tolerance tau (compressed_jacobian.cpp): entries this pattern drops
   // pass unnoticed up to about tau of their row's size. A narrow pattern with a `wider` one
   // behind it can ask for less than the default 1e-3, so that what it drops is negligible

@@ -309,17 +309,6 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   const double test_element = length / m;
   const bool paper = formulation() == core::ShootingFormulation::displacement_periodicity;
   const double reach = c * (paper ? period : 0.5 * period);
-  std::vector<std::pair<double, double>> pieces;
-  // Unknowns k whose support [node[k], node[k + 2]] meets a folded piece.
-  auto columns_meeting = [&](const std::pair<double, double>& piece, auto&& add) {
-    const auto [lo, hi] = piece;
-    const int first = static_cast<int>(std::lower_bound(node.begin(), node.end(), lo) -
-                                       node.begin());  // node[first] >= lo
-    for (int k = std::max(0, first - 2); k < nodal; ++k) {
-      if (node[static_cast<std::size_t>(k)] > hi) break;
-      if (node[static_cast<std::size_t>(std::min(k + 2, n))] >= lo) add(k);
-    }
-  };
   bar::History history;
   if (paper) {
     // u(x, T) also holds the displacement the free end keeps from each contact release: after
@@ -339,7 +328,23 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
       return std::nullopt;
     }
   }
-  auto with_margin = [&](double margin) {
+  // By value: the wider pattern is built after this returns, when a check asks for it.
+  const auto nodes = std::make_shared<const std::vector<double>>(std::move(node));
+  const auto contact = std::make_shared<const bar::History>(std::move(history));
+  auto with_margin = [=, this](double margin) {
+    const std::vector<double>& node = *nodes;
+    const bar::History& history = *contact;
+    std::vector<std::pair<double, double>> pieces;
+    // Unknowns k whose support [node[k], node[k + 2]] meets a folded piece.
+    auto columns_meeting = [&](const std::pair<double, double>& piece, auto&& add) {
+      const auto [lo, hi] = piece;
+      const int first = static_cast<int>(std::lower_bound(node.begin(), node.end(), lo) -
+                                         node.begin());  // node[first] >= lo
+      for (int k = std::max(0, first - 2); k < nodal; ++k) {
+        if (node[static_cast<std::size_t>(k)] > hi) break;
+        if (node[static_cast<std::size_t>(std::min(k + 2, n))] >= lo) add(k);
+      }
+    };
     core::JacobianPattern pattern;
     pattern.row_columns.resize(static_cast<std::size_t>(num_equations()));
     for (int j = 0; j < options_.free_knots; ++j) pattern.dense_columns.push_back(knot_index(j));
@@ -384,13 +389,14 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   // their `wider` pattern. Measured on the mode-1 trace at N = 100 (README.md, section
   // 'Cost'): the bare supports' check errors reach 2.5e-5 of the row (the c dt pattern's own
   // 1.1e-5: finite-difference error and kinks), 18 of 369 Jacobians were widened, 3x fewer
-  // residuals than the c dt pattern alone. The exact solver follows the characteristics
+  // residuals than the c dt pattern alone; the c dt pattern is built only for those (building
+  // both every time was 5 % of the N = 160 trace). The exact solver follows the characteristics
   // exactly: the bare supports are its structural pattern.
   core::JacobianPattern pattern = with_margin(test_element);
   if (!tdbem) return pattern;
   pattern.check_tolerance = 1e-4;
-  pattern.wider = std::make_shared<const core::JacobianPattern>(
-      with_margin(test_element + c * time_step(period)));
+  const double wide = test_element + c * time_step(period);
+  pattern.make_wider = [with_margin, wide] { return with_margin(wide); };
   return pattern;
 }
 

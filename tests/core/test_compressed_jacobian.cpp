@@ -169,6 +169,19 @@ TEST(CompressedJacobian, AFailedCheckTriesTheWiderPatternBeforeColumnByColumn) {
   EXPECT_EQ(report.residuals, (1 + 3 + 1) + (1 + 4 + 1));
   ASSERT_EQ(finite_difference_jacobian(wrong, x, dense), EvalStatus::ok);
   EXPECT_EQ((J - dense).cwiseAbs().maxCoeff(), 0.0);
+  // The same wider pattern built on demand: built once, the same Jacobian and residuals.
+  JacobianPattern on_demand = wrong.pattern();
+  int built = 0;
+  on_demand.make_wider = [&] {
+    ++built;
+    return right.pattern();
+  };
+  ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, on_demand, J, {}, &report),
+            EvalStatus::ok);
+  EXPECT_EQ(built, 1);
+  EXPECT_TRUE(report.widened);
+  EXPECT_EQ(report.residuals, (1 + 3 + 1) + (1 + 4 + 1));
+  EXPECT_EQ((J - dense).cwiseAbs().maxCoeff(), 0.0);
   // A wider pattern that is wrong too ends column by column.
   pattern.wider = std::make_shared<const JacobianPattern>(wrong.pattern());
   ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, pattern, J, {}, &report),
