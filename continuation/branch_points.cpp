@@ -26,8 +26,8 @@ namespace {
 // of sigma; sigma's own error is of its square over the gap) is below 1e-10 sigma plus 1e-14
 // |A|_F, the round-off of the solves; false when it is not within max_iterations (a cluster of
 // small singular values converges slowly): the caller falls back to the SVD.
-bool smallest_singular_triplet(const core::Matrix& A, const core::Vector& start,
-                               core::Vector& left, core::Vector& right, double& sigma) {
+bool smallest_singular_triplet(const core::Matrix& A, const core::Vector& start, core::Vector& left,
+                               core::Vector& right, double& sigma) {
   const Eigen::Index n = A.cols();
   if (A.rows() < n || n == 0) return false;
   const Eigen::HouseholderQR<core::Matrix> qr(A);
@@ -337,12 +337,9 @@ bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vecto
   return false;
 }
 
-BranchPointDetector::Evaluation BranchPointDetector::evaluate(const std::vector<Sample>& polyline,
-                                                              double s,
-                                                              const TestFunctionValue& reference,
-                                                              const Chord* initial,
-                                                              const Evaluation* last,
-                                                              const Evaluation* near) {
+BranchPointDetector::Evaluation BranchPointDetector::evaluate(
+    const std::vector<Sample>& polyline, double s, const TestFunctionValue& reference,
+    const Chord* initial, const Evaluation* last, const Evaluation* near) {
   Evaluation e;
   std::size_t i = 0;
   while (i + 2 < polyline.size() && s > polyline[i + 1].s) ++i;

@@ -131,9 +131,9 @@ TEST(BorderedTestFunction, ChangesSignAcrossASimpleBranchPoint) {
 TEST(BorderedTestFunction, InverseIterationAgreesWithTheSvd) {
   const Eigen::Index m = 40, n = 20;
   std::srand(7);
-  const core::Matrix U = Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(m + 1, n))
-                             .householderQ() *
-                         core::Matrix::Identity(m + 1, n);
+  const core::Matrix U =
+      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(m + 1, n)).householderQ() *
+      core::Matrix::Identity(m + 1, n);
   const core::Matrix V =
       Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(n, n)).householderQ();
   for (const auto& [smallest, second] :
