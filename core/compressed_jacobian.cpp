@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 
 #include "core/errors.hpp"
 
@@ -89,12 +90,13 @@ double check_weight(int j) {
 // and colouring costs O(entries x row width), about a tenth of a mode-1 trace at N = 160
 // (perf record); comparing the pattern costs O(entries). The colouring is a function of the
 // pattern alone, so the cache changes no result.
-Colouring cached_colour(const JacobianPattern& pattern, int m, int n) {
+// Shared, so that a wider pattern's colouring (which may evict this one) leaves it intact.
+std::shared_ptr<const Colouring> cached_colour(const JacobianPattern& pattern, int m, int n) {
   struct Entry {
     std::vector<std::vector<int>> row_columns;
     std::vector<int> dense_columns;
     int m = -1, n = -1;
-    Colouring colouring;
+    std::shared_ptr<const Colouring> colouring;
   };
   // Two entries, the most recent first: a narrow pattern and the `wider` one behind it.
   thread_local std::array<Entry, 2> cache;
@@ -107,7 +109,8 @@ Colouring cached_colour(const JacobianPattern& pattern, int m, int n) {
     }
   }
   Entry fresh{pattern.row_columns, pattern.dense_columns, m, n,
-              colour(pattern, m, n)};  // throws on a malformed pattern: nothing cached
+              std::make_shared<const Colouring>(
+                  colour(pattern, m, n))};  // throws on a malformed pattern: nothing cached
   cache[1] = std::move(cache[0]);
   cache[0] = std::move(fresh);
   return cache[0].colouring;
@@ -128,7 +131,8 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
   out = {};
   const int n = problem.num_unknowns();
   const int m = problem.num_equations();
-  const Colouring c = cached_colour(pattern, m, n);  // a copy: a wider pattern recolours
+  const std::shared_ptr<const Colouring> colouring = cached_colour(pattern, m, n);
+  const Colouring& c = *colouring;
   out.colours = c.colours;
   const bool central = options.scheme == FiniteDifferenceOptions::Scheme::central;
   const double rel = relative_step(options);
@@ -241,10 +245,10 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
         std::max(out.check_error, tolerance > 0 ? error / tolerance : (error > 0 ? HUGE_VAL : 0.0));
   }
   if (!(out.check_error <= 1)) {
-    if (!pattern.wider && !pattern.make_wider) return fall_back();
+    if (!pattern.wider) return fall_back();
     CompressedJacobianReport wider;
-    const EvalStatus ws = compressed_finite_difference_jacobian(
-        problem, x, pattern.wider ? *pattern.wider : pattern.make_wider(), J, options, &wider);
+    const EvalStatus ws =
+        compressed_finite_difference_jacobian(problem, x, pattern.wider(), J, options, &wider);
     out.widened = true;
     out.fell_back = wider.fell_back;
     out.residuals += wider.residuals;

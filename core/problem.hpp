@@ -22,7 +22,6 @@
 
 #include <atomic>
 #include <functional>
-#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -60,15 +59,15 @@ struct EvaluationCounters {
 // may be nonzero in every row. Every entry outside is taken as exactly 0 by the compressed
 // finite-difference Jacobian (compressed_jacobian.hpp), which verifies that claim at each use.
 // A pattern may name a wider one to try when its check fails, before column by column (e.g. a
-// pattern exact near the solutions and a structural bound everywhere).
+// pattern exact near the solutions and a structural bound everywhere); it is built only then.
 struct JacobianPattern {
   std::vector<std::vector<int>> row_columns;  // num_equations() rows
   std::vector<int> dense_columns;
-  std::shared_ptr<const JacobianPattern> wider;  // may be empty
-  // Or the wider pattern built only when the check fails, for one that costs as much to build
-  // as a residual (used when `wider` is empty; may be empty). Called before the Jacobian call
-  // that asked for the pattern returns: it may refer to the problem.
-  std::function<JacobianPattern()> make_wider;
+  // Builds the wider pattern when the check fails (may be empty: none). Called before the
+  // Jacobian call that asked for the pattern returns, so it may refer to the problem; a pattern
+  // can cost as much to build as a residual (the contact bar's), and the wider one is seldom
+  // needed.
+  std::function<JacobianPattern()> wider;
   // The check's relative tolerance tau (compressed_jacobian.cpp): entries this pattern drops
   // pass unnoticed up to about tau of their row's size. A narrow pattern with a `wider` one
   // behind it can ask for less than the default 1e-3, so that what it drops is negligible

@@ -113,7 +113,7 @@ bool smallest_singular_values(const Matrix& J, const RankOptions& options, RankR
     return false;
 
   // sigma_max: Golub-Kahan-Lanczos bidiagonalisation of R (fully reorthogonalised), the largest
-  // singular value of its bidiagonal, until that moves by less than 1e-13 of itself (at most
+  // singular value of its bidiagonal, until that moves by less than 1e-10 of itself (at most
   // 60 steps; Lanczos finds the extreme values in a few tens of steps where power iteration on
   // a clustered top of the spectrum took hundreds, and left 0.3 % on the contact bar).
   double sigma_max = 0;

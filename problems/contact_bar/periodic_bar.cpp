@@ -396,7 +396,7 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   if (!tdbem) return pattern;
   pattern.check_tolerance = 1e-4;
   const double wide = test_element + c * time_step(period);
-  pattern.make_wider = [with_margin, wide] { return with_margin(wide); };
+  pattern.wider = [with_margin, wide] { return with_margin(wide); };
   return pattern;
 }
 
