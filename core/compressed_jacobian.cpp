@@ -179,7 +179,7 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
     }
     status[ts] = st;
   };
-  run_striped(tasks, options.threads, task);
+  run_tasks(tasks, options.threads, task);
   out.residuals += tasks * (central ? 2 : 1);
   auto fall_back = [&] {
     out.fell_back = true;

@@ -60,7 +60,7 @@ EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, M
     status[static_cast<std::size_t>(j)] = s;
   };
 
-  run_striped(n, options.threads, column);
+  run_tasks(n, options.threads, column);
   for (EvalStatus s : status)
     if (s != EvalStatus::ok) return s;
   return EvalStatus::ok;
@@ -95,17 +95,19 @@ EvalStatus Problem::compute_jacobian(const Vector& x, Matrix& J) const {
   return s;
 }
 
-void run_striped(int tasks, int threads, const std::function<void(int)>& task) {
+void run_tasks(int tasks, int threads, const std::function<void(int)>& task) {
   threads = std::max(1, std::min(threads, tasks));
   if (threads == 1) {
     for (int t = 0; t < tasks; ++t) task(t);
     return;
   }
+  std::atomic<int> next{0};
+  const auto work = [&] {
+    for (int t = next++; t < tasks; t = next++) task(t);
+  };
   std::vector<std::thread> pool;
-  for (int k = 0; k < threads; ++k)
-    pool.emplace_back([&, k] {
-      for (int t = k; t < tasks; t += threads) task(t);
-    });
+  for (int k = 1; k < threads; ++k) pool.emplace_back(work);
+  work();
   for (auto& th : pool) th.join();
 }
 

@@ -77,16 +77,18 @@ std::vector<int> parse_element_list(const std::string& text,
 
 // The finite-difference Jacobian (core::finite_difference_jacobian) of the mode-1 shooting
 // residual at its first point (the closed-form orbit of the trace's start, end amplitude
-// 1.25 g0) on a grid of `elements` intervals, with 1 and 2 threads: best of `repetitions` wall
-// times each (the process CPU time of those runs too), and whether both matrices are identical.
+// 1.25 g0) on a grid of `elements` intervals, with 1 and 2 threads, `repetitions` times each
+// in alternation: the median wall and process CPU times, and whether both matrices are
+// identical.
 struct JacobianThreadsTiming {
   int elements = 0;
   int rows = 0, columns = 0;
-  double one_thread_seconds = 0, two_thread_seconds = 0;  // wall, best of the repetitions
-  double one_thread_cpu = 0, two_thread_cpu = 0;          // process CPU of that best run
+  int repetitions = 0;
+  double one_thread_seconds = 0, two_thread_seconds = 0;  // wall, median of the repetitions
+  double one_thread_cpu = 0, two_thread_cpu = 0;          // process CPU, median
   bool identical = false;                                 // bit for bit
   double speedup() const { return one_thread_seconds / two_thread_seconds; }
 };
-JacobianThreadsTiming time_jacobian_threads(int elements, int repetitions = 3);
+JacobianThreadsTiming time_jacobian_threads(int elements, int repetitions = 21);
 
 }  // namespace backbone::contact_bar
