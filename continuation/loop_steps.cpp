@@ -91,7 +91,8 @@ void LoopSteps::resume(const LoopState& state, bool record) {
           ? state.tangent
           : (state.previous.size() > 0 ? core::Vector(state.z - state.previous) : core::Vector());
   BranchPoint point =
-      recorder_.finish(state.z, state.index, 0, 0.0, state.arclength, true, direction);
+      recorder_.finish(state.z, state.index, 0, 0.0, state.arclength, true, direction,
+                       state.previous.size() > 0 ? &state.previous : nullptr);
   point.state = std::make_shared<LoopState>(state);
   push(std::move(point));
 }
@@ -175,8 +176,8 @@ bool LoopSteps::record(const core::Vector& x, const core::Vector& y, const core:
       curve_direction
           ? *curve_direction
           : (state && state->tangent.size() == y.size() ? state->tangent : core::Vector(y - x));
-  BranchPoint point =
-      recorder_.finish(y, next_index(), newton_iterations, ds, arclength_, force_rank, direction);
+  BranchPoint point = recorder_.finish(y, next_index(), newton_iterations, ds, arclength_,
+                                       force_rank, direction, &x);
   double bound_value = 0;
   if (const Bound* bound = recorder_.violated_bound(point, bound_value)) {
     land_on_bound(*bound, bound_value, x, y, forward, ds, arclength_at_x);
@@ -215,7 +216,7 @@ void LoopSteps::land_on_bound(const Bound& bound, double value, const core::Vect
   if (!landed) return;
   const double chord = (z - x).norm();
   push(recorder_.finish(z, index, s.iterations, chord, arclength_at_x + chord, true,
-                        core::Vector(z - x)));
+                        core::Vector(z - x), &x));
   branch_.message = fmt::format("{} reached its bound {:.6g} (point {} lies on it)",
                                 bound.observable, value, index);
 }

@@ -26,7 +26,8 @@ double PointRecorder::elapsed_seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_direction) {
+void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_direction,
+                               const core::Vector* previous) {
   core::Matrix J;
   if (problem_.jacobian(point.x, J) != core::EvalStatus::ok) return;
   core::RankOptions rank = options_.rank;
@@ -35,17 +36,17 @@ void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_dir
   const core::Matrix* nearby = options_.chord_corrections ? &J : nullptr;
   if (verifier_) {
     core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, report,
-                                 nearby);
+                                 nearby, previous);
     point.dimension = report.verified_dimension;
   } else {
     point.dimension = report.nullity;
   }
   point.rank = std::move(report);
-  recheck_dimension(point, curve_direction, nearby);
+  recheck_dimension(point, curve_direction, nearby, previous);
 }
 
 void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,
-                                      const core::Matrix* jacobian) {
+                                      const core::Matrix* jacobian, const core::Vector* previous) {
   if (!verifier_ || !point.rank || point.rank->verified_dimension < 0 || point.dimension >= 1)
     return;
   point.dimension_flag = DimensionFlag::unconfirmed;
@@ -54,7 +55,7 @@ void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& cu
   core::RankReport along;
   along.null_directions = curve_direction / norm;
   core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, along,
-                               jacobian);
+                               jacobian, previous);
   if (along.verified_dimension != 1) return;
   // The curve is there. The rest of the candidate null space, orthogonal to it: the columns of
   // an orthonormal basis of span(D) after the curve direction's component in it.
@@ -70,13 +71,14 @@ void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& cu
   core::RankReport others;
   others.null_directions = D * Q.rightCols(k - 1);
   core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, others,
-                               jacobian);
+                               jacobian, previous);
   point.dimension += std::max(others.verified_dimension, 0);
 }
 
 BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_iterations,
                                   double ds, double arclength, bool force_rank,
-                                  const core::Vector& curve_direction) {
+                                  const core::Vector& curve_direction,
+                                  const core::Vector* previous) {
   BranchPoint p;
   p.index = index;
   p.x = x;
@@ -89,7 +91,8 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   p.step_size = ds;
   p.arclength = arclength;
   const bool due = options_.rank_check_every > 0 && index % options_.rank_check_every == 0;
-  if (due || (force_rank && options_.rank_check_every > 0)) check_rank(p, curve_direction);
+  if (due || (force_rank && options_.rank_check_every > 0))
+    check_rank(p, curve_direction, previous);
   p.residual_evaluations = counted_.counters().residuals - residuals_at_start_;
   p.jacobian_evaluations = counted_.counters().jacobians - jacobians_at_start_;
   p.seconds = elapsed_seconds();

@@ -37,17 +37,22 @@ class PointRecorder {
   void begin();
   // Fills a BranchPoint; runs the rank report when index % rank_check_every == 0 or force_rank.
   // curve_direction: the direction of the traced curve at x (empty: unknown), for the re-check.
+  // previous: the branch's point before x (nullptr: none), a known neighbour for the
+  // verification (core::verify_null_directions).
   BranchPoint finish(const core::Vector& x, int index, int newton_iterations, double ds,
-                     double arclength, bool force_rank, const core::Vector& curve_direction = {});
+                     double arclength, bool force_rank, const core::Vector& curve_direction = {},
+                     const core::Vector* previous = nullptr);
   // Rank report (and verification) at an already recorded point.
-  void check_rank(BranchPoint& point, const core::Vector& curve_direction = {});
+  void check_rank(BranchPoint& point, const core::Vector& curve_direction = {},
+                  const core::Vector* previous = nullptr);
   // With a verified dimension below 1 and a verifier: probes curve_direction; when it is real,
   // the dimension is 1 plus the verified candidate directions orthogonal to it (flag
   // rechecked), else the flag says unconfirmed. Nothing happens at a point of dimension >= 1.
   // jacobian: J at point.x when the caller has it (the probes then start with chord steps on
   // it, ContinuationOptions::chord_corrections).
   void recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,
-                         const core::Matrix* jacobian = nullptr);
+                         const core::Matrix* jacobian = nullptr,
+                         const core::Vector* previous = nullptr);
   // First bound the point violates, or nullptr; `value` receives the bound value crossed.
   const Bound* violated_bound(const BranchPoint& point, double& value) const;
   double elapsed_seconds() const;

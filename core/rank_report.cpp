@@ -266,6 +266,20 @@ bool found_neighbour(const Probe& p, const VerifyOptions& options) {
   return p.converged && p.drift <= options.drift_ratio;
 }
 
+// A probe's verdict from a solution z already known near x (the branch's previous point), as
+// if a probe had stepped by h = d . (z - x) and been corrected onto z: the same tests of F(z)
+// and of the drift (the caller has checked ||F(z)||_inf <= residual_tolerance, once).
+Probe known_neighbour(const Vector& x, const Vector& d, const Vector& z) {
+  Probe result;
+  const Vector e = z - x;
+  const double h = d.dot(e);
+  if (!(std::abs(h) > 0) || !std::isfinite(h)) return result;
+  result.converged = true;
+  result.secant = e / h;
+  result.drift = (e - h * d).norm() / std::abs(h);
+  return result;
+}
+
 // Probes along +d, and along -d when +d finds no neighbour: at a point on the boundary of a
 // manifold (a grazing limit of a continuum) only one side holds solutions.
 Probe probe_either_side(const Problem& problem, const Vector& x, const Vector& d, double h,
@@ -281,7 +295,7 @@ Probe probe_either_side(const Problem& problem, const Vector& x, const Vector& d
 
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
                             const VerifyOptions& options, RankReport& report,
-                            const Matrix* jacobian_at_x) {
+                            const Matrix* jacobian_at_x, const Vector* neighbour) {
   options.validate();
   const int n = problem.num_unknowns();
   if (x.size() != n || report.null_directions.rows() != n)
@@ -300,14 +314,28 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
     return options.step * (s > 0 ? s : 1.0);
   };
 
+  // A known neighbour stands in for the probe of the direction it verifies.
+  bool neighbour_ok = false;
+  if (neighbour && neighbour->size() == n && neighbour->allFinite()) {
+    Vector f;
+    neighbour_ok = problem.residual(*neighbour, f) == EvalStatus::ok &&
+                   f.lpNorm<Eigen::Infinity>() <= options.residual_tolerance;
+  }
+  const auto probe_direction = [&](const Vector& d) {
+    if (neighbour_ok) {
+      Probe known = known_neighbour(x, d, *neighbour);
+      if (found_neighbour(known, options)) return known;
+    }
+    return probe_either_side(problem, x, d, step_along(d), corrector, options, jacobian_at_x);
+  };
+
   // Pass 1: probe the candidate basis as given.
   Matrix D = report.null_directions;
   std::vector<Probe> first(static_cast<std::size_t>(k));
   bool all_verified = true;
   for (int i = 0; i < k; ++i) {
     auto& p = first[static_cast<std::size_t>(i)];
-    p = probe_either_side(problem, x, D.col(i), step_along(D.col(i)), corrector, options,
-                          jacobian_at_x);
+    p = probe_direction(D.col(i));
     all_verified = all_verified && found_neighbour(p, options);
   }
   if (all_verified) {
@@ -335,8 +363,7 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
   }
   int verified = 0;
   for (int i = 0; i < k; ++i) {
-    const Probe p = probe_either_side(problem, x, D.col(i), step_along(D.col(i)), corrector,
-                                      options, jacobian_at_x);
+    const Probe p = probe_direction(D.col(i));
     const bool real = found_neighbour(p, options);
     report.direction_verified[static_cast<std::size_t>(i)] = real;
     verified += real ? 1 : 0;

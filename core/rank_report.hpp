@@ -90,9 +90,16 @@ RankReport rank_report(const Matrix& J, const RankOptions& options);
 // jacobian_at_x (J of problem at x, when the caller has it) starts every probe's correction
 // with chord steps on its factorization (core/newton.hpp): a probe steps by `step`, so J(x) is
 // as good as a fresh one there, and a probe costs a few residuals instead of a Jacobian.
+// neighbour (a solution already known near x: the branch's previous point) stands in for the
+// probe of a direction d it verifies by the same tests, as if a probe had stepped by
+// h = d . (neighbour - x) and been corrected onto it: ||F(neighbour)||_inf <= residual_tolerance
+// and |neighbour - x - h d| <= drift_ratio |h|. On a curve the one candidate is the tangent,
+// which the secant to the previous point verifies: one residual instead of a correction
+// (core/README.md, 'Rank reports').
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
                             const VerifyOptions& options, RankReport& report,
-                            const Matrix* jacobian_at_x = nullptr);
+                            const Matrix* jacobian_at_x = nullptr,
+                            const Vector* neighbour = nullptr);
 
 // The candidates where J(x) cannot give them: at a point where F is not differentiable (the
 // grazing limit of a contact family, where a contact phase vanishes, forward differences mix

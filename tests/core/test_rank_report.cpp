@@ -216,6 +216,47 @@ TEST(VerifyNullDirections, CircleIsACurve) {
   }
 }
 
+// A known neighbour (the branch's previous point) verifies the direction it lies along by the
+// probe's own tests, for the price of one residual; one that lies off the candidate direction
+// (drift above drift_ratio 0.1) or off the solution set leaves the probe to run.
+TEST(VerifyNullDirections, AKnownNeighbourAlongTheDirectionStandsInForItsProbe) {
+  Sphere circle(2);
+  const double a = std::atan2(0.8, 0.6);
+  const auto on_circle = [](double angle) {
+    Vector z(2);
+    z << std::cos(angle), std::sin(angle);
+    return z;
+  };
+  const Vector x = on_circle(a);
+  Matrix J;
+  ASSERT_EQ(circle.jacobian(x, J), EvalStatus::ok);
+  EigenNewton eigen(tight());
+  struct Case {
+    Vector neighbour;
+    bool probed;
+  };
+  // The chord to angle a + t leaves the tangent at x by tan(t / 2) of its length: 0.05 at
+  // t = 0.1 (stands in), 0.26 at t = 0.5 (too far off). The third lies 0.01 along the tangent,
+  // 5e-5 off the circle (|F| 1e-4 > residual_tolerance 1e-9).
+  Vector tangent(2);
+  tangent << -0.8, 0.6;
+  const Vector off = x + 0.01 * tangent;
+  for (const Case& c :
+       {Case{on_circle(a + 0.1), false}, Case{on_circle(a - 0.5), true}, Case{off, true}}) {
+    RankReport r = rank_report(J, RankOptions{});
+    const long residuals = circle.counters().residuals, jacobians = circle.counters().jacobians;
+    verify_null_directions(circle, x, eigen, VerifyOptions{}, r, nullptr, &c.neighbour);
+    EXPECT_EQ(r.verified_dimension, 1) << r.summary();
+    const long used = circle.counters().residuals - residuals;
+    if (c.probed) {
+      EXPECT_GT(used, 1);  // the neighbour's residual, then the probe's
+    } else {
+      EXPECT_EQ(used, 1);
+      EXPECT_EQ(circle.counters().jacobians, jacobians);
+    }
+  }
+}
+
 TEST(VerifyNullDirections, SphereIsASurface) {
   Sphere sphere(3);
   Vector x(3);
