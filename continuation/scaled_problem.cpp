@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/compressed_jacobian.hpp"
 #include "core/errors.hpp"
 
 namespace backbone::continuation {
@@ -74,8 +75,10 @@ core::EvalStatus ScaledProblem::compute_jacobian(const core::Vector& z, core::Ma
 core::EvalStatus ScaledProblem::base_jacobian(const core::Vector& x, core::Matrix& J_x) const {
   {
     const std::lock_guard<std::mutex> lock(cache_mutex_);
-    // Exact equality: the same point, so the base would return the same matrix.
-    if (cached_x_.size() == x.size() && cached_x_ == x) {
+    // Exact equality: the same point, so the base would return the same matrix (checked to
+    // the same tolerance: a corrector's looser Jacobian is not a rank report's).
+    if (cached_x_.size() == x.size() && cached_x_ == x &&
+        cached_check_tolerance_ == core::CorrectorJacobians::tolerance()) {
       J_x = cached_base_jacobian_;
       return core::EvalStatus::ok;
     }
@@ -85,6 +88,7 @@ core::EvalStatus ScaledProblem::base_jacobian(const core::Vector& x, core::Matri
   const std::lock_guard<std::mutex> lock(cache_mutex_);
   cached_x_ = x;
   cached_base_jacobian_ = J_x;
+  cached_check_tolerance_ = core::CorrectorJacobians::tolerance();
   return s;
 }
 

@@ -115,6 +115,7 @@ class ScaledProblem : public core::Problem {
   mutable std::mutex cache_mutex_;  // compute_jacobian may be called from several threads
   mutable core::Vector cached_x_;   // the base's unknowns; empty: nothing cached
   mutable core::Matrix cached_base_jacobian_;
+  mutable double cached_check_tolerance_ = 0;  // core::CorrectorJacobians in force then
 };
 
 }  // namespace backbone::continuation

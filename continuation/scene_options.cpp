@@ -68,6 +68,10 @@ po::options_description continuation_keys(const po::options_description& problem
   add("newton_reuse_jacobian", po::value<bool>()->default_value(false),
       "eigen corrector: after a fresh Jacobian, take chord steps on its factorization while each "
       "cuts ||F|| tenfold (one residual each), else a fresh Jacobian");
+  add("newton_jacobian_check", po::value<double>()->default_value(1e-2),
+      "eigen corrector: accept a compressed Jacobian whose check error is below this fraction "
+      "of each row (the answer is judged by F alone); rank reports keep the pattern's own; 0: "
+      "the pattern's own everywhere");
   add("chord_corrections", po::value<bool>()->default_value(true),
       "arclength: start each correction (and each rank-verification probe) with chord steps on "
       "the previous point's Jacobian, a fresh Jacobian only when they contract too slowly");
@@ -153,6 +157,11 @@ RunSettings read_run_settings(const core::Scene& scene) {
       std::max(o.verification.residual_tolerance, run.newton_options.residual_tolerance);
   run.newton_options.max_iterations = static_cast<int>(scene.integer("newton_max_iterations", 1));
   run.newton_options.reuse_jacobian = scene.flag("newton_reuse_jacobian");
+  run.newton_options.jacobian_check_tolerance = scene.non_negative("newton_jacobian_check");
+  if (!(run.newton_options.jacobian_check_tolerance < 1))
+    throw core::InputError(
+        "newton_jacobian_check",
+        fmt::format("must be in [0, 1) (got {})", run.newton_options.jacobian_check_tolerance));
   o.chord_corrections = scene.flag("chord_corrections");
   run.formulation = core::parse_formulation(scene.text("formulation"));
   run.natural_parameter = scene.text("natural_parameter");

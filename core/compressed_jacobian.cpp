@@ -235,7 +235,7 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
       }
     }
   }
-  const double tau = pattern.check_tolerance;
+  const double tau = std::max(pattern.check_tolerance, CorrectorJacobians::tolerance());
   constexpr double sigma = 1e-2;
   const double floor = sigma * (m > 0 ? size.maxCoeff() : 0.0);
   for (int i = 0; i < m; ++i) {
@@ -255,6 +255,22 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
     return ws;
   }
   return EvalStatus::ok;
+}
+
+namespace {
+thread_local double corrector_check_tolerance = 0;
+}  // namespace
+
+CorrectorJacobians::CorrectorJacobians(double tolerance) : outer_(corrector_check_tolerance) {
+  corrector_check_tolerance = tolerance;
+}
+
+CorrectorJacobians::~CorrectorJacobians() {
+  corrector_check_tolerance = outer_;
+}
+
+double CorrectorJacobians::tolerance() {
+  return corrector_check_tolerance;
 }
 
 }  // namespace backbone::core

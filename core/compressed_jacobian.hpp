@@ -50,4 +50,24 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
                                                  const FiniteDifferenceOptions& options = {},
                                                  CompressedJacobianReport* report = nullptr);
 
+// While one is alive, the compressed Jacobians computed on this thread accept a check error up
+// to `tolerance` of a row where their pattern asks for less (JacobianPattern::check_tolerance):
+// for a corrector, whose answer is judged by F alone, so that an entry of 1e-3 of its row
+// costs at most a slower contraction, not a wider pattern (core/README.md, 'Compressed
+// Jacobians'). Nested scopes: the innermost holds.
+//
+//   { CorrectorJacobians loose(1e-2); problem.jacobian(x, J); }  // checked to 1e-2 only
+class CorrectorJacobians {
+ public:
+  explicit CorrectorJacobians(double tolerance);
+  ~CorrectorJacobians();
+  CorrectorJacobians(const CorrectorJacobians&) = delete;
+  CorrectorJacobians& operator=(const CorrectorJacobians&) = delete;
+  // The tolerance in force on this thread (0: none, the patterns' own).
+  static double tolerance();
+
+ private:
+  double outer_;
+};
+
 }  // namespace backbone::core

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/compressed_jacobian.hpp"
+
 namespace backbone::core {
 
 namespace {
@@ -182,7 +184,10 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
       }
       // Too slow (or not evaluable): a fresh Jacobian at x, in this same iteration.
     }
-    eval = problem.jacobian(x, J);
+    {
+      const CorrectorJacobians loose(options_.jacobian_check_tolerance);
+      eval = problem.jacobian(x, J);
+    }
     if (eval != EvalStatus::ok)
       return finish(NewtonStatus::evaluation_failed,
                     fmt::format("eigen: Jacobian at iteration {}: {}", iteration, to_string(eval)));

@@ -41,6 +41,9 @@ void NewtonOptions::validate() const {
     throw InputError("newton.max_iterations", fmt::format("must be >= 1 (got {})", max_iterations));
   if (!(rank_cutoff >= 0 && rank_cutoff < 1))
     throw InputError("newton.rank_cutoff", fmt::format("must be in [0, 1) (got {})", rank_cutoff));
+  if (!(jacobian_check_tolerance >= 0 && jacobian_check_tolerance < 1))
+    throw InputError("newton.jacobian_check_tolerance",
+                     fmt::format("must be in [0, 1) (got {})", jacobian_check_tolerance));
   if (!(reuse_contraction > 0 && reuse_contraction < 1))
     throw InputError("newton.reuse_contraction",
                      fmt::format("must be in (0, 1) (got {})", reuse_contraction));

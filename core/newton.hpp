@@ -35,6 +35,10 @@ struct NewtonOptions {
   // would reach residual_tolerance); else compute a fresh Jacobian at once.
   bool reuse_jacobian = false;
   double reuse_contraction = 0.1;  // in (0, 1)
+  // Eigen backend: the check tolerance of the compressed Jacobians of its iterations, where
+  // their pattern asks for less (core::CorrectorJacobians): the answer is judged by F alone, so
+  // an entry a pattern drops costs at most a slower contraction. 0: the patterns' own.
+  double jacobian_check_tolerance = 1e-2;  // in [0, 1)
   void validate() const;  // throws InputError naming the field, e.g. "newton.max_iterations"
 };
 

@@ -332,17 +332,17 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   const auto nodes = std::make_shared<const std::vector<double>>(std::move(node));
   const auto contact = std::make_shared<const bar::History>(std::move(history));
   auto with_margin = [=, this](double margin) {
-    const std::vector<double>& node = *nodes;
-    const bar::History& history = *contact;
+    const std::vector<double>& knot = *nodes;
+    const bar::History& events = *contact;
     std::vector<std::pair<double, double>> pieces;
     // Unknowns k whose support [node[k], node[k + 2]] meets a folded piece.
     auto columns_meeting = [&](const std::pair<double, double>& piece, auto&& add) {
       const auto [lo, hi] = piece;
-      const int first = static_cast<int>(std::lower_bound(node.begin(), node.end(), lo) -
-                                         node.begin());  // node[first] >= lo
+      const int first = static_cast<int>(std::lower_bound(knot.begin(), knot.end(), lo) -
+                                         knot.begin());  // knot[first] >= lo
       for (int k = std::max(0, first - 2); k < nodal; ++k) {
-        if (node[static_cast<std::size_t>(k)] > hi) break;
-        if (node[static_cast<std::size_t>(std::min(k + 2, n))] >= lo) add(k);
+        if (knot[static_cast<std::size_t>(k)] > hi) break;
+        if (knot[static_cast<std::size_t>(std::min(k + 2, n))] >= lo) add(k);
       }
     };
     core::JacobianPattern pattern;
@@ -350,11 +350,11 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
     for (int j = 0; j < options_.free_knots; ++j) pattern.dense_columns.push_back(knot_index(j));
     pattern.dense_columns.push_back(period_index());
     std::vector<char> dense(static_cast<std::size_t>(nodal), 0);
-    for (std::size_t k = 1; k < history.t.size(); ++k) {
-      const bool before = history.contact_force[k - 1] > 0, after = history.contact_force[k] > 0;
+    for (std::size_t k = 1; k < events.t.size(); ++k) {
+      const bool before = events.contact_force[k - 1] > 0, after = events.contact_force[k] > 0;
       if (before == after) continue;  // closings too: the margin of one step costs little
       pieces.clear();
-      fold_interval(length - c * history.t[k] - margin, length - c * history.t[k - 1] + margin,
+      fold_interval(length - c * events.t[k] - margin, length - c * events.t[k - 1] + margin,
                     length, pieces);
       for (const auto& piece : pieces)
         columns_meeting(piece, [&](int col) { dense[static_cast<std::size_t>(col)] = 1; });

@@ -124,6 +124,49 @@ TEST(CompressedJacobian, ThreadsGiveTheOneThreadJacobianBitForBit) {
   }
 }
 
+TEST(CompressedJacobian, ACorrectorsScopeLoosensTheCheckAndEndsWithIt) {
+  // The check error is |(J p)_i - d_i| / (tau (size_i + floor)): at the corrector's tau it is
+  // the strict one times 1e-3 / tau, exactly the same differences. Dropping the superdiagonal
+  // gives errors of e > 1 at the default tau 1e-3 (the test above); a scope of 2 e 1e-3 accepts
+  // that Jacobian as it is (no fallback, the dropped entries missing), one of e 1e-3 / 2 does not,
+  // and a nested scope of 0 brings the pattern's own back.
+  const int n = 20;
+  Arrow wrong(n, /*drop_superdiagonal=*/true);
+  const Vector x = point(n);
+  Matrix J;
+  CompressedJacobianReport strict;
+  ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &strict),
+            EvalStatus::ok);
+  ASSERT_TRUE(strict.fell_back);
+  const double e = strict.check_error;
+  ASSERT_GT(e, 2.0);  // (about 1.6e3 here: the scopes below are loose beyond use, but exact)
+  EXPECT_EQ(CorrectorJacobians::tolerance(), 0.0);
+  {
+    const CorrectorJacobians loose(2 * e * 1e-3);
+    CompressedJacobianReport report;
+    ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &report),
+              EvalStatus::ok);
+    EXPECT_FALSE(report.fell_back);
+    EXPECT_NEAR(report.check_error, 0.5, 1e-12);
+    EXPECT_EQ(J(0, 1), 0.0);  // the dropped entry stays dropped
+    {
+      const CorrectorJacobians own(0);
+      ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &report),
+                EvalStatus::ok);
+      EXPECT_TRUE(report.fell_back);
+    }
+    EXPECT_DOUBLE_EQ(CorrectorJacobians::tolerance(), 2 * e * 1e-3);
+  }
+  {
+    const CorrectorJacobians not_enough(0.5 * e * 1e-3);
+    CompressedJacobianReport report;
+    ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &report),
+              EvalStatus::ok);
+    EXPECT_TRUE(report.fell_back);
+  }
+  EXPECT_EQ(CorrectorJacobians::tolerance(), 0.0);
+}
+
 TEST(RunTasks, EachTaskRunsOnceAndTheCallingThreadTakesPart) {
   // The tasks are taken dynamically: every index exactly once, whatever the number of threads
   // (also more threads than tasks), and the calling thread is one of the workers. With 2
