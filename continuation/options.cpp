@@ -20,7 +20,7 @@ const char* to_string(Method m) {
   return "?";
 }
 const char* to_string(Predictor p) {
-  return p == Predictor::secant ? "secant" : "tangent";
+  return p == Predictor::secant ? "secant" : p == Predictor::quadratic ? "quadratic" : "tangent";
 }
 
 Method parse_method(const std::string& name) {
@@ -35,7 +35,9 @@ Method parse_method(const std::string& name) {
 Predictor parse_predictor(const std::string& name) {
   if (name == "secant") return Predictor::secant;
   if (name == "tangent") return Predictor::tangent;
-  throw core::InputError("predictor", fmt::format("must be secant or tangent (got '{}')", name));
+  if (name == "quadratic") return Predictor::quadratic;
+  throw core::InputError("predictor",
+                         fmt::format("must be tangent, secant or quadratic (got '{}')", name));
 }
 
 namespace {

@@ -29,7 +29,7 @@ namespace backbone::continuation {
 
 // natural_then_arclength: natural until it stalls, then pseudo-arclength (switching.hpp).
 enum class Method { natural, arclength, natural_then_arclength };
-enum class Predictor { secant, tangent };
+enum class Predictor { secant, tangent, quadratic };
 const char* to_string(Method m);
 const char* to_string(Predictor p);
 Method parse_method(const std::string& name);        // InputError("method", ...)

@@ -29,7 +29,10 @@ po::options_description continuation_keys(const po::options_description& problem
   add("method", po::value<std::string>()->default_value("arclength"),
       "arclength (pseudo-arclength, passes folds), natural, or natural_then_arclength "
       "(natural until it stalls, then arclength: the paper's strategy)");
-  add("predictor", po::value<std::string>()->default_value("tangent"), "tangent or secant");
+  add("predictor", po::value<std::string>()->default_value("auto"),
+      "tangent, secant, quadratic (the tangent plus the curvature seen from the previous point) "
+      "or auto: quadratic, tangent when branch points are detected (continuation/README.md, "
+      "'Predictors')");
   add("newton", po::value<std::string>()->default_value("eigen"), "corrector: eigen or kinsol");
   add("formulation", po::value<std::string>()->default_value("regular"),
       "shooting residual: regular (v(T/2) = 0) or paper (u0 - u(T) = 0)");
@@ -128,7 +131,8 @@ RunSettings read_run_settings(const core::Scene& scene) {
   RunSettings run;
   ContinuationOptions& o = run.options;
   o.method = parse_method(scene.text("method"));
-  o.predictor = parse_predictor(scene.text("predictor"));
+  const std::string predictor = scene.text("predictor");
+  if (predictor != "auto") o.predictor = parse_predictor(predictor);
   o.ds = scene.positive("ds");
   o.ds_min = scene.positive("ds_min");
   o.ds_max = scene.positive("ds_max");
@@ -143,6 +147,10 @@ RunSettings read_run_settings(const core::Scene& scene) {
   run.follow.max_points = static_cast<int>(scene.integer("follow_max_points", 1));
   o.branch_points.detect = scene.flag("detect_branch_points") ||
                            run.follow.selection.kind != FollowSelection::Kind::none;
+  // The detector samples its test function at the points: it was measured with the tangent
+  // predictor's steps, which the quadratic one lengthens (continuation/README.md, 'Predictors').
+  if (predictor == "auto")
+    o.predictor = o.branch_points.detect ? Predictor::tangent : Predictor::quadratic;
   o.branch_points.max_turn_degrees = scene.non_negative("max_turn_degrees");
   read_bounds(scene, o);
   o.validate();

@@ -496,6 +496,31 @@ TEST(NaturalThenArclength, AddsArclengthInTheSameUnits) {
   expect_arc_to_three(b, expect_chords_of_the_unit_circle(b));
 }
 
+// The quadratic predictor on the unit circle at fixed steps of 0.3 rad: the tangent predictor
+// lands ds^2 / 2 = 0.045 off the circle, the quadratic one, whose curvature estimate from the
+// previous chord is exact up to O(ds), O(ds^3) ~ 1e-2 x that. Every point is on the circle
+// (the oracle |x| = 1), and the quadratic branch needs fewer Newton iterations after point 1
+// (point 1 has no previous point: both predict by the tangent).
+TEST(Continuation, QuadraticPredictorStartsCloserOnACircle) {
+  algebraic::Circle circle;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(12);
+  opt.ds = opt.ds_max = opt.ds_min = 0.3;
+  opt.rank_check_every = 0;
+  int iterations[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    opt.predictor = k == 0 ? continuation::Predictor::tangent : continuation::Predictor::quadratic;
+    const Branch b = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+    ASSERT_EQ(b.points.size(), 12u) << b.message;
+    for (const auto& p : b.points) EXPECT_NEAR(p.x.norm(), 1.0, 1e-10);
+    for (std::size_t i = 2; i < b.points.size(); ++i)
+      iterations[k] += b.points[i].newton_iterations;
+  }
+  EXPECT_LT(iterations[1], iterations[0]) << iterations[0];
+  EXPECT_EQ(continuation::parse_predictor("quadratic"), continuation::Predictor::quadratic);
+  EXPECT_STREQ(continuation::to_string(continuation::Predictor::quadratic), "quadratic");
+}
+
 // The rank verification runs with the corrector options.verification describes: probes 0.05
 // along the circle's tangent start 1.25e-3 off the circle, and one Newton iteration (quadratic:
 // to ~1e-6) cannot reach the verifier's 1e-10, while the default 60 can (3 iterations). Only
