@@ -124,45 +124,43 @@ TEST(CompressedJacobian, ThreadsGiveTheOneThreadJacobianBitForBit) {
   }
 }
 
+// The compressed Jacobian of `problem` at x from its own pattern, with its report.
+CompressedJacobianReport compress(const Arrow& problem, const Vector& x, Matrix& J) {
+  CompressedJacobianReport report;
+  EXPECT_EQ(compressed_finite_difference_jacobian(problem, x, problem.pattern(), J, {}, &report),
+            EvalStatus::ok);
+  return report;
+}
+
 TEST(CompressedJacobian, ACorrectorsScopeLoosensTheCheckAndEndsWithIt) {
   // The check error is |(J p)_i - d_i| / (tau (size_i + floor)): at the corrector's tau it is
   // the strict one times 1e-3 / tau, exactly the same differences. Dropping the superdiagonal
-  // gives errors of e > 1 at the default tau 1e-3 (the test above); a scope of 2 e 1e-3 accepts
+  // gives errors of e > 1 at the default tau 1e-3 (the test below); a scope of 2 e 1e-3 accepts
   // that Jacobian as it is (no fallback, the dropped entries missing), one of e 1e-3 / 2 does not,
   // and a nested scope of 0 brings the pattern's own back.
-  const int n = 20;
-  Arrow wrong(n, /*drop_superdiagonal=*/true);
-  const Vector x = point(n);
+  const Arrow wrong(20, /*drop_superdiagonal=*/true);
+  const Vector x = point(20);
   Matrix J;
-  CompressedJacobianReport strict;
-  ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &strict),
-            EvalStatus::ok);
+  const CompressedJacobianReport strict = compress(wrong, x, J);
   ASSERT_TRUE(strict.fell_back);
   const double e = strict.check_error;
   ASSERT_GT(e, 2.0);  // (about 1.6e3 here: the scopes below are loose beyond use, but exact)
   EXPECT_EQ(CorrectorJacobians::tolerance(), 0.0);
   {
     const CorrectorJacobians loose(2 * e * 1e-3);
-    CompressedJacobianReport report;
-    ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &report),
-              EvalStatus::ok);
-    EXPECT_FALSE(report.fell_back);
-    EXPECT_NEAR(report.check_error, 0.5, 1e-12);
+    const CompressedJacobianReport accepted = compress(wrong, x, J);
+    EXPECT_FALSE(accepted.fell_back);
+    EXPECT_NEAR(accepted.check_error, 0.5, 1e-12);
     EXPECT_EQ(J(0, 1), 0.0);  // the dropped entry stays dropped
     {
       const CorrectorJacobians own(0);
-      ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &report),
-                EvalStatus::ok);
-      EXPECT_TRUE(report.fell_back);
+      EXPECT_TRUE(compress(wrong, x, J).fell_back);
     }
     EXPECT_DOUBLE_EQ(CorrectorJacobians::tolerance(), 2 * e * 1e-3);
   }
   {
     const CorrectorJacobians not_enough(0.5 * e * 1e-3);
-    CompressedJacobianReport report;
-    ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &report),
-              EvalStatus::ok);
-    EXPECT_TRUE(report.fell_back);
+    EXPECT_TRUE(compress(wrong, x, J).fell_back);
   }
   EXPECT_EQ(CorrectorJacobians::tolerance(), 0.0);
 }
@@ -206,9 +204,7 @@ TEST(CompressedJacobian, AWrongPatternIsCaughtAndTheJacobianRecomputedColumnByCo
   Arrow wrong(n, /*drop_superdiagonal=*/true);
   const Vector x = point(n);
   Matrix J;
-  CompressedJacobianReport report;
-  ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, wrong.pattern(), J, {}, &report),
-            EvalStatus::ok);
+  const CompressedJacobianReport report = compress(wrong, x, J);
   EXPECT_TRUE(report.fell_back);
   EXPECT_GT(report.check_error, 1.0);
   Matrix dense;
