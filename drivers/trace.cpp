@@ -11,7 +11,6 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <csignal>
 #include <filesystem>
 #include <optional>
 #include <sstream>
@@ -20,6 +19,7 @@
 #include "continuation/progress.hpp"
 #include "continuation/restart.hpp"
 #include "continuation/scene_options.hpp"
+#include "continuation/stop_signals.hpp"
 #include "core/errors.hpp"
 #include "core/output_folder.hpp"
 #include "core/periodic_orbit.hpp"
@@ -67,13 +67,6 @@ void print_help(const cont::ProblemPlugin* problem) {
          << "\n(defaults of a problem's own keys: backbone trace SCENE --help)\n";
   }
   fmt::print("{}\n", text.str());
-}
-
-// SIGINT / SIGTERM ask the continuation to stop before its next step (ContinuationHooks::
-// cancel_requested): the current point is finished and written, then the summary.
-volatile std::sig_atomic_t stop_signal = 0;
-extern "C" void request_stop(int signal) {
-  stop_signal = signal;
 }
 
 int run_trace(const std::vector<std::string>& args_in) {
@@ -195,12 +188,12 @@ int run_trace(const std::vector<std::string>& args_in) {
                           {"out", "help", "branch", "start", "direction"});
   core::write_text_atomically(out / "summary.txt", summary("running", nullptr, 0, -1));
 
-  stop_signal = 0;
-  std::signal(SIGINT, request_stop);
-  std::signal(SIGTERM, request_stop);
+  // SIGINT / SIGTERM: stop before the next step (the point is finished and written, then the
+  // summary); a second one stops at once (continuation/stop_signals.hpp).
+  std::optional<cont::StopSignals> stop(std::in_place);
   cont::ProgressLine progress(options);
   cont::ContinuationHooks hooks;
-  hooks.cancel_requested = [] { return stop_signal != 0; };
+  hooks.cancel_requested = [&] { return stop->requested(); };
   hooks.on_point = [&](const cont::BranchPoint& p_in) {
     if (restart && !resume.empty() && p_in.index == restart->index) return;  // in the files
     const cont::BranchPoint& p = p_in;
@@ -225,8 +218,8 @@ int run_trace(const std::vector<std::string>& args_in) {
 
   cont::SwitchingBranch result = cont::run_continuation(
       problem, setup.guess, direction, run, *corrector, hooks, restart ? &*restart : nullptr);
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  const int stop_signal = stop->signal();
+  stop.reset();  // the default actions again
   progress.finish();
   cont::Branch& branch = result.branch;
   const bool complete = !branch.points.empty() && !branch.ended_early();
@@ -255,8 +248,8 @@ int run_trace(const std::vector<std::string>& args_in) {
     fmt::print(stderr,
                "backbone trace: interrupted by signal {} after {} points; continue with "
                "backbone trace --resume {}\n",
-               static_cast<int>(stop_signal), writer.points(), out.string());
-    return 128 + static_cast<int>(stop_signal);
+               stop_signal, writer.points(), out.string());
+    return 128 + stop_signal;
   }
   if (!complete || !followed_complete) {
     fmt::print(stderr, "backbone trace: {} ended before its bound or point budget{}\n",
