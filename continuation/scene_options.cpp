@@ -132,6 +132,11 @@ RunSettings read_run_settings(const core::Scene& scene) {
   ContinuationOptions& o = run.options;
   o.method = parse_method(scene.text("method"));
   const std::string predictor = scene.text("predictor");
+  if (predictor != "auto" && predictor != "tangent" && predictor != "secant" &&
+      predictor != "quadratic")
+    throw core::InputError(
+        "predictor",
+        fmt::format("must be auto, tangent, secant or quadratic (got '{}')", predictor));
   if (predictor != "auto") o.predictor = parse_predictor(predictor);
   o.ds = scene.positive("ds");
   o.ds_min = scene.positive("ds_min");

@@ -55,6 +55,8 @@ TEST(TraceCli, BadInputExitsTwoAndWritesNothing) {
   expect_bad_input(paper + " --steps_per_period 41", "steps_per_period");
   expect_bad_input(paper + " --return_tolerance -1", "return_tolerance");
   expect_bad_input(paper + " --right_end free", "right_end");
+  expect_bad_input(paper + " --predictor cubic", "predictor");
+  expect_bad_input(paper + " --newton_jacobian_check 1", "newton_jacobian_check");
   // The size of a residual is bounded before any work (it used to run for ever): 1e7 steps per
   // period at 20 intervals, a million intervals at 40 steps, both above max_residual_work 1e7.
   expect_bad_input(paper + " --steps_per_period 10000000", "steps_per_period");
