@@ -131,13 +131,8 @@ RunSettings read_run_settings(const core::Scene& scene) {
   RunSettings run;
   ContinuationOptions& o = run.options;
   o.method = parse_method(scene.text("method"));
-  const std::string predictor = scene.text("predictor");
-  if (predictor != "auto" && predictor != "tangent" && predictor != "secant" &&
-      predictor != "quadratic")
-    throw core::InputError(
-        "predictor",
-        fmt::format("must be auto, tangent, secant or quadratic (got '{}')", predictor));
-  if (predictor != "auto") o.predictor = parse_predictor(predictor);
+  const std::string predictor =
+      scene.choice("predictor", {"auto", "tangent", "secant", "quadratic"});
   o.ds = scene.positive("ds");
   o.ds_min = scene.positive("ds_min");
   o.ds_max = scene.positive("ds_max");
@@ -154,8 +149,9 @@ RunSettings read_run_settings(const core::Scene& scene) {
                            run.follow.selection.kind != FollowSelection::Kind::none;
   // The detector samples its test function at the points: it was measured with the tangent
   // predictor's steps, which the quadratic one lengthens (continuation/README.md, 'Predictors').
-  if (predictor == "auto")
-    o.predictor = o.branch_points.detect ? Predictor::tangent : Predictor::quadratic;
+  o.predictor = predictor != "auto"      ? parse_predictor(predictor)
+                : o.branch_points.detect ? Predictor::tangent
+                                         : Predictor::quadratic;
   o.branch_points.max_turn_degrees = scene.non_negative("max_turn_degrees");
   read_bounds(scene, o);
   o.validate();

@@ -75,16 +75,6 @@ Colouring colour(const JacobianPattern& pattern, int m, int n) {
   return c;
 }
 
-// Entry j of the check direction, +-(1..2): splitmix64 of j, the same for every x and run.
-double check_weight(int j) {
-  std::uint64_t z = 0x9E3779B97F4A7C15ull * (static_cast<std::uint64_t>(j) + 1);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  z ^= z >> 31;
-  const double u = static_cast<double>(z >> 11) * 0x1.0p-53;  // [0, 1)
-  return (z & 1) ? 1 + u : -(1 + u);
-}
-
 // The colouring of the last pattern seen on this thread: a trace asks for the same pattern
 // at Jacobian after Jacobian (the contact bar's depends on x only through its contact phases),
 // and colouring costs O(entries x row width), about a tenth of a mode-1 trace at N = 160
@@ -149,7 +139,7 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
     h[j] = finite_difference_step(x[j], scale[j], rel);
     // Dense columns are differenced alone, as column by column: the check leaves them out (it
     // would only add their second-order terms, or a kink of F along them, to its error).
-    volatile double shifted = x[j] + check_weight(j) * h[j];
+    volatile double shifted = x[j] + fixed_weight(static_cast<std::uint64_t>(j)) * h[j];
     p[j] = c.dense[static_cast<std::size_t>(j)] ? 0.0 : shifted - x[j];
     if (c.colour[static_cast<std::size_t>(j)] >= 0)
       groups[static_cast<std::size_t>(c.colour[static_cast<std::size_t>(j)])].push_back(j);

@@ -28,6 +28,15 @@ double finite_difference_step(double x_j, double scale_j, double relative_step) 
   return shifted - x_j;
 }
 
+double fixed_weight(std::uint64_t index) {
+  std::uint64_t z = 0x9E3779B97F4A7C15ull * (index + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  const double u = static_cast<double>(z >> 11) * 0x1.0p-53;  // [0, 1)
+  return (z & 1) ? 1 + u : -(1 + u);
+}
+
 EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, Matrix& J,
                                       const FiniteDifferenceOptions& options) {
   const int n = problem.num_unknowns();

@@ -18,6 +18,7 @@
 //   set_default_jacobian_threads(2);    // problem.jacobian(x, J) now uses two threads
 #pragma once
 
+#include <cstdint>
 #include <functional>
 
 #include "core/problem.hpp"
@@ -35,6 +36,10 @@ struct FiniteDifferenceOptions {
 // scale_j is 0), rounded so that x_j + h is exactly x_j + h in floating point.
 double relative_step(const FiniteDifferenceOptions& options);
 double finite_difference_step(double x_j, double scale_j, double relative_step);
+
+// A fixed pseudo-random weight +-(1..2) for each index: splitmix64 of index + 1, the same for
+// every x and run (the compressed Jacobian's check direction, the rank report's start blocks).
+double fixed_weight(std::uint64_t index);
 
 EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, Matrix& J,
                                       const FiniteDifferenceOptions& options = {});

@@ -11,6 +11,7 @@
 
 #include "core/bordered_system.hpp"
 #include "core/errors.hpp"
+#include "core/finite_difference.hpp"
 
 namespace backbone::core {
 
@@ -72,19 +73,12 @@ void count_rank(RankReport& report, const RankOptions& options, Eigen::Index n) 
   }
 }
 
-// A fixed, well-spread start block (n x k): entries +-(1..2) from splitmix64, orthonormalised.
+// A fixed, well-spread start block (n x k): entries +-(1..2) (fixed_weight), orthonormalised.
 Matrix start_block(Eigen::Index n, Eigen::Index k) {
   Matrix X(n, k);
-  std::uint64_t z = 0x9E3779B97F4A7C15ull;
   for (Eigen::Index j = 0; j < k; ++j)
-    for (Eigen::Index i = 0; i < n; ++i) {
-      z += 0x9E3779B97F4A7C15ull;
-      std::uint64_t w = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-      w = (w ^ (w >> 27)) * 0x94D049BB133111EBull;
-      w ^= w >> 31;
-      const double u = static_cast<double>(w >> 11) * 0x1.0p-53;
-      X(i, j) = (w & 1) ? 1 + u : -(1 + u);
-    }
+    for (Eigen::Index i = 0; i < n; ++i)
+      X(i, j) = fixed_weight(static_cast<std::uint64_t>(j * n + i + 1));
   const Eigen::HouseholderQR<Matrix> qr(X);
   return qr.householderQ() * Matrix::Identity(n, k);
 }
