@@ -22,21 +22,29 @@ namespace {
 // margin is checked on R: two steps of inverse iteration on R^T R from a fixed start estimate
 // sigma_min(R) from above (||R^-1 R^-T z|| / ||z|| <= 1 / sigma_min^2), quickly where it
 // matters (a sigma_min far below the next is found in one step); QR is kept when that estimate
-// is above 1e3 times the cut-off of |R|'s largest diagonal entry, else J is factorised again by
-// the COD. The two give the same solution up to round-off (cond(J) eps).
+// is above 1e3 times the cut-off of |R|'s largest diagonal entry, else the COD factorises R
+// (J^+ = R^+ Q^T: 2/5 of a COD of J when m = 2n). The two give the same solution up to
+// round-off (cond(J) eps).
 class LeastSquares {
  public:
   void compute(const Matrix& J, double rank_cutoff) {
     const double cutoff = rank_cutoff > 0 ? rank_cutoff : std::numeric_limits<double>::epsilon();
     use_qr_ = false;
+    on_r_ = false;
+    cod_.setThreshold(cutoff);
     if (J.rows() >= J.cols() && J.cols() > 0) {
       qr_.compute(J);
       use_qr_ = well_conditioned(cutoff);
+      if (!use_qr_) {
+        // J = Q_1 R with orthonormal Q_1, so J^+ = R^+ Q_1^T: the COD of the n x n R gives J's
+        // minimum-norm solution, at 2/5 of the COD of the m x n J when m = 2n (its pivots,
+        // hence its rank, are R's, the same singular values up to round-off).
+        const Eigen::Index n = J.cols();
+        cod_.compute(Matrix(qr_.matrixQR().topRows(n).template triangularView<Eigen::Upper>()));
+        on_r_ = true;
+      }
     }
-    if (!use_qr_) {
-      cod_.setThreshold(cutoff);
-      cod_.compute(J);
-    }
+    if (!use_qr_ && !on_r_) cod_.compute(J);
   }
   int rank() const {
     return use_qr_ ? static_cast<int>(qr_.cols()) : static_cast<int>(cod_.rank());
@@ -50,7 +58,14 @@ class LeastSquares {
       dx = Vector::Zero(cols());
       return 0;
     }
-    dx = use_qr_ ? Vector(qr_.solve(rhs)) : Vector(cod_.solve(rhs));
+    if (use_qr_) {
+      dx = qr_.solve(rhs);
+    } else if (on_r_) {
+      Vector y = qr_.householderQ().transpose() * rhs;
+      dx = cod_.solve(y.head(qr_.cols()));
+    } else {
+      dx = cod_.solve(rhs);
+    }
     return r;
   }
 
@@ -75,6 +90,7 @@ class LeastSquares {
   }
 
   bool use_qr_ = false;
+  bool on_r_ = false;  // cod_ factorises qr_'s R, not J
   Eigen::HouseholderQR<Matrix> qr_;
   Eigen::CompleteOrthogonalDecomposition<Matrix> cod_;
 };
