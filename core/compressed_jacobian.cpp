@@ -129,10 +129,6 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
   const Vector scale = problem.typical_scale();
 
   Vector r0;
-  EvalStatus s = problem.residual(x, r0);
-  ++out.residuals;
-  if (s != EvalStatus::ok) return s;
-
   Vector h(n), p(n);
   std::vector<std::vector<int>> groups(static_cast<std::size_t>(c.colours));
   for (int j = 0; j < n; ++j) {
@@ -145,13 +141,19 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
       groups[static_cast<std::size_t>(c.colour[static_cast<std::size_t>(j)])].push_back(j);
   }
 
-  // Task t < colours: that colour's step(s); task colours: the check direction.
-  const int tasks = c.colours + 1;
-  std::vector<Vector> plus(static_cast<std::size_t>(tasks)),
-      minus(static_cast<std::size_t>(central ? tasks : 0));
+  // Task t < colours: that colour's step(s); task colours: the check direction; the last, F(x)
+  // itself, which the differences need only at the end: with threads, no residual runs alone.
+  const int tasks = c.colours + 2;
+  const int base = c.colours + 1;
+  std::vector<Vector> plus(static_cast<std::size_t>(base)),
+      minus(static_cast<std::size_t>(central ? base : 0));
   std::vector<EvalStatus> status(static_cast<std::size_t>(tasks), EvalStatus::ok);
   auto task = [&](int t) {
     const std::size_t ts = static_cast<std::size_t>(t);
+    if (t == base) {
+      status[ts] = problem.residual(x, r0);
+      return;
+    }
     const bool check = t == c.colours;
     Vector xs = x;
     if (check)
@@ -170,7 +172,9 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
     status[ts] = st;
   };
   run_tasks(tasks, options.threads, task);
-  out.residuals += tasks * (central ? 2 : 1);
+  out.residuals += 1 + base * (central ? 2 : 1);
+  if (status[static_cast<std::size_t>(base)] != EvalStatus::ok)
+    return status[static_cast<std::size_t>(base)];
   auto fall_back = [&] {
     out.fell_back = true;
     const long before = problem.counters().residuals;
