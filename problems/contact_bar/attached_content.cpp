@@ -3,7 +3,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
-#include <numbers>
+#include <unsupported/Eigen/FFT>
 #include <vector>
 
 namespace backbone::contact_bar {
@@ -49,22 +49,19 @@ AttachedContent attached_content(const ContactBarOrbitProblem& problem,
   }
   if (!std::isfinite(amplitude)) return c;
   c.amplitude = amplitude;
-  // Direct DFT over one period: harmonics 1..samples/2 (both orbits are sampled on their own
-  // period, so the content is periodic over the sampled window).
-  // The twiddles exp(-2 pi i j / samples) once (h k mod samples indexes them): a std::polar
-  // per term made this DFT ~0.3 s of CPU per described branch point at 4096 samples.
-  std::vector<std::complex<double>> twiddle(static_cast<std::size_t>(samples));
-  for (int j = 0; j < samples; ++j)
-    twiddle[static_cast<std::size_t>(j)] =
-        std::polar(1.0, -2 * std::numbers::pi * j / static_cast<double>(samples));
+  // Spectrum over one period (both orbits are sampled on their own period, so the content is
+  // periodic over the sampled window): harmonics 1..samples/2 by an FFT (Eigen's, kissfft),
+  // O(samples log samples). The direct DFT it replaces took 20-40 ms per described branch
+  // point at 4096 samples, 8 % of a mode-1 trace with detection at N = 100.
+  Eigen::FFT<double> fft;
+  std::vector<std::complex<double>> spectrum;
+  fft.fwd(spectrum, d);
   int best = 0;
   double best_magnitude = -1;
   for (int h = 1; h <= samples / 2; ++h) {
-    std::complex<double> sum = 0;
-    for (int k = 0, j = 0; k < samples; ++k, j = (j + h) % samples)
-      sum += d[static_cast<std::size_t>(k)] * twiddle[static_cast<std::size_t>(j)];
-    if (std::abs(sum) > best_magnitude) {
-      best_magnitude = std::abs(sum);
+    const double magnitude = std::abs(spectrum[static_cast<std::size_t>(h)]);
+    if (magnitude > best_magnitude) {
+      best_magnitude = magnitude;
       best = h;
     }
   }
