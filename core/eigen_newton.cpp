@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/compressed_jacobian.hpp"
+#include "core/sparse_least_squares.hpp"
 
 namespace backbone::core {
 
@@ -29,30 +30,28 @@ class LeastSquares {
  public:
   void compute(const Matrix& J, double rank_cutoff) {
     const double cutoff = rank_cutoff > 0 ? rank_cutoff : std::numeric_limits<double>::epsilon();
-    use_qr_ = false;
-    on_r_ = false;
-    cod_.setThreshold(cutoff);
-    if (J.rows() >= J.cols() && J.cols() > 0) {
-      qr_.compute(J);
-      use_qr_ = well_conditioned(cutoff);
-      if (!use_qr_) {
-        // J = Q_1 R with orthonormal Q_1, so J^+ = R^+ Q_1^T: the COD of the n x n R gives J's
-        // minimum-norm solution, at 2/5 of the COD of the m x n J when m = 2n (its pivots,
-        // hence its rank, are R's, the same singular values up to round-off).
-        const Eigen::Index n = J.cols();
-        cod_.compute(Matrix(qr_.matrixQR().topRows(n).template triangularView<Eigen::Upper>()));
-        on_r_ = true;
-      }
-    }
-    if (!use_qr_ && !on_r_) cod_.compute(J);
+    use_sparse_ = sparse_.compute(J, cutoff);
+    if (!use_sparse_) dense(J, cutoff);
+    cutoff_ = cutoff;
   }
   int rank() const {
-    return use_qr_ ? static_cast<int>(qr_.cols()) : static_cast<int>(cod_.rank());
+    return use_sparse_ ? static_cast<int>(sparse_.cols())
+           : use_qr_   ? static_cast<int>(qr_.cols())
+                       : static_cast<int>(cod_.rank());
   }
-  int cols() const { return static_cast<int>(use_qr_ ? qr_.cols() : cod_.cols()); }
+  int cols() const {
+    return static_cast<int>(use_sparse_ ? sparse_.cols() : use_qr_ ? qr_.cols() : cod_.cols());
+  }
   // Least-squares solution of J dx = rhs (minimum norm for a rank-deficient J). Returns the
   // rank used.
   int solve(const Vector& rhs, Vector& dx) const {
+    if (use_sparse_) {
+      if (sparse_.solve(rhs, dx)) return rank();
+      // The iteration did not converge on this right-hand side (not seen on the contact bar):
+      // the dense factorisation of the same J from here on.
+      use_sparse_ = false;
+      dense(sparse_.matrix(), cutoff_);
+    }
     const int r = rank();
     if (r == 0) {
       dx = Vector::Zero(cols());
@@ -89,10 +88,34 @@ class LeastSquares {
     return estimate > 1e3 * cutoff * largest;
   }
 
-  bool use_qr_ = false;
-  bool on_r_ = false;  // cod_ factorises qr_'s R, not J
-  Eigen::HouseholderQR<Matrix> qr_;
-  Eigen::CompleteOrthogonalDecomposition<Matrix> cod_;
+  // The dense path: Householder QR where J is well conditioned, else the COD of its R.
+  void dense(const Matrix& J, double cutoff) const {
+    use_qr_ = false;
+    on_r_ = false;
+    cod_.setThreshold(cutoff);
+    if (J.rows() >= J.cols() && J.cols() > 0) {
+      qr_.compute(J);
+      use_qr_ = well_conditioned(cutoff);
+      if (!use_qr_) {
+        // J = Q_1 R with orthonormal Q_1, so J^+ = R^+ Q_1^T: the COD of the n x n R gives J's
+        // minimum-norm solution, at 2/5 of the COD of the m x n J when m = 2n (its pivots,
+        // hence its rank, are R's, the same singular values up to round-off).
+        const Eigen::Index n = J.cols();
+        cod_.compute(Matrix(qr_.matrixQR().topRows(n).template triangularView<Eigen::Upper>()));
+        on_r_ = true;
+      }
+    }
+    if (!use_qr_ && !on_r_) cod_.compute(J);
+  }
+
+  // mutable: solve() may replace the sparse path by the dense one of the same J.
+  SparseLeastSquares sparse_;
+  mutable bool use_sparse_ = false;
+  double cutoff_ = 0;
+  mutable bool use_qr_ = false;
+  mutable bool on_r_ = false;  // cod_ factorises qr_'s R, not J
+  mutable Eigen::HouseholderQR<Matrix> qr_;
+  mutable Eigen::CompleteOrthogonalDecomposition<Matrix> cod_;
 };
 
 // A chord step is kept when it cuts ||F||_2 by 1 / reuse_contraction, or, more slowly but still

@@ -1,0 +1,132 @@
+#include "core/sparse_least_squares.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "core/finite_difference.hpp"
+
+namespace backbone::core {
+
+bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
+  const Eigen::Index m = J.rows(), n = J.cols();
+  a_.resize(0, 0);
+  if (n < min_columns || m < n) return false;
+  // Compressed columns in one pass down the columns (J is column-major).
+  std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0), inner;
+  std::vector<double> values;
+  std::vector<int> row_count(static_cast<std::size_t>(m), 0);
+  const long budget = static_cast<long>(m) * n / 8;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index i = 0; i < m; ++i)
+      if (const double v = J(i, j); v != 0) {
+        inner.push_back(static_cast<int>(i));
+        values.push_back(v);
+        ++row_count[static_cast<std::size_t>(i)];
+      }
+    if (static_cast<long>(inner.size()) > budget) return false;
+    outer[static_cast<std::size_t>(j) + 1] = static_cast<int>(inner.size());
+  }
+  const int dense_length = static_cast<int>(std::max<Eigen::Index>(16, n / 8));
+  std::vector<char> dense_row(static_cast<std::size_t>(m), 0);
+  int dense_rows = 0;
+  for (Eigen::Index i = 0; i < m; ++i)
+    if (row_count[static_cast<std::size_t>(i)] > dense_length) {
+      dense_row[static_cast<std::size_t>(i)] = 1;
+      if (++dense_rows > max_dense_rows) return false;
+    }
+  a_ = Eigen::Map<const Eigen::SparseMatrix<double>>(m, n, static_cast<Eigen::Index>(inner.size()),
+                                                     outer.data(), inner.data(), values.data());
+  Eigen::SparseMatrix<double> sparse_rows = a_;
+  sparse_rows.prune([&](Eigen::Index i, Eigen::Index, double) {
+    return !dense_row[static_cast<std::size_t>(i)];
+  });
+  Eigen::SparseMatrix<double> normal = sparse_rows.transpose() * sparse_rows;
+  double largest_diagonal = 0, largest_column = 0;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    largest_diagonal = std::max(largest_diagonal, normal.coeff(j, j));
+    largest_column = std::max(largest_column, a_.col(j).norm());
+  }
+  if (!(largest_diagonal > 0) || !std::isfinite(largest_diagonal)) {
+    a_.resize(0, 0);
+    return false;
+  }
+  const double mu = 1e-10 * largest_diagonal;
+  for (Eigen::Index j = 0; j < n; ++j) normal.coeffRef(j, j) += mu;
+  factor_.compute(normal);
+  if (factor_.info() != Eigen::Success) {
+    a_.resize(0, 0);
+    return false;
+  }
+  // sigma_min from above: two steps of inverse iteration on J^T J from a fixed start
+  // (|| (J^T J)^-1 z || / ||z|| <= 1 / sigma_min^2), pseudo-random so that no null vector is
+  // orthogonal to it by symmetry (ones is, to the difference of two equal columns).
+  Vector z(n), y;
+  for (Eigen::Index j = 0; j < n; ++j) z[j] = fixed_weight(static_cast<std::uint64_t>(j));
+  double estimate = largest_column;
+  for (int step = 0; step < 2; ++step) {
+    if (!normal_solve(z, y, 1e-6)) {
+      a_.resize(0, 0);
+      return false;
+    }
+    const double grow = y.norm() / z.norm();
+    if (!std::isfinite(grow) || !(grow > 0)) {
+      a_.resize(0, 0);
+      return false;
+    }
+    estimate = std::min(estimate, 1.0 / std::sqrt(grow));
+    z = y / y.norm();
+  }
+  const double cutoff = rank_cutoff > 0 ? rank_cutoff : 0.0;
+  if (!(estimate > std::max(2 * cutoff, 1e-7) * largest_column)) {
+    a_.resize(0, 0);
+    return false;
+  }
+  return true;
+}
+
+bool SparseLeastSquares::normal_solve(const Vector& g, Vector& y, double relative_tolerance) const {
+  const double g_norm = g.norm();
+  y = Vector::Zero(g.size());
+  last_iterations_ = 0;
+  if (g_norm == 0) return true;
+  Vector r = g, z = factor_.solve(r), p = z;
+  double rz = r.dot(z);
+  Vector best = y;
+  double best_residual = 1.0, previous = 1.0;
+  for (int it = 1; it <= max_iterations; ++it) {
+    const Vector q = a_.transpose() * (a_ * p);
+    const double curvature = p.dot(q);
+    if (!(curvature > 0) || !std::isfinite(curvature)) break;
+    const double alpha = rz / curvature;
+    y += alpha * p;
+    r -= alpha * q;
+    last_iterations_ = it;
+    const double residual = r.norm() / g_norm;
+    if (residual < best_residual) {
+      best_residual = residual;
+      best = y;
+    }
+    // Converged, or stalled at round-off (no halving once below relative_tolerance x 1e3).
+    if (residual <= 1e-3 * relative_tolerance ||
+        (residual <= relative_tolerance && residual > 0.5 * previous))
+      break;
+    previous = residual;
+    z = factor_.solve(r);
+    const double rz_next = r.dot(z);
+    p = z + (rz_next / rz) * p;
+    rz = rz_next;
+  }
+  y = best;
+  return best_residual <= relative_tolerance;
+}
+
+bool SparseLeastSquares::solve(const Vector& b, Vector& x) const {
+  if (a_.size() == 0 || b.size() != a_.rows()) return false;
+  Vector y;
+  if (!normal_solve(a_.transpose() * b, y, 1e-11)) return false;
+  x = y;
+  return true;
+}
+
+}  // namespace backbone::core

@@ -1,0 +1,98 @@
+// SparseLeastSquares (core/sparse_least_squares.hpp) against a dense Householder QR and the
+// SVD, on matrices shaped like the contact bar's bordered shooting Jacobian: sparse rows, one
+// dense column, one dense row.
+#include <gtest/gtest.h>
+
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <random>
+
+#include "core/eigen_newton.hpp"
+#include "core/sparse_least_squares.hpp"
+
+namespace {
+
+using backbone::core::Matrix;
+using backbone::core::SparseLeastSquares;
+using backbone::core::Vector;
+
+// m x n: rows i and i + n/2... of ~7 entries (a band and a folded image, like the bar's), a
+// dense last column, and, with `bordered`, a dense last row. Fixed seed.
+Matrix shooting_like(int m, int n, bool bordered, unsigned seed = 7) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Matrix J = Matrix::Zero(m, n);
+  const int rows = bordered ? m - 1 : m;
+  for (int i = 0; i < rows; ++i) {
+    const int a = (i / 2) % (n - 1), b = (n - 2 - i / 2 + 3 * n) % (n - 1);
+    for (int d = -1; d <= 1; ++d) {
+      J(i, (a + d + n - 1) % (n - 1)) += 1 + u(gen);
+      J(i, (b + d + n - 1) % (n - 1)) += 0.5 * u(gen);
+    }
+    J(i, n - 1) = u(gen);
+  }
+  if (bordered)
+    for (int j = 0; j < n; ++j) J(m - 1, j) = u(gen);
+  return J;
+}
+
+TEST(SparseLeastSquares, MatchesTheHouseholderSolutionOfAnInconsistentSystem) {
+  const Matrix J = shooting_like(201, 100, true);
+  const Vector b = Vector::LinSpaced(201, -1, 2).array().sin();  // not in J's range
+  SparseLeastSquares ls;
+  ASSERT_TRUE(ls.compute(J, 1e-12));
+  Vector x;
+  ASSERT_TRUE(ls.solve(b, x));
+  const Eigen::HouseholderQR<Matrix> qr(J);
+  const Vector reference = qr.solve(b);
+  // Both are least-squares solutions to about cond(J) eps (cond ~ 1e2 here) and the iteration
+  // stops at 1e-11 of J^T b in the normal residual.
+  EXPECT_LT((x - reference).norm(), 1e-9 * reference.norm());
+  EXPECT_LT((J.transpose() * (J * x - b)).norm(), 1e-10 * (J.transpose() * b).norm());
+}
+
+TEST(SparseLeastSquares, ADenseRowFixesTheNullDirectionOfTheSparseRows) {
+  // On a branch the sparse rows (F's Jacobian) have a null vector t and the arclength row t^T
+  // removes it: the sparse rows' normal matrix is singular, J is not. Here t is dense and the
+  // dense column is chosen so that F t = 0.
+  Matrix J = shooting_like(201, 100, true);
+  const Vector t = Vector::LinSpaced(100, 1, 2).normalized();
+  J.block(0, 99, 200, 1) = -J.block(0, 0, 200, 99) * t.head(99) / t[99];
+  J.row(200) = t.transpose();
+  ASSERT_LT((J.topRows(200) * t).norm(), 1e-13 * J.norm());
+  const Vector b = J * Vector::LinSpaced(100, 0, 1);  // consistent
+  SparseLeastSquares ls;
+  ASSERT_TRUE(ls.compute(J, 1e-12));
+  Vector x;
+  ASSERT_TRUE(ls.solve(b, x));
+  EXPECT_LT((x - Vector::LinSpaced(100, 0, 1)).norm(), 1e-9 * Vector::LinSpaced(100, 0, 1).norm());
+}
+
+TEST(SparseLeastSquares, RefusesWhatTheDensePathDoesBetter) {
+  SparseLeastSquares ls;
+  // Too small to pay: the dense QR keeps every small problem bit for bit as before.
+  EXPECT_FALSE(ls.compute(shooting_like(41, 20, true), 1e-12));
+  // Dense.
+  EXPECT_FALSE(ls.compute(Matrix::Ones(200, 100) + Matrix::Identity(200, 100), 1e-12));
+  // Rank deficient: the minimum-norm solution is not the normal equations' (a column repeated).
+  Matrix deficient = shooting_like(201, 100, true);
+  deficient.col(5) = deficient.col(6);
+  EXPECT_FALSE(ls.compute(deficient, 1e-12));
+  // Conditioned worse than the cut-off allows: sigma_min ~ 1e-6 sigma_max against 1e-5.
+  Matrix graded = shooting_like(201, 100, true);
+  graded.col(3) *= 1e-6;
+  EXPECT_FALSE(ls.compute(graded, 1e-5));
+  EXPECT_TRUE(ls.compute(shooting_like(201, 100, true), 1e-5));
+}
+
+TEST(SparseLeastSquares, MinimumNormSolveTakesItAndAgreesWithTheSvd) {
+  const Matrix J = shooting_like(301, 150, true, 11);
+  const Vector b = Vector::LinSpaced(301, 0, 3).array().cos();
+  Vector dx;
+  EXPECT_EQ(backbone::core::minimum_norm_solve(J, b, 1e-12, dx), 150);
+  const Eigen::JacobiSVD<Matrix> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Vector pinv = svd.solve(b);
+  EXPECT_LT((dx - pinv).norm(), 1e-9 * pinv.norm());
+}
+
+}  // namespace
