@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -12,6 +13,7 @@
 #include "core/bordered_system.hpp"
 #include "core/errors.hpp"
 #include "core/finite_difference.hpp"
+#include "core/sparse_least_squares.hpp"
 
 namespace backbone::core {
 
@@ -83,6 +85,38 @@ Matrix start_block(Eigen::Index n, Eigen::Index k) {
   return qr.householderQ() * Matrix::Identity(n, k);
 }
 
+// A with A^T A = J^T J, the operator the iteration below works with: R of a Householder QR of J
+// (n x n), or, for a sparse J (sparse_least_squares.hpp), J itself with a sparse Cholesky
+// factor of J^T J + mu I for the inverse iteration (mu = 1e-10 of its largest diagonal entry:
+// the same eigenvectors, J^T J itself being singular wherever there is a null direction).
+struct TriangularGram {
+  Matrix r;
+  Eigen::Index rows() const { return r.rows(); }
+  Vector times(const Vector& v) const { return r.triangularView<Eigen::Upper>() * v; }
+  Matrix times(const Matrix& x) const { return r.triangularView<Eigen::Upper>() * x; }
+  Vector times_transpose(const Vector& u) const {
+    return r.triangularView<Eigen::Upper>().transpose() * u;
+  }
+  Matrix inverse_gram(const Matrix& x) const {
+    const auto upper = r.triangularView<Eigen::Upper>();
+    return upper.solve(Matrix(upper.transpose().solve(x)));
+  }
+};
+
+struct SparseGram {
+  Eigen::SparseMatrix<double> a;
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> factor;
+  Eigen::Index rows() const { return a.rows(); }
+  Vector times(const Vector& v) const { return a * v; }
+  Matrix times(const Matrix& x) const { return a * x; }
+  Vector times_transpose(const Vector& u) const { return a.transpose() * u; }
+  Matrix inverse_gram(const Matrix& x) const { return factor.solve(x); }
+};
+
+template <class Gram>
+bool smallest_singular_values(const Gram& gram, Eigen::Index n, const RankOptions& options,
+                              RankReport& report);
+
 // The smallest singular values of J (m >= n) and their right vectors, without a full SVD:
 // R from a Householder QR of J (J = QR, same singular values and right vectors), sigma_max by
 // Lanczos bidiagonalisation of R, the k smallest by block inverse iteration on R^T R (two
@@ -94,18 +128,42 @@ Matrix start_block(Eigen::Index n, Eigen::Index k) {
 // full SVD) when R is singular to working precision, the block would exceed n / 2, or 60 steps
 // do not converge. Measured on the contact bar's mode 1 at N = 160 (321 x 161): 4-7 steps,
 // sigma_zero and sigma_kept within 3.4e-6 of the full SVD's (sigma_max's Lanczos estimate),
-// the same branch and dimensions; core/README.md, 'Rank reports'.
+// the same branch and dimensions; core/README.md, 'Rank reports'. A sparse J without dense
+// rows skips the QR: the products are J's, the inverse iteration a sparse Cholesky solve
+// (SparseGram); should that not converge, the QR is taken after all.
 bool smallest_singular_values(const Matrix& J, const RankOptions& options, RankReport& report) {
   const Eigen::Index n = J.cols();
   if (J.rows() < n || n < 4) return false;
+  {
+    // Sparse without dense rows (those would make J^T J dense): no QR at all.
+    SparseGram sparse;
+    std::vector<char> dense_row;
+    if (sparse_view(J, sparse.a, dense_row) &&
+        std::find(dense_row.begin(), dense_row.end(), 1) == dense_row.end()) {
+      Eigen::SparseMatrix<double> normal = sparse.a.transpose() * sparse.a;
+      double largest = 0;
+      for (Eigen::Index j = 0; j < n; ++j) largest = std::max(largest, normal.coeff(j, j));
+      if (largest > 0 && std::isfinite(largest)) {
+        for (Eigen::Index j = 0; j < n; ++j) normal.coeffRef(j, j) += 1e-10 * largest;
+        sparse.factor.compute(normal);
+        if (sparse.factor.info() == Eigen::Success &&
+            smallest_singular_values(sparse, n, options, report))
+          return true;
+      }
+    }
+  }
   const Eigen::HouseholderQR<Matrix> qr(J);
-  const Matrix R = qr.matrixQR().topRows(n).triangularView<Eigen::Upper>();
-  const auto upper = R.triangularView<Eigen::Upper>();
-  const double largest_pivot = R.diagonal().cwiseAbs().maxCoeff();
+  TriangularGram triangular{qr.matrixQR().topRows(n).triangularView<Eigen::Upper>()};
+  const double largest_pivot = triangular.r.diagonal().cwiseAbs().maxCoeff();
   if (!(largest_pivot > 0) || !std::isfinite(largest_pivot) ||
-      !(R.diagonal().cwiseAbs().minCoeff() > 1e-15 * largest_pivot))
+      !(triangular.r.diagonal().cwiseAbs().minCoeff() > 1e-15 * largest_pivot))
     return false;
+  return smallest_singular_values(triangular, n, options, report);
+}
 
+template <class Gram>
+bool smallest_singular_values(const Gram& gram, Eigen::Index n, const RankOptions& options,
+                              RankReport& report) {
   // sigma_max: Golub-Kahan-Lanczos bidiagonalisation of R (fully reorthogonalised), the largest
   // singular value of its bidiagonal, until that moves by less than 1e-10 of itself (at most
   // 60 steps; Lanczos finds the extreme values in a few tens of steps where power iteration on
@@ -113,17 +171,17 @@ bool smallest_singular_values(const Matrix& J, const RankOptions& options, RankR
   double sigma_max = 0;
   {
     const int steps = static_cast<int>(std::min<Eigen::Index>(60, n));
-    Matrix V(n, steps + 1), U(n, steps);
+    Matrix V(n, steps + 1), U(gram.rows(), steps);
     Vector alpha = Vector::Zero(steps), beta = Vector::Zero(steps);
     V.col(0) = start_block(n, 1).col(0);
     for (int j = 0; j < steps; ++j) {
-      Vector u = upper * V.col(j);
+      Vector u = gram.times(Vector(V.col(j)));
       if (j > 0) u -= beta[j - 1] * U.col(j - 1);
       u -= U.leftCols(j) * (U.leftCols(j).transpose() * u);
       alpha[j] = u.norm();
       if (!(alpha[j] > 0) || !std::isfinite(alpha[j])) break;
       U.col(j) = u / alpha[j];
-      Vector w = upper.transpose() * U.col(j) - alpha[j] * V.col(j);
+      Vector w = gram.times_transpose(Vector(U.col(j))) - alpha[j] * V.col(j);
       w -= V.leftCols(j + 1) * (V.leftCols(j + 1).transpose() * w);
       beta[j] = w.norm();
       // The largest eigenvalue of the tridiagonal B^T B (B: alpha on the diagonal, beta above).
@@ -153,12 +211,11 @@ bool smallest_singular_values(const Matrix& J, const RankOptions& options, RankR
     int previous_below = -1;
     double previous_kept = 0;
     for (int step = 0; step < 60 && !converged; ++step) {
-      Matrix Y = upper.transpose().solve(X);
-      Y = upper.solve(Y);
+      Matrix Y = gram.inverse_gram(X);
       if (!Y.allFinite()) return false;
       const Eigen::HouseholderQR<Matrix> block(Y);
       X = block.householderQ() * Matrix::Identity(n, k);
-      const Eigen::JacobiSVD<Matrix> ritz(upper * X, Eigen::ComputeThinU | Eigen::ComputeThinV);
+      const Eigen::JacobiSVD<Matrix> ritz(gram.times(X), Eigen::ComputeThinU | Eigen::ComputeThinV);
       s = ritz.singularValues();
       W = X * ritz.matrixV();
       int below = 0;

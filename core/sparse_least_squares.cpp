@@ -8,10 +8,9 @@
 
 namespace backbone::core {
 
-bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
+bool sparse_view(const Matrix& J, Eigen::SparseMatrix<double>& A, std::vector<char>& dense_row) {
   const Eigen::Index m = J.rows(), n = J.cols();
-  a_.resize(0, 0);
-  if (n < min_columns || m < n) return false;
+  if (n < SparseLeastSquares::min_columns || m < n) return false;
   // Compressed columns in one pass down the columns (J is column-major).
   std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0), inner;
   std::vector<double> values;
@@ -28,15 +27,26 @@ bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
     outer[static_cast<std::size_t>(j) + 1] = static_cast<int>(inner.size());
   }
   const int dense_length = static_cast<int>(std::max<Eigen::Index>(16, n / 8));
-  std::vector<char> dense_row(static_cast<std::size_t>(m), 0);
+  dense_row.assign(static_cast<std::size_t>(m), 0);
   int dense_rows = 0;
   for (Eigen::Index i = 0; i < m; ++i)
     if (row_count[static_cast<std::size_t>(i)] > dense_length) {
       dense_row[static_cast<std::size_t>(i)] = 1;
-      if (++dense_rows > max_dense_rows) return false;
+      if (++dense_rows > SparseLeastSquares::max_dense_rows) return false;
     }
-  a_ = Eigen::Map<const Eigen::SparseMatrix<double>>(m, n, static_cast<Eigen::Index>(inner.size()),
-                                                     outer.data(), inner.data(), values.data());
+  A = Eigen::Map<const Eigen::SparseMatrix<double>>(m, n, static_cast<Eigen::Index>(inner.size()),
+                                                    outer.data(), inner.data(), values.data());
+  return true;
+}
+
+bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
+  const Eigen::Index n = J.cols();
+  std::vector<char> dense_row;
+  a_.resize(0, 0);
+  if (!sparse_view(J, a_, dense_row)) {
+    a_.resize(0, 0);
+    return false;
+  }
   Eigen::SparseMatrix<double> sparse_rows = a_;
   sparse_rows.prune([&](Eigen::Index i, Eigen::Index, double) {
     return !dense_row[static_cast<std::size_t>(i)];

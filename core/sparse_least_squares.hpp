@@ -27,10 +27,17 @@
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <vector>
 
 #include "core/types.hpp"
 
 namespace backbone::core {
+
+// J (m x n) in compressed columns when sparse enough to pay: n >= SparseLeastSquares::
+// min_columns, m >= n, at most n / 8 entries per row on average and at most max_dense_rows
+// rows with more than max(16, n / 8) entries, which dense_row marks. false otherwise (A and
+// dense_row then mean nothing). Exact zeros of J are left out, every other entry kept.
+bool sparse_view(const Matrix& J, Eigen::SparseMatrix<double>& A, std::vector<char>& dense_row);
 
 class SparseLeastSquares {
  public:

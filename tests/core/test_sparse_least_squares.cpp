@@ -8,6 +8,7 @@
 #include <random>
 
 #include "core/eigen_newton.hpp"
+#include "core/rank_report.hpp"
 #include "core/sparse_least_squares.hpp"
 
 namespace {
@@ -93,6 +94,32 @@ TEST(SparseLeastSquares, MinimumNormSolveTakesItAndAgreesWithTheSvd) {
   const Eigen::JacobiSVD<Matrix> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
   const Vector pinv = svd.solve(b);
   EXPECT_LT((dx - pinv).norm(), 1e-9 * pinv.norm());
+}
+
+// The rank report of a sparse J without dense rows takes no QR (rank_report.cpp, SparseGram):
+// against the full SVD on a shooting-like J with three exact null directions (repeated and
+// scaled columns). The kept values come from Rayleigh-Ritz with J itself: within 1e-10 of the
+// SVD's (round-off of J X plus the inverse iteration's span error, eps ||J|| / gap ~ 1e-13 at
+// the gap here); the null span to 1e-9 like the dense path's test (test_rank_report.cpp).
+TEST(SparseLeastSquares, TheRankReportOfASparseJacobianAgreesWithTheSvd) {
+  Matrix J = shooting_like(199, 100, false);
+  J.col(10) = J.col(11);
+  J.col(40) = 2 * J.col(41);
+  J.col(70) = -J.col(72);
+  backbone::core::RankOptions options;
+  options.full_spectrum = false;
+  options.relative_threshold = 1e-5;
+  const backbone::core::RankReport r = backbone::core::rank_report(J, options);
+  const Eigen::JacobiSVD<Matrix> svd(J, Eigen::ComputeFullV);
+  const Vector& s = svd.singularValues();
+  ASSERT_EQ(r.nullity, 3);
+  EXPECT_EQ(r.rank, 97);
+  EXPECT_NEAR(r.singular_values[0], s[0], 1e-9 * s[0]);
+  EXPECT_NEAR(r.singular_values[96], s[96], 1e-10 * s[0]);
+  for (int i = 97; i < 100; ++i) EXPECT_LT(r.singular_values[i], 1e-10 * s[0]) << i;
+  const Matrix exact = svd.matrixV().rightCols(3) * svd.matrixV().rightCols(3).transpose();
+  const Matrix& N = r.null_directions;
+  EXPECT_LT((N * N.transpose() - exact).norm(), 1e-9);
 }
 
 }  // namespace
