@@ -61,7 +61,8 @@ void read_mode1_scene(Mode1Scene& s, const Mode1BranchSettings& settings) {
        "--shooting_elements", std::to_string(settings.elements), "--steps_per_period",
        std::to_string(settings.steps_per_period), "--formulation", settings.formulation, "--newton",
        settings.newton, "--test_elements", std::to_string(settings.test_elements), "--threads",
-       std::to_string(settings.threads)},
+       std::to_string(settings.threads), "--rank_check_every",
+       std::to_string(settings.rank_check_every)},
       po::options_description());
 }
 
@@ -88,6 +89,7 @@ std::string error_text(double value) {
 
 std::string Mode1BranchSettings::label() const {
   if (study == "grid") return fmt::format("N = {}", elements);
+  if (study == "grid_unchecked") return fmt::format("N = {}, no rank checks", elements);
   std::string text = fmt::format("N = {}", elements);
   if (steps_per_period != 40) text += fmt::format(", steps_per_period = {}", steps_per_period);
   if (formulation != "regular") text += fmt::format(", {} formulation", formulation);
@@ -97,6 +99,9 @@ std::string Mode1BranchSettings::label() const {
                         : test_elements > 0 ? fmt::format(" (test_elements {})", test_elements)
                                             : std::string());
   if (threads != 1) text += fmt::format(", {} threads", threads);
+  if (rank_check_every != 1)
+    text += rank_check_every == 0 ? std::string(", no rank checks")
+                                  : fmt::format(", rank checks every {} points", rank_check_every);
   return text;
 }
 
@@ -288,6 +293,18 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
     fine_runs.push_back(run(s));
     if (!fine_runs.back().complete) status = 1;
   }
+  // Without rank reports (--rank_check_every 0), up to N = 640: what the corrections cost
+  // alone, and the start at T = 3.8 is not probed (at N = 320 its many-dimensional verification
+  // is 43 of the trace's 45 s, problems/contact_bar/README.md, 'Cost').
+  std::vector<Mode1BranchCost> unchecked_runs;
+  for (int n : {40, 80, 160, 320, 640}) {
+    Mode1BranchSettings s;
+    s.study = "grid_unchecked";
+    s.elements = n;
+    s.rank_check_every = 0;
+    unchecked_runs.push_back(run(s));
+    if (!unchecked_runs.back().complete) status = 1;
+  }
   const auto grid_run = [&](int n) -> Mode1BranchCost {
     for (const Mode1BranchCost& c : grid_runs)
       if (c.settings.elements == n) return c;
@@ -390,7 +407,9 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
               "set ylabel 'CPU ms per point'\nset title 'Mode 1, T 3.8 -> 3.01: cost per point'\n"
               "plot {0} using (strcol('study') eq 'grid' ? column('N') : NaN):'ms_per_point' "
               "with linespoints pt 7 ps 1.5 title 'regular, eigen, 1 thread, 40 steps per "
-              "period'{1}, 25 dt 3 title 'target at N = 160: 25 ms'\n"
+              "period'{1}, {0} using (strcol('study') eq 'grid_unchecked' ? column('N') : NaN):"
+              "'ms_per_point' with linespoints pt 6 ps 1.5 title 'the same without rank checks', "
+              "25 dt 3 title 'target at N = 160: 25 ms'\n"
               "set format y '%.0e'\nset xlabel 'CPU seconds per branch'\n"
               "set ylabel 'worst relative frequency error (closed form)'\n"
               "set title 'Work-precision: whole branches that reach E = 5e-3 (errors of 0 at "
@@ -430,6 +449,7 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
   std::string grid_rows, variant_rows;
   for (const Mode1BranchCost& c : grid_runs) grid_rows += row(c);
   for (const Mode1BranchCost& c : fine_runs) grid_rows += row(c);
+  for (const Mode1BranchCost& c : unchecked_runs) grid_rows += row(c);
   for (const Mode1BranchCost* c :
        {&base, &spp80, &paper_run, &eigen_square, &kinsol_square, &threads_base, &threads_run})
     variant_rows += row(*c);
@@ -444,6 +464,16 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
       largest.settings.elements, point_ratio,
       largest.settings.elements < 640 ? "640 not run here" : (point_ratio <= 2 ? "met" : "not met"),
       base.jacobians_per_point(), largest.jacobians_per_point(), largest.settings.elements);
+  const double unchecked_points =
+      static_cast<double>(unchecked_runs.back().points) / unchecked_runs.front().points;
+  const double unchecked_exponent = time_per_point_exponent(unchecked_runs, 40);
+  const std::string unchecked_verdict = fmt::format(
+      " Without rank checks (`--rank_check_every 0`), ms per point grows like N^{:.2f} over N = "
+      "40..640 ({} ms per point at 640, worst error {}) and N = 640 takes {:.3g}x the points of "
+      "N = 40.",
+      unchecked_exponent, significant(unchecked_runs.back().ms_per_point()),
+      error_text(unchecked_runs.back().worst_error), unchecked_points);
+  fmt::print("  {}\n", unchecked_verdict);
   std::string fine_verdict;
   if (std::count_if(fine_runs.begin(), fine_runs.end(),
                     [](const Mode1BranchCost& c) { return c.settings.elements >= 40; }) >= 2) {
@@ -511,9 +541,9 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
           "| threads | wall s | process CPU s |\n|---|---|---|\n| 1 | {6:.4g} | {7:.4g} |\n"
           "| 2 | {8:.4g} | {9:.4g} |\n\n**Where backbone stands:** {10}\n\n"
           "![Mode 1 cost per point and work-precision](mode1_scaling.png)\n",
-          header, grid_rows, grid_verdict + fine_verdict, variant_rows, variant_verdict, jacobian_n,
-          jt.one_thread_seconds, jt.one_thread_cpu, jt.two_thread_seconds, jt.two_thread_cpu,
-          jacobian_verdict, jt.repetitions));
+          header, grid_rows, grid_verdict + fine_verdict + unchecked_verdict, variant_rows,
+          variant_verdict, jacobian_n, jt.one_thread_seconds, jt.one_thread_cpu,
+          jt.two_thread_seconds, jt.two_thread_cpu, jacobian_verdict, jt.repetitions));
   return status;
 }
 

@@ -31,6 +31,7 @@ struct Mode1BranchSettings {
   std::string newton = "eigen";         // or kinsol (square systems only: test_elements 0)
   int test_elements = -1;               // -1: the trace's auto (2x the unknowns)
   int threads = 1;                      // finite-difference Jacobian columns
+  int rank_check_every = 1;             // --rank_check_every (0: no rank reports)
   double energy_max = 5e-3;             // [J]
   // "N = 40", "steps_per_period = 80", "paper formulation", ...: the row's label.
   std::string label() const;
