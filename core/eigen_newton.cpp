@@ -44,7 +44,7 @@ class LeastSquares {
   }
   // Least-squares solution of J dx = rhs (minimum norm for a rank-deficient J). Returns the
   // rank used.
-  int solve(const Vector& rhs, Vector& dx) const {
+  int solve(const Vector& rhs, Vector& dx) {
     if (use_sparse_) {
       if (sparse_.solve(rhs, dx)) return rank();
       // The iteration did not converge on this right-hand side (not seen on the contact bar):
@@ -89,7 +89,7 @@ class LeastSquares {
   }
 
   // The dense path: Householder QR where J is well conditioned, else the COD of its R.
-  void dense(const Matrix& J, double cutoff) const {
+  void dense(const Matrix& J, double cutoff) {
     use_qr_ = false;
     on_r_ = false;
     cod_.setThreshold(cutoff);
@@ -108,14 +108,13 @@ class LeastSquares {
     if (!use_qr_ && !on_r_) cod_.compute(J);
   }
 
-  // mutable: solve() may replace the sparse path by the dense one of the same J.
   SparseLeastSquares sparse_;
-  mutable bool use_sparse_ = false;
+  bool use_sparse_ = false;  // solve() may replace it by the dense path of the same J
   double cutoff_ = 0;
-  mutable bool use_qr_ = false;
-  mutable bool on_r_ = false;  // cod_ factorises qr_'s R, not J
-  mutable Eigen::HouseholderQR<Matrix> qr_;
-  mutable Eigen::CompleteOrthogonalDecomposition<Matrix> cod_;
+  bool use_qr_ = false;
+  bool on_r_ = false;  // cod_ factorises qr_'s R, not J
+  Eigen::HouseholderQR<Matrix> qr_;
+  Eigen::CompleteOrthogonalDecomposition<Matrix> cod_;
 };
 
 // A chord step is kept when it cuts ||F||_2 by 1 / reuse_contraction, or, more slowly but still

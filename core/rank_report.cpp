@@ -105,7 +105,7 @@ struct TriangularGram {
 
 struct SparseGram {
   Eigen::SparseMatrix<double> a;
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> factor;
+  NormalFactor factor;
   Eigen::Index rows() const { return a.rows(); }
   Vector times(const Vector& v) const { return a * v; }
   Matrix times(const Matrix& x) const { return a * x; }
@@ -139,18 +139,10 @@ bool smallest_singular_values(const Matrix& J, const RankOptions& options, RankR
     SparseGram sparse;
     std::vector<char> dense_row;
     if (sparse_view(J, sparse.a, dense_row) &&
-        std::find(dense_row.begin(), dense_row.end(), 1) == dense_row.end()) {
-      Eigen::SparseMatrix<double> normal = sparse.a.transpose() * sparse.a;
-      double largest = 0;
-      for (Eigen::Index j = 0; j < n; ++j) largest = std::max(largest, normal.coeff(j, j));
-      if (largest > 0 && std::isfinite(largest)) {
-        for (Eigen::Index j = 0; j < n; ++j) normal.coeffRef(j, j) += 1e-10 * largest;
-        sparse.factor.compute(normal);
-        if (sparse.factor.info() == Eigen::Success &&
-            smallest_singular_values(sparse, n, options, report))
-          return true;
-      }
-    }
+        std::find(dense_row.begin(), dense_row.end(), 1) == dense_row.end() &&
+        factor_shifted_normal(sparse.a, sparse.factor) &&
+        smallest_singular_values(sparse, n, options, report))
+      return true;
   }
   const Eigen::HouseholderQR<Matrix> qr(J);
   TriangularGram triangular{qr.matrixQR().topRows(n).triangularView<Eigen::Upper>()};

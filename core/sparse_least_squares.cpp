@@ -39,35 +39,31 @@ bool sparse_view(const Matrix& J, Eigen::SparseMatrix<double>& A, std::vector<ch
   return true;
 }
 
+bool factor_shifted_normal(const Eigen::SparseMatrix<double>& A, NormalFactor& factor) {
+  Eigen::SparseMatrix<double> normal = A.transpose() * A;
+  double largest = 0;
+  for (Eigen::Index j = 0; j < normal.cols(); ++j) largest = std::max(largest, normal.coeff(j, j));
+  if (!(largest > 0) || !std::isfinite(largest)) return false;
+  for (Eigen::Index j = 0; j < normal.cols(); ++j) normal.coeffRef(j, j) += 1e-10 * largest;
+  factor.compute(normal);
+  return factor.info() == Eigen::Success;
+}
+
 bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
   const Eigen::Index n = J.cols();
-  std::vector<char> dense_row;
-  a_.resize(0, 0);
-  if (!sparse_view(J, a_, dense_row)) {
+  const auto reject = [this] {
     a_.resize(0, 0);
     return false;
-  }
+  };
+  std::vector<char> dense_row;
+  if (!sparse_view(J, a_, dense_row)) return reject();
   Eigen::SparseMatrix<double> sparse_rows = a_;
   sparse_rows.prune([&](Eigen::Index i, Eigen::Index, double) {
     return !dense_row[static_cast<std::size_t>(i)];
   });
-  Eigen::SparseMatrix<double> normal = sparse_rows.transpose() * sparse_rows;
-  double largest_diagonal = 0, largest_column = 0;
-  for (Eigen::Index j = 0; j < n; ++j) {
-    largest_diagonal = std::max(largest_diagonal, normal.coeff(j, j));
-    largest_column = std::max(largest_column, a_.col(j).norm());
-  }
-  if (!(largest_diagonal > 0) || !std::isfinite(largest_diagonal)) {
-    a_.resize(0, 0);
-    return false;
-  }
-  const double mu = 1e-10 * largest_diagonal;
-  for (Eigen::Index j = 0; j < n; ++j) normal.coeffRef(j, j) += mu;
-  factor_.compute(normal);
-  if (factor_.info() != Eigen::Success) {
-    a_.resize(0, 0);
-    return false;
-  }
+  if (!factor_shifted_normal(sparse_rows, factor_)) return reject();
+  double largest_column = 0;
+  for (Eigen::Index j = 0; j < n; ++j) largest_column = std::max(largest_column, a_.col(j).norm());
   // sigma_min from above: two steps of inverse iteration on J^T J from a fixed start
   // (|| (J^T J)^-1 z || / ||z|| <= 1 / sigma_min^2), pseudo-random so that no null vector is
   // orthogonal to it by symmetry (ones is, to the difference of two equal columns).
@@ -75,30 +71,20 @@ bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
   for (Eigen::Index j = 0; j < n; ++j) z[j] = fixed_weight(static_cast<std::uint64_t>(j));
   double estimate = largest_column;
   for (int step = 0; step < 2; ++step) {
-    if (!normal_solve(z, y, 1e-6)) {
-      a_.resize(0, 0);
-      return false;
-    }
+    if (!normal_solve(z, y, 1e-6)) return reject();
     const double grow = y.norm() / z.norm();
-    if (!std::isfinite(grow) || !(grow > 0)) {
-      a_.resize(0, 0);
-      return false;
-    }
+    if (!std::isfinite(grow) || !(grow > 0)) return reject();
     estimate = std::min(estimate, 1.0 / std::sqrt(grow));
     z = y / y.norm();
   }
   const double cutoff = rank_cutoff > 0 ? rank_cutoff : 0.0;
-  if (!(estimate > std::max(2 * cutoff, 1e-7) * largest_column)) {
-    a_.resize(0, 0);
-    return false;
-  }
+  if (!(estimate > std::max(2 * cutoff, 1e-7) * largest_column)) return reject();
   return true;
 }
 
 bool SparseLeastSquares::normal_solve(const Vector& g, Vector& y, double relative_tolerance) const {
   const double g_norm = g.norm();
   y = Vector::Zero(g.size());
-  last_iterations_ = 0;
   if (g_norm == 0) return true;
   Vector r = g, z = factor_.solve(r), p = z;
   double rz = r.dot(z);
@@ -111,13 +97,13 @@ bool SparseLeastSquares::normal_solve(const Vector& g, Vector& y, double relativ
     const double alpha = rz / curvature;
     y += alpha * p;
     r -= alpha * q;
-    last_iterations_ = it;
     const double residual = r.norm() / g_norm;
     if (residual < best_residual) {
       best_residual = residual;
       best = y;
     }
-    // Converged, or stalled at round-off (no halving once below relative_tolerance x 1e3).
+    // Converged (1e-3 of the tolerance), or within the tolerance and no longer halving: the
+    // round-off floor.
     if (residual <= 1e-3 * relative_tolerance ||
         (residual <= relative_tolerance && residual > 0.5 * previous))
       break;

@@ -39,6 +39,14 @@ namespace backbone::core {
 // dense_row then mean nothing). Exact zeros of J are left out, every other entry kept.
 bool sparse_view(const Matrix& J, Eigen::SparseMatrix<double>& A, std::vector<char>& dense_row);
 
+using NormalFactor =
+    Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>>;
+
+// The sparse Cholesky factor of A^T A + mu I, mu = 1e-10 of A^T A's largest diagonal entry (A^T A
+// alone is singular wherever A has a null direction; the shift keeps its eigenvectors). false
+// when A^T A has no positive finite diagonal or the factorisation fails.
+bool factor_shifted_normal(const Eigen::SparseMatrix<double>& A, NormalFactor& factor);
+
 class SparseLeastSquares {
  public:
   // false (nothing kept) when J is too small or too dense to pay (n < min_columns, more than
@@ -50,7 +58,6 @@ class SparseLeastSquares {
   Eigen::Index cols() const { return a_.cols(); }
   // J as compute() kept it (dense), e.g. for a dense factorisation after a failed solve.
   Matrix matrix() const { return Matrix(a_); }
-  int last_iterations() const { return last_iterations_; }
 
   static constexpr Eigen::Index min_columns = 64;
   static constexpr int max_dense_rows = 8;
@@ -62,8 +69,7 @@ class SparseLeastSquares {
   bool normal_solve(const Vector& g, Vector& y, double relative_tolerance) const;
 
   Eigen::SparseMatrix<double> a_;  // J, compressed columns
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> factor_;
-  mutable int last_iterations_ = 0;
+  NormalFactor factor_;
 };
 
 }  // namespace backbone::core
