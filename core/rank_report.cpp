@@ -280,16 +280,48 @@ struct Probe {
   double drift = std::numeric_limits<double>::infinity();  // |corrected - stepped| / h
 };
 
+// The probe's constrained system, whose Jacobian is refused (EvalStatus::failed, which ends
+// the correction) at iterates farther than `radius` from x. A probe's end is used only within
+// |h| / drift_ratio of x (found_neighbour needs it within drift_ratio |h| of the stepped point,
+// and the rotation takes secants up to 1 / drift_ratio long): a correction that has wandered
+// beyond that is not expected back, and its further Jacobians were most of the cost of a
+// rank report on a many-dimensional family (core/README.md, 'Rank reports'). Residuals (line
+// searches, chord steps) stay allowed.
+class ProbeRegion : public Problem {
+ public:
+  ProbeRegion(const Problem& constrained, const Vector& x, double radius)
+      : constrained_(constrained), center_(x), radius_(radius) {}
+  int num_unknowns() const override { return constrained_.num_unknowns(); }
+  int num_equations() const override { return constrained_.num_equations(); }
+  std::string name() const override { return constrained_.name(); }
+  Vector typical_scale() const override { return constrained_.typical_scale(); }
+
+ protected:
+  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
+    return constrained_.residual(x, r);
+  }
+  EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override {
+    if (!((x - center_).norm() <= radius_)) return EvalStatus::failed;
+    return constrained_.jacobian(x, J);
+  }
+
+ private:
+  const Problem& constrained_;
+  const Vector& center_;
+  double radius_;
+};
+
 // Steps from x by h along d, re-corrects on the hyperplane through the stepped point.
 Probe probe(const Problem& problem, const Vector& x, const Vector& d, double h,
             Corrector& corrector, const VerifyOptions& options, const Matrix* jacobian_at_x) {
   Probe result;
   const Vector stepped = x + h * d;
-  const BorderedSystem constrained(problem, {BorderRow::hyperplane(d, stepped)});
+  const BorderedSystem bordered(problem, {BorderRow::hyperplane(d, stepped)});
+  const ProbeRegion constrained(bordered, x, std::abs(h) / options.drift_ratio);
   Vector y = stepped;
   Matrix nearby;
-  const NewtonSummary s = jacobian_at_x && constrained.jacobian_with_base(stepped, *jacobian_at_x,
-                                                                          nearby) == EvalStatus::ok
+  const NewtonSummary s = jacobian_at_x && bordered.jacobian_with_base(stepped, *jacobian_at_x,
+                                                                       nearby) == EvalStatus::ok
                               ? corrector.solve(constrained, y, nearby)
                               : corrector.solve(constrained, y);
   if (!y.allFinite()) return result;

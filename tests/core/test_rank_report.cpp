@@ -322,6 +322,36 @@ TEST(VerifyNullDirections, DoubleRootNeedsTheVerifiersIterationBudget) {
   }
 }
 
+// F(x) = x_1^2 exp(x_2) = 0: the line x_1 = 0. From the origin, the probe along e_2 starts on
+// it (F = 0, no Jacobian); the one along e_1 meets the hyperplane x_1 = +-h, where F = h^2
+// exp(x_2) has no root and each Gauss-Newton step moves x_2 by -1 (F / dF/dx_2 = 1). Unbounded,
+// that correction "converges" at x_2 = -10 (h^2 e^-10 < 1e-10, h = 1e-3) after 10 Jacobians,
+// 1e4 h from the stepped point; the probe's region (|h| / drift_ratio = 1e-2 around x) refuses
+// the second Jacobian, at x_2 = -1. Both sides of e_1 in both passes (the rotation puts e_2
+// first, e_1 second): 4 Jacobians where there were 40, and the same verdict.
+class ExpParabola : public Problem {
+ public:
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 1; }
+
+ protected:
+  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
+    r.resize(1);
+    r[0] = x[0] * x[0] * std::exp(x[1]);
+    return EvalStatus::ok;
+  }
+};
+
+TEST(VerifyNullDirections, AProbeThatWandersOffEndsAtTheEdgeOfItsRegion) {
+  const ExpParabola p;
+  RankReport r;
+  r.null_directions = Matrix::Identity(2, 2);
+  const VerifyOptions v;
+  verify_null_directions(p, Vector::Zero(2), *make_verifier(v), v, r);
+  EXPECT_EQ(r.verified_dimension, 1) << r.summary();
+  EXPECT_EQ(p.counters().jacobians, 4);
+}
+
 TEST(VerifyNullDirections, BoundaryOfAHalfPlaneIsASurface) {
   // At the origin e_x points out of the half-plane x <= 0: the probe at x = +h stalls at
   // F = h^2 = 1e-6, far above the 1e-9 tolerance, so a one-sided verifier rejects it (given
