@@ -239,12 +239,20 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
         std::max(out.check_error, tolerance > 0 ? error / tolerance : (error > 0 ? HUGE_VAL : 0.0));
   }
   if (!(out.check_error <= 1)) {
-    if (!pattern.wider) return fall_back();
+    if (!pattern.wider) {
+      // A kink, not a missed entry, and a corrector judges its answer by F: keep J.
+      if (pattern.structural && CorrectorJacobians::tolerance() > 0) {
+        out.kept_unchecked = true;
+        return EvalStatus::ok;
+      }
+      return fall_back();
+    }
     CompressedJacobianReport wider;
     const EvalStatus ws =
         compressed_finite_difference_jacobian(problem, x, pattern.wider(), J, options, &wider);
     out.widened = true;
     out.fell_back = wider.fell_back;
+    out.kept_unchecked = wider.kept_unchecked;
     out.residuals += wider.residuals;
     return ws;
   }

@@ -12,7 +12,8 @@
 // (p_j = +-(1..2) h_j, the same for every x) compares J p with F(x + p) - F(x); a pattern that
 // misses an entry J_ij shows up there as |J_ij| h_j (the tolerance is in the .cpp). On failure
 // the Jacobian is recomputed from pattern.wider when there is one (report->widened, checked
-// the same way), else column by column (report->fell_back).
+// the same way), else column by column (report->fell_back), except for a structural pattern
+// inside a corrector's scope, whose J is kept (report->kept_unchecked).
 //
 //   JacobianPattern pattern;                 // tridiagonal 5 x 5: 3 colours instead of 5
 //   for (int i = 0; i < 5; ++i) for (int j = i - 1; j <= i + 1; ++j)
@@ -36,6 +37,9 @@ struct CompressedJacobianReport {
   bool fell_back = false;  // the check failed (or a coloured step could not be evaluated):
                            // J is the column-by-column finite-difference Jacobian
   double check_error = 0;  // max_i |(J p)_i - (F(x + p) - F(x))_i| / tolerance_i
+  // The check failed on a structural pattern (JacobianPattern::structural, the widest one
+  // tried) inside a corrector's scope: J is that pattern's, kept as it is.
+  bool kept_unchecked = false;
 };
 
 // Greedy colouring of the columns of `pattern` (n columns): colour[j] for each column, two

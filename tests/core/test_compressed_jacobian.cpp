@@ -165,6 +165,45 @@ TEST(CompressedJacobian, ACorrectorsScopeLoosensTheCheckAndEndsWithIt) {
   EXPECT_EQ(CorrectorJacobians::tolerance(), 0.0);
 }
 
+TEST(CompressedJacobian, AStructuralPatternIsKeptInACorrectorsScopeOnly) {
+  // The same failing check (the dropped superdiagonal, error e >> 1 at any scope below e 1e-3):
+  // outside a corrector's scope a pattern declared structural still falls back column by
+  // column; inside one its J is kept as it is, flagged, with the check's error reported.
+  const Arrow wrong(20, /*drop_superdiagonal=*/true);
+  const Vector x = point(20);
+  JacobianPattern pattern = wrong.pattern();
+  pattern.structural = true;
+  Matrix J;
+  CompressedJacobianReport report;
+  ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, pattern, J, {}, &report),
+            EvalStatus::ok);
+  EXPECT_TRUE(report.fell_back);
+  EXPECT_FALSE(report.kept_unchecked);
+  EXPECT_NE(J(0, 1), 0.0);
+  const double e = report.check_error;
+  ASSERT_GT(e, 2.0);
+  {
+    const CorrectorJacobians loose(0.5 * e * 1e-3);  // not enough to pass the check
+    ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, pattern, J, {}, &report),
+              EvalStatus::ok);
+    EXPECT_FALSE(report.fell_back);
+    EXPECT_TRUE(report.kept_unchecked);
+    EXPECT_NEAR(report.check_error, 2.0, 1e-12);
+    EXPECT_EQ(J(0, 1), 0.0);  // the dropped entry stays dropped
+  }
+  // Reached through the wider pattern: the flag comes along.
+  JacobianPattern narrow = wrong.pattern();
+  narrow.wider = [&pattern] { return pattern; };
+  {
+    const CorrectorJacobians loose(0.5 * e * 1e-3);
+    ASSERT_EQ(compressed_finite_difference_jacobian(wrong, x, narrow, J, {}, &report),
+              EvalStatus::ok);
+    EXPECT_TRUE(report.widened);
+    EXPECT_TRUE(report.kept_unchecked);
+    EXPECT_FALSE(report.fell_back);
+  }
+}
+
 TEST(RunTasks, EachTaskRunsOnceAndTheCallingThreadTakesPart) {
   // The tasks are taken dynamically: every index exactly once, whatever the number of threads
   // (also more threads than tasks), and the calling thread is one of the workers. With 2
