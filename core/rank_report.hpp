@@ -82,10 +82,11 @@ RankReport rank_report(const Matrix& J, const RankOptions& options);
 // numerical failure (a direction that fails to re-correct is simply not verified).
 // Each direction d is probed at +h, and at -h when +h finds no neighbour: at a point on the
 // boundary of a manifold (a grazing limit of a continuum) solutions lie on one side only.
-// When some candidate direction fails, the basis of the candidate null space is rotated
-// (same span, still orthonormal) onto the secants of the successful probes and probed again,
-// because the SVD basis need not be aligned with the solution set (J = 0 at a double root):
-// null_directions is then replaced by the rotated basis, and direction_verified refers to it.
+// When some candidate directions fail, the basis of their span is rotated (same span, still
+// orthonormal) onto the secants of their converged probes and probed again, because the SVD
+// basis need not be aligned with the solution set (J = 0 at a double root); the directions
+// that passed stay. null_directions is then replaced by the passed directions followed by the
+// rotated ones, and direction_verified refers to it.
 // The corrector must handle m + 1 equations in n unknowns: KINSOL only when m + 1 == n.
 // jacobian_at_x (J of problem at x, when the caller has it) starts every probe's correction
 // with chord steps on its factorization (core/newton.hpp): a probe steps by `step`, so J(x) is
