@@ -352,6 +352,41 @@ TEST(VerifyNullDirections, AProbeThatWandersOffEndsAtTheEdgeOfItsRegion) {
   EXPECT_EQ(p.counters().jacobians, 4);
 }
 
+// F(x) = (x_1 - x_3^2) exp(x_2) = 0: the surface x_1 = x_3^2. From the origin with the basis
+// (e_1, e_2, e_3): e_2 starts on it (no Jacobian), e_3 lands on it in one Newton step (x_1 =
+// h^2, drift h), e_1 wanders off like ExpParabola's (one Jacobian on each side). The second
+// pass keeps e_2 and e_3 as they are and probes again only the span of e_1: 1 + 2 + 2
+// Jacobians, and the basis returned starts with the two verified directions.
+class ExpSurface : public Problem {
+ public:
+  int num_unknowns() const override { return 3; }
+  int num_equations() const override { return 1; }
+
+ protected:
+  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
+    r.resize(1);
+    r[0] = (x[0] - x[2] * x[2]) * std::exp(x[1]);
+    return EvalStatus::ok;
+  }
+};
+
+TEST(VerifyNullDirections, TheSecondPassKeepsTheDirectionsThatPassed) {
+  const ExpSurface p;
+  RankReport r;
+  r.null_directions = Matrix::Identity(3, 3);
+  const VerifyOptions v;
+  verify_null_directions(p, Vector::Zero(3), *make_verifier(v), v, r);
+  EXPECT_EQ(r.verified_dimension, 2) << r.summary();
+  EXPECT_EQ(p.counters().jacobians, 5);
+  ASSERT_EQ(r.direction_verified.size(), 3u);
+  EXPECT_TRUE(r.direction_verified[0]);
+  EXPECT_TRUE(r.direction_verified[1]);
+  EXPECT_FALSE(r.direction_verified[2]);
+  EXPECT_EQ(r.null_directions.col(0), Vector::Unit(3, 1));
+  EXPECT_EQ(r.null_directions.col(1), Vector::Unit(3, 2));
+  EXPECT_EQ(r.null_directions.col(2).cwiseAbs(), Vector::Unit(3, 0));
+}
+
 TEST(VerifyNullDirections, BoundaryOfAHalfPlaneIsASurface) {
   // At the origin e_x points out of the half-plane x <= 0: the probe at x = +h stalls at
   // F = h^2 = 1e-6, far above the 1e-9 tolerance, so a one-sided verifier rejects it (given
