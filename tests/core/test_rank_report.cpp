@@ -322,6 +322,35 @@ TEST(VerifyNullDirections, DoubleRootNeedsTheVerifiersIterationBudget) {
   }
 }
 
+// One equation g(x) exp(x_2) = 0 in n unknowns: the solution set is g = 0, and where g has
+// no root on a hyperplane, Gauss-Newton moves x_2 by -1 per step.
+class TimesExp : public Problem {
+ public:
+  TimesExp(int n, double (*g)(const Vector&)) : n_(n), g_(g) {}
+  int num_unknowns() const override { return n_; }
+  int num_equations() const override { return 1; }
+
+ protected:
+  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
+    r.resize(1);
+    r[0] = g_(x) * std::exp(x[1]);
+    return EvalStatus::ok;
+  }
+
+ private:
+  int n_;
+  double (*g_)(const Vector&);
+};
+
+// verify_null_directions from the origin with the candidate basis (e_1, ..., e_n).
+RankReport verified_from_origin(const Problem& p) {
+  RankReport r;
+  r.null_directions = Matrix::Identity(p.num_unknowns(), p.num_unknowns());
+  const VerifyOptions v;
+  verify_null_directions(p, Vector::Zero(p.num_unknowns()), *make_verifier(v), v, r);
+  return r;
+}
+
 // F(x) = x_1^2 exp(x_2) = 0: the line x_1 = 0. From the origin, the probe along e_2 starts on
 // it (F = 0, no Jacobian); the one along e_1 meets the hyperplane x_1 = +-h, where F = h^2
 // exp(x_2) has no root and each Gauss-Newton step moves x_2 by -1 (F / dF/dx_2 = 1). Unbounded,
@@ -329,53 +358,21 @@ TEST(VerifyNullDirections, DoubleRootNeedsTheVerifiersIterationBudget) {
 // 1e4 h from the stepped point; the probe's region (|h| / drift_ratio = 1e-2 around x) refuses
 // the second Jacobian, at x_2 = -1. Both sides of e_1 in both passes (the rotation puts e_2
 // first, e_1 second): 4 Jacobians where there were 40, and the same verdict.
-class ExpParabola : public Problem {
- public:
-  int num_unknowns() const override { return 2; }
-  int num_equations() const override { return 1; }
-
- protected:
-  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
-    r.resize(1);
-    r[0] = x[0] * x[0] * std::exp(x[1]);
-    return EvalStatus::ok;
-  }
-};
-
 TEST(VerifyNullDirections, AProbeThatWandersOffEndsAtTheEdgeOfItsRegion) {
-  const ExpParabola p;
-  RankReport r;
-  r.null_directions = Matrix::Identity(2, 2);
-  const VerifyOptions v;
-  verify_null_directions(p, Vector::Zero(2), *make_verifier(v), v, r);
+  const TimesExp p(2, [](const Vector& x) { return x[0] * x[0]; });
+  const RankReport r = verified_from_origin(p);
   EXPECT_EQ(r.verified_dimension, 1) << r.summary();
   EXPECT_EQ(p.counters().jacobians, 4);
 }
 
 // F(x) = (x_1 - x_3^2) exp(x_2) = 0: the surface x_1 = x_3^2. From the origin with the basis
 // (e_1, e_2, e_3): e_2 starts on it (no Jacobian), e_3 lands on it in one Newton step (x_1 =
-// h^2, drift h), e_1 wanders off like ExpParabola's (one Jacobian on each side). The second
+// h^2, drift h), e_1 wanders off as in the test above (one Jacobian on each side). The second
 // pass keeps e_2 and e_3 as they are and probes again only the span of e_1: 1 + 2 + 2
 // Jacobians, and the basis returned starts with the two verified directions.
-class ExpSurface : public Problem {
- public:
-  int num_unknowns() const override { return 3; }
-  int num_equations() const override { return 1; }
-
- protected:
-  EvalStatus compute_residual(const Vector& x, Vector& r) const override {
-    r.resize(1);
-    r[0] = (x[0] - x[2] * x[2]) * std::exp(x[1]);
-    return EvalStatus::ok;
-  }
-};
-
 TEST(VerifyNullDirections, TheSecondPassKeepsTheDirectionsThatPassed) {
-  const ExpSurface p;
-  RankReport r;
-  r.null_directions = Matrix::Identity(3, 3);
-  const VerifyOptions v;
-  verify_null_directions(p, Vector::Zero(3), *make_verifier(v), v, r);
+  const TimesExp p(3, [](const Vector& x) { return x[0] - x[2] * x[2]; });
+  const RankReport r = verified_from_origin(p);
   EXPECT_EQ(r.verified_dimension, 2) << r.summary();
   EXPECT_EQ(p.counters().jacobians, 5);
   ASSERT_EQ(r.direction_verified.size(), 3u);
