@@ -356,8 +356,8 @@ RankReport verified_from_origin(const Problem& p) {
 // exp(x_2) has no root and each Gauss-Newton step moves x_2 by -1 (F / dF/dx_2 = 1). Unbounded,
 // that correction "converges" at x_2 = -10 (h^2 e^-10 < 1e-10, h = 1e-3) after 10 Jacobians,
 // 1e4 h from the stepped point; the probe's region (|h| / drift_ratio = 1e-2 around x) refuses
-// the second Jacobian, at x_2 = -1. Both sides of e_1 in both passes (the rotation puts e_2
-// first, e_1 second): 4 Jacobians where there were 40, and the same verdict.
+// the second Jacobian, at x_2 = -1. Both sides of e_1 in both passes (the second probes only
+// e_1 again): 4 Jacobians where there were 40, and the same verdict.
 TEST(VerifyNullDirections, AProbeThatWandersOffEndsAtTheEdgeOfItsRegion) {
   const TimesExp p(2, [](const Vector& x) { return x[0] * x[0]; });
   const RankReport r = verified_from_origin(p);
