@@ -395,9 +395,10 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   // Without free knots, the exact solver's bare supports and the TD-BEM's c dt margin hold
   // every entry, so a check that fails on them is a kink of F (a contact event moved by the
   // check's step): structural, kept by a corrector (core/problem.hpp). At the grazing start
-  // of mode 1 at N = 320 (a family of 23 verified dimensions) 2 of 3 of the probes' Jacobians
+  // of mode 1 at N = 320 (a family of 23 verified dimensions) most of the probes' Jacobians
   // fell back column by column; kept, the same probes reached the same verdicts with the same
-  // number of Jacobians, on 2.7x fewer residuals. With free knots (the subharmonic members)
+  // number of Jacobians on 47,305 residuals instead of 128,450 (11,247 instead of 26,703 once
+  // the probes had their region, core/rank_report.cpp). With free knots (the subharmonic members)
   // they are not: kept, the probes of SubharmonicRepresentation.VerifiedDimensionIsTwo
   // stalled at |F| ~ 1e-8 where the column-by-column Jacobians converge.
   const bool structural = options_.free_knots == 0;
