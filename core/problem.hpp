@@ -76,8 +76,8 @@ struct JacobianPattern {
   // True when the pattern holds every entry F can have, whatever x: its check then fails only
   // where F has a kink between x and the check's step (a contact event that the step moves),
   // which column-by-column differences straddle as well. Inside a corrector's scope
-  // (CorrectorJacobians), such a pattern's Jacobian is kept when its check fails
-  // (CompressedJacobianReport::kept_unchecked) instead of being recomputed column by column:
+  // (CorrectorJacobians with a tolerance > 0), such a pattern's Jacobian is kept when its check
+  // fails (CompressedJacobianReport::kept_unchecked) instead of being recomputed column by column:
   // the corrector's answer is judged by F alone (core/README.md, 'Compressed Jacobians').
   bool structural = false;
 };

@@ -428,28 +428,30 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
   // along the rotated directions the drift criterion is meaningful. (Rotating and probing
   // the whole basis again also re-probed what pass 1 had verified, and could lose some of it:
   // 23 verified on the contact bar's grazing start at N = 320 where this keeps 26 of 32.)
-  std::vector<int> kept, redo;
-  for (int i = 0; i < k; ++i)
-    (found_neighbour(first[static_cast<std::size_t>(i)], options) ? kept : redo).push_back(i);
-  const int r = static_cast<int>(redo.size());
-  Matrix R(n, r);
-  for (int c = 0; c < r; ++c) R.col(c) = D.col(redo[static_cast<std::size_t>(c)]);
+  std::vector<int> order;  // the passed directions first, then the others
+  for (const bool passed : {true, false})
+    for (int i = 0; i < k; ++i)
+      if (found_neighbour(first[static_cast<std::size_t>(i)], options) == passed)
+        order.push_back(i);
+  const int verified_before =
+      k - static_cast<int>(std::count_if(first.begin(), first.end(), [&](const Probe& p) {
+        return !found_neighbour(p, options);
+      }));
+  const int r = k - verified_before;
+  Matrix rotated(n, k);
+  for (int c = 0; c < k; ++c) rotated.col(c) = D.col(order[static_cast<std::size_t>(c)]);
   Matrix secants(r, r);
   int good = 0;
-  for (int i : redo) {
-    const auto& p = first[static_cast<std::size_t>(i)];
+  for (int c = verified_before; c < k; ++c) {
+    const auto& p = first[static_cast<std::size_t>(order[static_cast<std::size_t>(c)])];
     if (p.converged && p.secant.norm() <= 1.0 / options.drift_ratio)
-      secants.col(good++) = R.transpose() * p.secant;  // coordinates in span(R)
+      secants.col(good++) = rotated.rightCols(r).transpose() * p.secant;  // in their span
   }
   if (good > 0) {
     Eigen::JacobiSVD<Matrix> svd(secants.leftCols(good), Eigen::ComputeFullU);
-    R = R * svd.matrixU();  // still an orthonormal basis of span(R), principal secants first
+    // Still an orthonormal basis of their span, principal secants first.
+    rotated.rightCols(r) = (rotated.rightCols(r) * svd.matrixU()).eval();
   }
-  const int verified_before = static_cast<int>(kept.size());
-  Matrix rotated(n, k);
-  for (int c = 0; c < verified_before; ++c)
-    rotated.col(c) = D.col(kept[static_cast<std::size_t>(c)]);
-  rotated.rightCols(r) = R;
   report.direction_verified.assign(static_cast<std::size_t>(k), false);
   int verified = 0;
   for (int c = 0; c < k; ++c) {
