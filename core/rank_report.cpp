@@ -45,6 +45,9 @@ NewtonOptions VerifyOptions::corrector_options() const {
   NewtonOptions newton;
   newton.residual_tolerance = corrector_tolerance_ratio * residual_tolerance;
   newton.max_iterations = max_iterations;
+  // Chord steps on a probe's fresh Jacobian while they contract (core/README.md, 'Rank
+  // reports': 146 -> 106 Jacobians on the contact bar's grazing start at N = 320).
+  newton.reuse_jacobian = true;
   return newton;
 }
 

@@ -55,7 +55,7 @@ struct VerifyOptions {
   int max_iterations = 60;
   double corrector_tolerance_ratio = 0.1;
   void validate() const;
-  // NewtonOptions' defaults with the two settings above.
+  // NewtonOptions' defaults with the two settings above, and chord steps (reuse_jacobian).
   NewtonOptions corrector_options() const;
 };
 
