@@ -641,7 +641,7 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
   if (!chord_of_j) own_chord.emplace(J, null_cutoff());
   const Chord& chord = chord_of_j ? *chord_of_j : *own_chord;
   const core::VerifyOptions& v = options_.verification;
-  const double h = v.step;
+  const double h = options_.branch_points.probe_step;
   double smallest = std::numeric_limits<double>::infinity();
   int attached = 0;
   int subspace_done = 0, subspace_failed = 0;

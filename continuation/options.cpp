@@ -91,6 +91,7 @@ void BranchPointOptions::validate() const {
     throw core::InputError("branch_points.dip_ratio",
                            fmt::format("must be in (0, 1) (got {})", dip_ratio));
   require_positive("branch_points.location_tolerance", location_tolerance);
+  require_positive("branch_points.probe_step", probe_step);
   if (max_probes < 1)
     throw core::InputError("branch_points.max_probes",
                            fmt::format("must be >= 1 (got {})", max_probes));

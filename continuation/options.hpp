@@ -57,6 +57,13 @@ struct BranchPointOptions {
   int max_location_steps = 40;
   // Probes of candidate attached directions at a located point (each a corrected point).
   int max_probes = 24;
+  // Their step (scaled units). Not the rank verification's (core::VerifyOptions::step, 1e-4):
+  // a located point lies within ~1e-7 in period of the intersection, not on it, so its probes
+  // step farther than the points' own verification does. On the contact bar at 100 intervals
+  // the attached dimensions at T = 3.6 and 3.5 read 14 and 20 with 1e-4, 17 and 22 with 1e-3,
+  // and the follow starts (the probe points) sit one step from the located point
+  // (continuation/README.md, 'Branch points').
+  double probe_step = 1e-3;
   void validate() const;  // InputError naming branch_points.<field>
 };
 

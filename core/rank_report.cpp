@@ -314,19 +314,36 @@ class ProbeRegion : public Problem {
   double radius_;
 };
 
+// J(x) as the start of the probes' chord steps, while it serves. At a kink of F (the contact
+// bar's grazing start) J(x) mixes the two sides and no probe's first chord step on it pays, yet
+// each probe factorised it (a dense QR of the bordered system, whose other null directions keep
+// it off the sparse path): once two probes have needed a fresh Jacobian and none has been
+// corrected on J(x) alone, the later probes start with a fresh one (core/README.md, 'Rank
+// reports').
+struct ChordStart {
+  const Matrix* jacobian_at_x = nullptr;
+  int refused = 0, served = 0;
+  const Matrix* jacobian() const { return refused >= 2 && served == 0 ? nullptr : jacobian_at_x; }
+  void record(const NewtonSummary& s) {
+    (s.jacobian_evaluations == 0 ? served : refused) += 1;
+  }
+};
+
 // Steps from x by h along d, re-corrects on the hyperplane through the stepped point.
 Probe probe(const Problem& problem, const Vector& x, const Vector& d, double h,
-            Corrector& corrector, const VerifyOptions& options, const Matrix* jacobian_at_x) {
+            Corrector& corrector, const VerifyOptions& options, ChordStart& start) {
   Probe result;
   const Vector stepped = x + h * d;
   const BorderedSystem bordered(problem, {BorderRow::hyperplane(d, stepped)});
   const ProbeRegion constrained(bordered, x, std::abs(h) / options.drift_ratio);
   Vector y = stepped;
   Matrix nearby;
-  const NewtonSummary s = jacobian_at_x && bordered.jacobian_with_base(stepped, *jacobian_at_x,
-                                                                       nearby) == EvalStatus::ok
-                              ? corrector.solve(constrained, y, nearby)
-                              : corrector.solve(constrained, y);
+  const Matrix* base = start.jacobian();
+  const bool chord =
+      base && bordered.jacobian_with_base(stepped, *base, nearby) == EvalStatus::ok;
+  const NewtonSummary s =
+      chord ? corrector.solve(constrained, y, nearby) : corrector.solve(constrained, y);
+  if (chord) start.record(s);
   if (!y.allFinite()) return result;
   Vector f;
   // Judge the corrected point by F itself (the corrector's own tolerance may be looser).
@@ -362,10 +379,10 @@ Probe known_neighbour(const Vector& x, const Vector& d, const Vector& z) {
 // manifold (a grazing limit of a continuum) only one side holds solutions.
 Probe probe_either_side(const Problem& problem, const Vector& x, const Vector& d, double h,
                         Corrector& corrector, const VerifyOptions& options,
-                        const Matrix* jacobian_at_x) {
-  Probe forward = probe(problem, x, d, h, corrector, options, jacobian_at_x);
+                        ChordStart& start) {
+  Probe forward = probe(problem, x, d, h, corrector, options, start);
   if (found_neighbour(forward, options)) return forward;
-  Probe backward = probe(problem, x, d, -h, corrector, options, jacobian_at_x);
+  Probe backward = probe(problem, x, d, -h, corrector, options, start);
   return found_neighbour(backward, options) ? backward : forward;
 }
 
@@ -399,12 +416,13 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
     neighbour_ok = problem.residual(*neighbour, f) == EvalStatus::ok &&
                    f.lpNorm<Eigen::Infinity>() <= options.residual_tolerance;
   }
+  ChordStart start{jacobian_at_x};
   const auto probe_direction = [&](const Vector& d) {
     if (neighbour_ok) {
       Probe known = known_neighbour(x, d, *neighbour);
       if (found_neighbour(known, options)) return known;
     }
-    return probe_either_side(problem, x, d, step_along(d), corrector, options, jacobian_at_x);
+    return probe_either_side(problem, x, d, step_along(d), corrector, options, start);
   };
 
   // Pass 1: probe the candidate basis as given.

@@ -6,6 +6,7 @@
 #include <Eigen/QR>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -257,6 +258,12 @@ TEST(BranchPoints, TurnCheckShrinksSteepSteps) {
   EXPECT_DOUBLE_EQ(unchecked.points[1].step_size, 1.0);
   o.branch_points.max_turn_degrees = 180;
   EXPECT_THROW(o.validate(), core::InputError);
+  // The probes' step must be positive and finite (it scales every probe of a located point).
+  o.branch_points.max_turn_degrees = 20;
+  for (const double step : {0.0, -1e-3, std::numeric_limits<double>::infinity()}) {
+    o.branch_points.probe_step = step;
+    EXPECT_THROW(o.validate(), core::InputError) << step;
+  }
 }
 
 namespace {
@@ -351,7 +358,9 @@ TEST(BranchPoints, TableHasTheDocumentedColumns) {
   EXPECT_NEAR(t.column("lambda")[0], 1.0, 1e-9);
   EXPECT_EQ(t.column("dimension")[0], 1.0);
   EXPECT_NEAR(t.column("tangent_angle")[0], 45.0, 1e-3);
-  // The probe steps h = 1e-3 along x and lands on x = lambda - 1: offset h sqrt(2).
-  EXPECT_NEAR(t.column("offset")[0], 1e-3 * std::sqrt(2.0), 1e-9);
+  // The probe steps h (BranchPointOptions::probe_step) along x and lands on x = lambda - 1:
+  // offset h sqrt(2).
+  EXPECT_NEAR(t.column("offset")[0],
+              continuation::BranchPointOptions{}.probe_step * std::sqrt(2.0), 1e-9);
   EXPECT_EQ(t.column("verified")[0], 1.0);
 }

@@ -65,10 +65,11 @@ TEST(Follow, TranscriticalSwitchesOntoTheExactAttachedLine) {
       EXPECT_LE(std::abs(lambda - 1 - x), 1e-10 / x) << "x " << x;
       previous = x;
     }
-    // It starts at the probe: one step h = 1e-3 along the null direction (1, 0) beyond the
-    // traced tangent, corrected onto the line (x unchanged by the hyperplane x = h), and lands
-    // on the bound.
-    EXPECT_NEAR(f.branch.points.front().x[0], 1e-3, 1e-12);
+    // It starts at the probe: one step h (BranchPointOptions::probe_step) along the null
+    // direction (1, 0) beyond the traced tangent, corrected onto the line (x unchanged by the
+    // hyperplane x = h), and lands on the bound.
+    EXPECT_NEAR(f.branch.points.front().x[0], continuation::BranchPointOptions{}.probe_step,
+                1e-12);
     EXPECT_NEAR(f.branch.points.back().x[0], 2.0, 1e-9);
   }
 }

@@ -257,6 +257,36 @@ TEST(VerifyNullDirections, AKnownNeighbourAlongTheDirectionStandsInForItsProbe) 
   }
 }
 
+// The probes' chord steps start on J(x) while it serves (rank_report.cpp, ChordStart). On the
+// unit sphere in R^6 at e_0 (5 null directions; each probe steps h along e_i, where
+// F = h^2) the exact J(x) = 2 e_0^T corrects every probe alone: no Jacobian. A J(x) of the
+// wrong sign (what a Jacobian across a kink can be) moves each chord step outwards, so it
+// never pays: the first two probes try it (one residual each), the other three start with a
+// fresh Jacobian at once, and every direction still verifies, the answer being judged by F.
+TEST(VerifyNullDirections, ProbesStopStartingOnAJacobianAtXThatNeverServes) {
+  Sphere sphere(6);
+  const Vector x = Vector::Unit(6, 0);
+  Matrix exact;
+  ASSERT_EQ(sphere.jacobian(x, exact), EvalStatus::ok);
+  const Matrix wrong = -exact;
+  const auto verify = [&](const Matrix* at_x, long& residuals, long& jacobians) {
+    const auto verifier = make_verifier(VerifyOptions{});
+    RankReport r = rank_report(exact, RankOptions{});
+    const long r0 = sphere.counters().residuals, j0 = sphere.counters().jacobians;
+    verify_null_directions(sphere, x, *verifier, VerifyOptions{}, r, at_x);
+    residuals = sphere.counters().residuals - r0;
+    jacobians = sphere.counters().jacobians - j0;
+    return r.verified_dimension;
+  };
+  long res_exact = 0, jac_exact = 0, res_none = 0, jac_none = 0, res_wrong = 0, jac_wrong = 0;
+  EXPECT_EQ(verify(&exact, res_exact, jac_exact), 5);
+  EXPECT_EQ(jac_exact, 0);
+  EXPECT_EQ(verify(nullptr, res_none, jac_none), 5);
+  EXPECT_EQ(verify(&wrong, res_wrong, jac_wrong), 5);
+  EXPECT_EQ(jac_wrong, jac_none);
+  EXPECT_EQ(res_wrong, res_none + 2);  // two refused chord steps, then no more attempts
+}
+
 TEST(VerifyNullDirections, SphereIsASurface) {
   Sphere sphere(3);
   Vector x(3);
