@@ -28,9 +28,9 @@ namespace {
 // round-off (cond(J) eps).
 class LeastSquares {
  public:
-  void compute(const Matrix& J, double rank_cutoff) {
+  void compute(const Matrix& J, double rank_cutoff, bool damped = false) {
     const double cutoff = rank_cutoff > 0 ? rank_cutoff : std::numeric_limits<double>::epsilon();
-    use_sparse_ = sparse_.compute(J, cutoff);
+    use_sparse_ = sparse_.compute(J, cutoff, damped);
     if (!use_sparse_) dense(J, cutoff);
     cutoff_ = cutoff;
   }
@@ -182,7 +182,7 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
   bool chord = options_.reuse_jacobian;
   if (nearby_jacobian && nearby_jacobian->rows() == r.size() &&
       nearby_jacobian->cols() == x.size() && nearby_jacobian->allFinite()) {
-    factorization.compute(*nearby_jacobian, options_.rank_cutoff);
+    factorization.compute(*nearby_jacobian, options_.rank_cutoff, options_.damped_sparse);
     have_factorization = true;
     chord = true;
   }
@@ -229,7 +229,7 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     if (eval != EvalStatus::ok)
       return finish(NewtonStatus::evaluation_failed,
                     fmt::format("eigen: Jacobian at iteration {}: {}", iteration, to_string(eval)));
-    factorization.compute(J, options_.rank_cutoff);
+    factorization.compute(J, options_.rank_cutoff, options_.damped_sparse);
     have_factorization = true;
     chord = options_.reuse_jacobian;
     const int rank = factorization.solve(-r, dx);

@@ -39,6 +39,12 @@ struct NewtonOptions {
   // their pattern asks for less (core::CorrectorJacobians): the answer is judged by F alone, so
   // an entry a pattern drops costs at most a slower contraction. 0: the patterns' own.
   double jacobian_check_tolerance = 1e-2;  // in [0, 1)
+  // Eigen backend: a sparse J too ill-conditioned for the exact sparse path (a rank-deficient
+  // one) takes a damped step, (J^T J + mu I) dx = -J^T F by the sparse factor
+  // (SparseLeastSquares::compute, damped), instead of the dense COD's minimum-norm one: O(nnz)
+  // instead of O(m n^2). For the rank verification's probes (core::VerifyOptions), whose
+  // bordered systems keep the other null directions of a many-dimensional family.
+  bool damped_sparse = false;
   void validate() const;  // throws InputError naming the field, e.g. "newton.max_iterations"
 };
 

@@ -48,6 +48,9 @@ NewtonOptions VerifyOptions::corrector_options() const {
   // Chord steps on a probe's fresh Jacobian while they contract (core/README.md, 'Rank
   // reports': 146 -> 106 Jacobians on the contact bar's grazing start at N = 320).
   newton.reuse_jacobian = true;
+  // Damped sparse steps where the probe's bordered system keeps the family's other null
+  // directions (core/README.md, 'Rank reports').
+  newton.damped_sparse = true;
   return newton;
 }
 

@@ -39,18 +39,21 @@ bool sparse_view(const Matrix& J, Eigen::SparseMatrix<double>& A, std::vector<ch
   return true;
 }
 
-bool factor_shifted_normal(const Eigen::SparseMatrix<double>& A, NormalFactor& factor) {
+bool factor_shifted_normal(const Eigen::SparseMatrix<double>& A, NormalFactor& factor,
+                           double* shift) {
   Eigen::SparseMatrix<double> normal = A.transpose() * A;
   double largest = 0;
   for (Eigen::Index j = 0; j < normal.cols(); ++j) largest = std::max(largest, normal.coeff(j, j));
   if (!(largest > 0) || !std::isfinite(largest)) return false;
   for (Eigen::Index j = 0; j < normal.cols(); ++j) normal.coeffRef(j, j) += 1e-10 * largest;
+  if (shift) *shift = 1e-10 * largest;
   factor.compute(normal);
   return factor.info() == Eigen::Success;
 }
 
-bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
+bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff, bool damped) {
   const Eigen::Index n = J.cols();
+  shift_ = 0;
   const auto reject = [this] {
     a_.resize(0, 0);
     return false;
@@ -61,7 +64,7 @@ bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
   sparse_rows.prune([&](Eigen::Index i, Eigen::Index, double) {
     return !dense_row[static_cast<std::size_t>(i)];
   });
-  if (!factor_shifted_normal(sparse_rows, factor_)) return reject();
+  if (!factor_shifted_normal(sparse_rows, factor_, &factor_shift_)) return reject();
   double largest_column = 0;
   for (Eigen::Index j = 0; j < n; ++j) largest_column = std::max(largest_column, a_.col(j).norm());
   // sigma_min from above: two steps of inverse iteration on J^T J from a fixed start
@@ -70,15 +73,22 @@ bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff) {
   Vector z(n), y;
   for (Eigen::Index j = 0; j < n; ++j) z[j] = fixed_weight(static_cast<std::uint64_t>(j));
   double estimate = largest_column;
+  // Damped, the operator J^T J + mu I differs from the factor's by the dense rows alone (rank
+  // k), whatever J's conditioning: the conjugate gradients still end in about k + 2 steps.
+  const auto keep_damped = [&] {
+    if (!damped) return reject();
+    shift_ = factor_shift_;
+    return true;
+  };
   for (int step = 0; step < 2; ++step) {
-    if (!normal_solve(z, y, 1e-6)) return reject();
+    if (!normal_solve(z, y, 1e-6)) return keep_damped();
     const double grow = y.norm() / z.norm();
-    if (!std::isfinite(grow) || !(grow > 0)) return reject();
+    if (!std::isfinite(grow) || !(grow > 0)) return keep_damped();
     estimate = std::min(estimate, 1.0 / std::sqrt(grow));
     z = y / y.norm();
   }
   const double cutoff = rank_cutoff > 0 ? rank_cutoff : 0.0;
-  if (!(estimate > std::max(2 * cutoff, 1e-7) * largest_column)) return reject();
+  if (!(estimate > std::max(2 * cutoff, 1e-7) * largest_column)) return keep_damped();
   return true;
 }
 
@@ -91,7 +101,7 @@ bool SparseLeastSquares::normal_solve(const Vector& g, Vector& y, double relativ
   Vector best = y;
   double best_residual = 1.0, previous = 1.0;
   for (int it = 1; it <= max_iterations; ++it) {
-    const Vector q = a_.transpose() * (a_ * p);
+    const Vector q = a_.transpose() * (a_ * p) + shift_ * p;
     const double curvature = p.dot(q);
     if (!(curvature > 0) || !std::isfinite(curvature)) break;
     const double alpha = rz / curvature;

@@ -45,14 +45,22 @@ using NormalFactor =
 // The sparse Cholesky factor of A^T A + mu I, mu = 1e-10 of A^T A's largest diagonal entry (A^T A
 // alone is singular wherever A has a null direction; the shift keeps its eigenvectors). false
 // when A^T A has no positive finite diagonal or the factorisation fails.
-bool factor_shifted_normal(const Eigen::SparseMatrix<double>& A, NormalFactor& factor);
+// shift, when given, receives mu.
+bool factor_shifted_normal(const Eigen::SparseMatrix<double>& A, NormalFactor& factor,
+                           double* shift = nullptr);
 
 class SparseLeastSquares {
  public:
   // false (nothing kept) when J is too small or too dense to pay (n < min_columns, more than
   // max_dense_rows rows with more than max(16, n / 8) entries, more than n / 8 entries per row
   // on average), when the factor fails, or when J fails the conditioning tests above.
-  bool compute(const Matrix& J, double rank_cutoff);
+  // damped: where J passes the sparsity tests but fails the conditioning ones (a rank-deficient
+  // J), keep it all the same and solve the damped normal equations (J^T J + mu I) x = J^T b
+  // instead, mu the factor's shift: a Levenberg-Marquardt step, which drops the components
+  // along singular values far below sqrt(mu) (1e-5 of the largest column norm) where the
+  // minimum-norm solution would divide by them (core/README.md, 'Newton correctors').
+  bool compute(const Matrix& J, double rank_cutoff, bool damped = false);
+  bool is_damped() const { return shift_ > 0; }
   // x minimising |J x - b|; false when the iteration did not converge (then x is unchanged).
   bool solve(const Vector& b, Vector& x) const;
   Eigen::Index cols() const { return a_.cols(); }
@@ -70,6 +78,8 @@ class SparseLeastSquares {
 
   Eigen::SparseMatrix<double> a_;  // J, compressed columns
   NormalFactor factor_;
+  double factor_shift_ = 0;  // mu of the factor
+  double shift_ = 0;         // mu when damped, else 0
 };
 
 }  // namespace backbone::core

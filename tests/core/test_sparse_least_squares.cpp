@@ -86,6 +86,56 @@ TEST(SparseLeastSquares, RefusesWhatTheDensePathDoesBetter) {
   EXPECT_TRUE(ls.compute(shooting_like(201, 100, true), 1e-5));
 }
 
+// Damped (SparseLeastSquares::compute, damped = true; the rank verification's probes): a
+// rank-deficient J that the exact path refuses is kept, and the solution is that of the damped
+// normal equations (J^T J + mu I) x = J^T b, mu = 1e-10 of the largest diagonal entry of the
+// sparse rows' normal matrix, here solved densely by Cholesky as the oracle. J has three exact
+// null directions (a column repeated, one doubled, one negated, the dense row too) and one
+// column scaled by 1e-7, whose small singular value the damping suppresses where the
+// minimum-norm solution would divide by it: the damped solution has no component along the
+// null directions, and for a consistent b in the span of the well-conditioned columns it
+// reproduces b to about mu / sigma^2 of their smallest singular value (~1e-6 relative here).
+TEST(SparseLeastSquares, DampedKeepsARankDeficientJacobianAndSolvesTheDampedNormalEquations) {
+  Matrix J = shooting_like(201, 100, true, 5);
+  J.col(10) = J.col(11);
+  J.col(40) = 2 * J.col(41);
+  J.col(70) = -J.col(72);
+  J.col(3) *= 1e-7;  // sigma ~ 1e-7 sigma_max: damped (sigma / mu), not inverted (1 / sigma)
+  SparseLeastSquares ls;
+  EXPECT_FALSE(ls.compute(J, 1e-12));
+  ASSERT_TRUE(ls.compute(J, 1e-12, true));
+  EXPECT_TRUE(ls.is_damped());
+  const Matrix sparse_rows = J.topRows(200);
+  const double mu = 1e-10 * (sparse_rows.transpose() * sparse_rows).diagonal().maxCoeff();
+  const Matrix damped = J.transpose() * J + mu * Matrix::Identity(100, 100);
+  const Vector b = Vector::LinSpaced(201, -1, 2).array().sin();
+  Vector x;
+  ASSERT_TRUE(ls.solve(b, x));
+  const Vector reference = damped.llt().solve(J.transpose() * b);
+  // The iteration stops at 1e-11 of J^T b in the (damped) normal residual; the damped matrix
+  // is conditioned like J^T J on the kept part (~1e4 here), so x is within ~1e-7 of it.
+  EXPECT_LT((x - reference).norm(), 1e-6 * reference.norm());
+  Matrix null(100, 3);
+  null.setZero();
+  null(10, 0) = 1;
+  null(11, 0) = -1;
+  null(40, 1) = 1;
+  null(41, 1) = -2;
+  null(70, 2) = 1;
+  null(72, 2) = 1;
+  ASSERT_LT((J * null).norm(), 1e-13 * J.norm());
+  // Along the null directions J^T b holds only its round-off, eps |J| |b|, which the damping
+  // divides by mu = 1e-10 |J|^2: at most ~eps / 1e-10 = 2e-6 of x (measured 3e-8; the dense
+  // oracle's own is 1.5e-7).
+  EXPECT_LT((null.transpose() * x).norm(), 1e-5 * x.norm());
+  Vector kept = Vector::LinSpaced(100, 0, 1);
+  kept[3] = 0;
+  kept -= null * (null.transpose() * null).ldlt().solve(null.transpose() * kept);
+  Vector y;
+  ASSERT_TRUE(ls.solve(J * kept, y));
+  EXPECT_LT((J * y - J * kept).norm(), 1e-6 * (J * kept).norm());
+}
+
 TEST(SparseLeastSquares, MinimumNormSolveTakesItAndAgreesWithTheSvd) {
   const Matrix J = shooting_like(301, 150, true, 11);
   const Vector b = Vector::LinSpaced(301, 0, 3).array().cos();
