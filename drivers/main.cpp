@@ -3,6 +3,9 @@
 
 #include <exception>
 #include <new>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "core/errors.hpp"
 #include "drivers/commands.hpp"
@@ -13,6 +16,18 @@ namespace {
 std::map<std::string, Command>& registry() {
   static std::map<std::string, Command> table;
   return table;
+}
+
+// glibc serves every block above 128 KiB by its own mmap and returns it on free, so each dense
+// Jacobian, QR or bordered system of a fine grid (6.5 MB at N = 640) is faulted in page by
+// page again: on this project's (virtualised) machines that was 2.7 of the 7.7 s of mode 1 at
+// N = 640 without rank checks, and most of the run-to-run scatter. Served from the heap and
+// kept there, the same trace takes 2.7 s (drivers/README.md, 'Memory').
+void keep_large_blocks() {
+#if defined(__GLIBC__)
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
+#endif
 }
 
 void print_usage() {
@@ -35,6 +50,7 @@ const std::map<std::string, Command>& commands() {
 
 int main(int argc, char** argv) {
   using namespace backbone;
+  drivers::keep_large_blocks();
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     drivers::print_usage();
     return argc < 2 ? core::exit_bad_input : core::exit_ok;
