@@ -16,7 +16,7 @@
 //                      oracle return error and rank reports at the final point, residuals in
 //                      metres whatever unit the problem uses.
 //   mode1_scaling      mode 1 of the paper scene, T 3.8 -> 3.01, traced in-process over the
-//                      grids N (BACKBONE_MODE1_SCALING_N, default 20,40,80,160,320), 80 steps
+//                      grids N (BACKBONE_MODE1_SCALING_N, default 20,40,80,160,320,640), 80 steps
 //                      per period, the paper formulation, kinsol and 2 threads: points,
 //                      Jacobians and CPU ms per point, worst closed-form error, the exponent of
 //                      ms per point over N >= 40; the FD Jacobian alone at N = 200 with 1 and 2

@@ -248,7 +248,7 @@ JacobianThreadsTiming time_jacobian_threads(int elements, int repetitions) {
 int bench_mode1_scaling(const std::filesystem::path& out) {
   const char* grids_env = std::getenv("BACKBONE_MODE1_SCALING_N");
   const std::vector<int> grids =
-      parse_element_list(grids_env && *grids_env ? grids_env : "20,40,80,160,320");
+      parse_element_list(grids_env && *grids_env ? grids_env : "20,40,80,160,320,640");
   fmt::print(
       "bench mode1_scaling: mode 1, T 3.8 -> 3.01 (paper scene, start_offset 0.25, energy_max "
       "5e-3), whole-branch cost vs closed-form error over N = {} (BACKBONE_MODE1_SCALING_N), "
@@ -529,9 +529,10 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
           "continuation (all threads), since the "
           "machine may be shared; Jacobians per point: BranchPoint::jacobian_evaluations "
           "averaged. Error: |omega / omega_exact(E) - 1| against the mode-1 closed form at "
-          "each point's own energy. Grids: BACKBONE_MODE1_SCALING_N (default 20,40,80,160,320; "
+          "each point's own energy. Grids: BACKBONE_MODE1_SCALING_N (default "
+          "20,40,80,160,320,640; "
           "`BACKBONE_MODE1_SCALING_N=20,40,80,160,320,640,1000 backbone bench --case "
-          "mode1_scaling` adds the large ones).\n\n"
+          "mode1_scaling` adds N = 1000).\n\n"
           "### Over the grid\n\n{0}{1}\n**Where backbone stands:** {2}\n\n"
           "### Steps per period, formulation, corrector, threads\n\n{0}{3}\n"
           "**Where backbone stands:** {4}\n\n"
