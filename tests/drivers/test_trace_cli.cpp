@@ -191,6 +191,27 @@ TEST(TraceCli, ResumeContinuesAnInterruptedBranch) {
   fs::remove(part.string() + ".log");
 }
 
+// A complete branch is not resumed as it is (it would add a point on the bound its last point
+// lies on): the files stay byte for byte, exit 0. A key that extends it is taken up.
+TEST(TraceCli, ResumingACompleteBranchChangesNothingUnlessAKeyExtendsIt) {
+  const fs::path done = cli::scratch("trace_cli", "done");
+  ASSERT_EQ(cli::run("trace", small_mode1, done).code, 0);
+  const std::string before = file_text(done / "branch.csv");
+  const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
+                             done.string() + "'";
+  ASSERT_EQ(std::system((resume + " > '" + done.string() + ".log' 2>&1").c_str()), 0);
+  EXPECT_NE(file_text(done.string() + ".log").find("nothing to resume"), std::string::npos)
+      << file_text(done.string() + ".log");
+  EXPECT_EQ(file_text(done / "branch.csv"), before);
+  ASSERT_EQ(std::system((resume + " --energy_max 3e-3 > '" + done.string() + ".log' 2>&1").c_str()),
+            0)
+      << file_text(done.string() + ".log");
+  const auto extended = backbone::core::Table::read_csv(done / "branch.csv");
+  EXPECT_GT(extended.column("energy").back(), 2.5e-3);
+  fs::remove_all(done);
+  fs::remove(done.string() + ".log");
+}
+
 // A resumed run reads the resolved scene.ini, where keys left at their defaults are comments: in
 // the amplitude units (mode 1's default) newton_tolerance is then still "not given" and the
 // branch keeps its own 1e-10 (problems/contact_bar/README.md, 'Cost'). When scene.ini listed
