@@ -19,7 +19,9 @@
 // one), and where the normal equations are safe: sigma_min above 1e-7 of that norm, so that
 // conjugate gradients on J^T J reach the solution to about cond(J) eps. sigma_min is estimated
 // from above by two steps of inverse iteration on J^T J (each a conjugate-gradient solve) from a
-// pseudo-random start, as the dense path estimates it on R^T R.
+// pseudo-random start, as the dense path estimates it on R^T R; where that lands between the
+// cut-off and twice it, by up to six more, and J is kept once the estimate settles (falls by
+// less than 1 % a step) above 1.25 times the cut-off.
 //
 //   SparseLeastSquares ls;
 //   if (ls.compute(J, 1e-12)) ls.solve(b, x);   // else a dense QR or COD

@@ -136,6 +136,32 @@ TEST(SparseLeastSquares, DampedKeepsARankDeficientJacobianAndSolvesTheDampedNorm
   EXPECT_LT((J * y - J * kept).norm(), 1e-6 * (J * kept).norm());
 }
 
+// A cut-off far above the normal equations' floor (the tangent's, the rank threshold) with
+// sigma_min between 1.25 and 2 times it: two inverse-iteration steps cannot tell it from below
+// the cut-off by their margin, the settled estimate can, and the solution is the full-rank
+// least-squares one (the SVD's). Below 1.25 times it the dense path keeps its say.
+TEST(SparseLeastSquares, ASettledEstimateBetweenTheCutoffAndTwiceItIsKept) {
+  Matrix J = shooting_like(201, 100, true, 9);
+  J.col(3) *= 1e-4;
+  const Eigen::JacobiSVD<Matrix> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  double largest_column = 0;
+  for (Eigen::Index j = 0; j < J.cols(); ++j)
+    largest_column = std::max(largest_column, J.col(j).norm());
+  const double ratio = svd.singularValues().tail(1)[0] / largest_column;
+  // A clear gap to the next value, so that the estimate settles at sigma_min.
+  ASSERT_LT(svd.singularValues().tail(1)[0], 0.2 * svd.singularValues().tail(2)[0]);
+  SparseLeastSquares ls;
+  ASSERT_TRUE(ls.compute(J, ratio / 1.6));
+  EXPECT_FALSE(ls.is_damped());
+  const Vector b = Vector::LinSpaced(201, -1, 2).array().sin();
+  Vector x;
+  ASSERT_TRUE(ls.solve(b, x));
+  const Vector reference = svd.solve(b);
+  // cond(J) ~ 1 / ratio (~1e4 here): the iteration's cond(J) eps, with a margin.
+  EXPECT_LT((x - reference).norm(), 1e-8 * reference.norm());
+  EXPECT_FALSE(ls.compute(J, ratio / 1.1));
+}
+
 TEST(SparseLeastSquares, MinimumNormSolveTakesItAndAgreesWithTheSvd) {
   const Matrix J = shooting_like(301, 150, true, 11);
   const Vector b = Vector::LinSpaced(301, 0, 3).array().cos();
