@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/bordered_system.hpp"
 #include "core/errors.hpp"
 
@@ -196,6 +199,17 @@ void LoopSteps::land_on_bound(const Bound& bound, double value, const core::Vect
   branch_.message =
       fmt::format("{} reached its bound {:.6g} after point {}", bound.observable, value, index - 1);
   if (!options_.land_on_bounds) return;
+  // x on the bound already (the last point of a branch that landed, taken up again by a
+  // restart): the branch ends there, where landing again added a copy of it.
+  const core::Observables at_x = problem_.observables(x);
+  const auto observed = std::find_if(at_x.begin(), at_x.end(),
+                                     [&](const auto& o) { return o.first == bound.observable; });
+  if (observed != at_x.end() &&
+      std::abs(observed->second - value) <= 1e-9 * std::max(std::abs(value), 1e-300)) {
+    branch_.message = fmt::format("{} reached its bound {:.6g} (point {} lies on it)",
+                                  bound.observable, value, index - 1);
+    return;
+  }
   recorder_.begin();
   const core::BorderedSystem on_bound(problem_,
                                       {core::BorderRow::observable(bound.observable, value)});

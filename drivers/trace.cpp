@@ -85,15 +85,6 @@ int run_trace(const std::vector<std::string>& args_in) {
       throw core::InputError(
           "resume", fmt::format("'{}' holds no scene.ini of a traced branch", resume.string()));
     const std::string branch = core::read_text_value(resume / "summary.txt", "branch");
-    // A branch that reached its end is not resumed unless a key changes it (a larger bound or
-    // point budget extends it): resuming it as it was added a point on the bound it lay on.
-    if (args.size() == 2 &&
-        core::read_text_value(resume / "summary.txt", "status") == "complete") {
-      fmt::print("{}: the branch is complete ({}); nothing to resume. Give a key to extend it, "
-                 "e.g. --energy_max or --max_points.\n",
-                 resume.string(), core::read_text_value(resume / "summary.txt", "message"));
-      return core::exit_ok;
-    }
     args.erase(args.begin(), args.begin() + 2);
     args.insert(args.begin(),
                 {(resume / "scene.ini").string(), "--branch", branch, "--out", resume.string()});
