@@ -328,7 +328,10 @@ struct ChordStart {
   int refused = 0, served = 0;
   const Matrix* jacobian() const { return refused >= 2 && served == 0 ? nullptr : jacobian_at_x; }
   void record(const NewtonSummary& s) {
-    (s.jacobian_evaluations == 0 ? served : refused) += 1;
+    if (s.jacobian_evaluations == 0)
+      ++served;
+    else
+      ++refused;
   }
 };
 

@@ -82,6 +82,7 @@ bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff, bool dampe
   };
   const double cutoff = rank_cutoff > 0 ? rank_cutoff : 0.0;
   const double margin = std::max(2 * cutoff, 1e-7) * largest_column;
+  const double floor = std::max(1.25 * cutoff, 1e-7) * largest_column;
   // Two steps, and, where the estimate lands between the cut-off and twice it (a cut-off far
   // above the normal equations' floor: the tangent's, the rank threshold 1e-5), up to six more
   // while it still falls by 1 % a step: it then sits within that of sigma_min when the next
@@ -96,7 +97,6 @@ bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff, bool dampe
     z = y / y.norm();
     if (step < 1) continue;
     if (estimate > margin) return true;
-    const double floor = std::max(1.25 * cutoff, 1e-7) * largest_column;
     if (!(estimate > floor)) return keep_damped();
     if (step > 1 && estimate > 0.99 * previous) return true;  // settled above the floor
     previous = estimate;
