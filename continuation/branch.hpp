@@ -92,6 +92,8 @@ struct BranchPointReport {
   double test_value = 0;          // signed test function at x (branch_points.hpp)
   bool sign_change = false;       // bracketed by a sign change (else by a dip)
   int location_steps = 0;         // corrected points spent locating it
+  // The problem's Jacobians and residuals spent locating and verifying it (its counters).
+  long jacobian_evaluations = 0, residual_evaluations = 0;
   int nullity = -1;               // candidate null directions of J at x (rank report)
   // Candidate directions beyond the traced tangent along which a probe found solutions (at most
   // options.branch_points.max_probes probed): the dimension of the attached family at this
@@ -137,7 +139,7 @@ core::Table branch_table(const Branch& branch);
 // columns (ContinuationHooks::describe_branch_point, e.g. frequency_ratio), tangent_angle
 // [degrees], verified (0/1), nullity (candidate directions at the point), after_point, arclength,
 // test_value, sign_change (0/1: located as a root, else as a dip's minimum), location_steps,
-// seconds.
+// jacobian_evaluations, residual_evaluations (location and verification), seconds.
 core::Table branch_point_table(const Branch& branch, const core::Observables& template_point = {});
 
 }  // namespace backbone::continuation

@@ -1,5 +1,6 @@
 #include "continuation/branch_points.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -17,15 +18,20 @@ namespace backbone::continuation {
 
 namespace {
 
-// The smallest singular triplet of the tall matrix A (rows >= cols) by inverse iteration on the
-// triangular factor R of A's Householder QR (sigma(R) = sigma(A)), from `start` (the previous
-// point's right vector: the triplet moves little between points, so a few iterations suffice).
-// Measured on the 201 x 101 bordered matrix of the contact bar at 100 intervals: the QR takes
-// 0.23 ms where the thin SVD took 3.9 ms, and each iteration two triangular solves (~10 us).
-// Converged when the triplet's residual |R^T u - sigma v| (a singular value of A lies within it
-// of sigma; sigma's own error is of its square over the gap) is below 1e-10 sigma plus 1e-14
-// |A|_F, the round-off of the solves; false when it is not within max_iterations (a cluster of
-// small singular values converges slowly): the caller falls back to the SVD.
+// The smallest singular triplet of the tall matrix A (rows >= cols) from the triangular factor R
+// of A's Householder QR (sigma(R) = sigma(A)): a Krylov basis of inverse iteration on R^T R from
+// `start` (the reference's right vector: the triplet moves little between points), and the
+// Rayleigh-Ritz triplet of R on it (the smallest singular triplet of R K, K orthonormal).
+// Plain inverse iteration converges as (sigma_1 / sigma_2)^2 per step, which near a branch point
+// of the contact bar, where some twenty singular values vanish together, took the 200 steps
+// allowed and then the SVD; the Ritz triplet of the Krylov space resolves the smallest of the
+// cluster in a few tens of vectors. Measured on the 201 x 101 bordered matrix of the contact bar
+// at 100 intervals: the QR takes 0.34 ms where the thin SVD took 6 ms, and each vector two
+// triangular solves (~10 us). Converged when the triplet's residual |R^T u - sigma v| (a singular
+// value of A lies within it of sigma) is below 1e-4 sigma plus 1e-12 |A|_F: the location needs
+// the value to a few digits, and near a root the residual stalls at 1e-13..1e-12 |A|_F (the
+// round-off of the basis); false when it is not within 40 vectors (at the contact bar's located
+// points, sigma ~ 1e-9 inside a cluster: 6 of 83 calls): the caller falls back to the SVD.
 bool smallest_singular_triplet(const core::Matrix& A, const core::Vector& start, core::Vector& left,
                                core::Vector& right, double& sigma) {
   const Eigen::Index n = A.cols();
@@ -33,24 +39,40 @@ bool smallest_singular_triplet(const core::Matrix& A, const core::Vector& start,
   const Eigen::HouseholderQR<core::Matrix> qr(A);
   const core::Matrix R = qr.matrixQR().topRows(n).triangularView<Eigen::Upper>();
   if (!(R.diagonal().cwiseAbs().minCoeff() > 0)) return false;
-  const double floor = 1e-14 * A.norm();
-  core::Vector v = start.size() == n && start.norm() > 0 ? core::Vector(start.normalized())
-                                                         : core::Vector::Ones(n) / std::sqrt(n);
-  constexpr int max_iterations = 200;
-  for (int iteration = 0; iteration < max_iterations; ++iteration) {
-    // One step of inverse iteration on R^T R: v <- R^{-1} R^{-T} v, normalised.
-    core::Vector w = R.transpose().triangularView<Eigen::Lower>().solve(v);
-    w = R.triangularView<Eigen::Upper>().solve(w);
-    const double norm = w.norm();
-    if (!(norm > 0) || !std::isfinite(norm)) return false;
-    v = w / norm;
-    const core::Vector Rv = R * v;
-    sigma = Rv.norm();
+  const double floor = 1e-12 * A.norm();
+  const Eigen::Index max_vectors = std::min<Eigen::Index>(n, 40);
+  core::Matrix K(n, max_vectors), RK(n, max_vectors);
+  core::Vector v = start.size() == n && start.norm() > 0 ? core::Vector(start)
+                                                         : core::Vector::Ones(n);
+  Eigen::Index next_check = 1;
+  for (Eigen::Index j = 0; j < max_vectors; ++j) {
+    if (j > 0) {
+      // One step of inverse iteration on R^T R from the last basis vector.
+      v = R.transpose().triangularView<Eigen::Lower>().solve(K.col(j - 1));
+      v = R.triangularView<Eigen::Upper>().solve(v);
+    }
+    if (!v.allFinite()) return false;
+    const double before = v.norm();
+    for (int pass = 0; pass < 2; ++pass)  // classical Gram-Schmidt, twice
+      v -= K.leftCols(j) * (K.leftCols(j).transpose() * v);
+    const double norm = v.norm();
+    if (!(norm > 1e-12 * before)) return false;  // the space stopped growing: not expected
+    K.col(j) = v / norm;
+    RK.col(j) = R * K.col(j);
+    if (j + 1 != next_check && j + 1 != max_vectors) continue;
+    next_check = std::max<Eigen::Index>(next_check + 1, next_check * 3 / 2);
+    const Eigen::JacobiSVD<core::Matrix> small(RK.leftCols(j + 1),
+                                               Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const Eigen::Index last = j;
+    sigma = small.singularValues()(last);
     if (!(sigma > 0)) return false;
-    const double residual = (R.transpose() * (Rv / sigma) - sigma * v).norm();
-    if (residual <= 1e-10 * sigma + floor) {
-      right = v;
-      left = A * v / sigma;
+    core::Vector candidate = K.leftCols(j + 1) * small.matrixV().col(last);
+    candidate.normalize();
+    const core::Vector Rv = R * candidate;
+    const double residual = (R.transpose() * (Rv / sigma) - sigma * candidate).norm();
+    if (residual <= 1e-4 * sigma + floor) {
+      right = candidate;
+      left = A * candidate / sigma;
       return true;
     }
   }
@@ -92,26 +114,29 @@ TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vect
 }
 
 // Chord corrections with one Jacobian J (the unit scale's, m x n): Gauss-Newton steps with J's
-// truncated pseudo-inverse (singular values <= cutoff count as zero), and, for the hyperplane
-// row a . (y - anchor) = 0, a move in J's null space N towards a. The constraint is met after
-// every step when a has a component in N (|N^T a| >= 1/2): a probe direction is one of N's, and
-// a chord of the branch is close to its tangent, which is in N. One residual per step.
+// rank-truncated least-squares solution of least norm, and, for the hyperplane row
+// a . (y - anchor) = 0, a move in J's null space N towards a. The constraint is met after every
+// step when a has a component in N (|N^T a| >= 1/2): a probe direction is one of N's, and a chord
+// of the branch is close to its tangent, which is in N. One residual per step.
+// The rank is revealed by a complete orthogonal decomposition (column-pivoted QR, then a QR of
+// the kept rows: J P = Q [T 0; 0 0] Z), pivots below cutoff counting as zero: 0.34 ms for the
+// 200 x 101 Jacobian of the contact bar at 100 intervals where the thin SVD took 6 ms.
 struct BranchPointDetector::Chord {
-  core::Matrix jacobian;        // J itself
-  core::Matrix pseudo_inverse;  // n x m
-  core::Matrix null_space;      // n x nullity
+  core::Matrix jacobian;  // J itself
+  Eigen::CompleteOrthogonalDecomposition<core::Matrix> cod;
+  core::Matrix null_space;  // n x nullity, orthonormal
   Chord(const core::Matrix& J, double cutoff) : jacobian(J) {
-    Eigen::BDCSVD<core::Matrix> svd(J, Eigen::ComputeThinU | Eigen::ComputeThinV);
-    const Eigen::Index k = svd.singularValues().size();
-    Eigen::Index rank = 0;
-    while (rank < k && svd.singularValues()[rank] > cutoff) ++rank;
-    pseudo_inverse = svd.matrixV().leftCols(rank) *
-                     svd.singularValues().head(rank).cwiseInverse().asDiagonal() *
-                     svd.matrixU().leftCols(rank).transpose();
-    // J is m x n with m >= n - 1: the thin V holds min(m, n) columns; a wide J has n - m more
-    // null directions, which the thin SVD does not return (not needed for m >= n).
-    null_space = svd.matrixV().rightCols(k - rank);
+    const Eigen::Index n = J.cols();
+    // The first pivot of the column-pivoted QR is the largest column norm.
+    const double largest = J.size() > 0 ? J.colwise().norm().maxCoeff() : 0.0;
+    if (largest > 0) cod.setThreshold(std::min(1.0, cutoff / largest));
+    cod.compute(J);
+    const Eigen::Index rank = cod.rank();
+    const core::Matrix Z = cod.matrixZ();
+    null_space = cod.colsPermutation() * Z.bottomRows(n - rank).transpose();
   }
+  // The least-squares solution of least norm of J x = b (b: m x k).
+  core::Matrix solve(const core::Matrix& b) const { return cod.solve(b); }
 };
 
 struct BranchPointDetector::Evaluation {
@@ -142,28 +167,106 @@ core::Matrix BranchPointDetector::in_unit_scale(const core::Matrix& J) const {
 }
 
 bool BranchPointDetector::chord_correct(const Chord& chord, const core::Vector& normal,
-                                        const core::Vector& anchor, core::Vector& y) const {
-  const core::Vector w = chord.null_space.transpose() * normal;
+                                        const core::Vector& anchor, core::Vector& y,
+                                        const core::Matrix* kinks) const {
+  const core::Matrix& J = chord.jacobian;
+  const core::Matrix& N = chord.null_space;
+  const core::Vector w = N.transpose() * normal;
   if (!(w.squaredNorm() >= 0.25)) return false;
   const core::Vector f = factor();
   const core::Vector& rf = problem_.residual_factor();
   const double tolerance = options_.verification.corrector_options().residual_tolerance;
+  const Eigen::Index m = J.rows(), n = J.cols(), k = N.cols();
+  // Secant updates of the chord matrix, B = J + A C^T (good Broyden, unit columns of C): the
+  // contact bar's residual is piecewise affine in u0, and where a step crosses into another
+  // piece its Jacobian differs from J by rank one (measured at the branch points of the contact
+  // bar at 100 intervals: the difference's second singular value is 1e-3..1e-5 of its first),
+  // so one update turns the chord into the piece's own matrix. PA = P A and RA = (I - J P) A,
+  // the part of A outside J's range, are kept with them.
+  constexpr int max_updates = 6;
+  core::Matrix A(m, 0), C(n, 0), PA(n, 0), RA(m, 0);
+  const double row_scale = 1.0 / std::max(J.norm(), std::numeric_limits<double>::min());
   // On failure y is left at the iterate with the smallest residual (a start for a corrector).
   core::Vector best = y;
-  double previous = std::numeric_limits<double>::infinity();
+  double best_norm = std::numeric_limits<double>::infinity();
+  int without_progress = 0;
+  core::Vector r_previous, dx;
   for (int iteration = 0; iteration < 30; ++iteration) {
     core::Vector r;
     if (problem_.residual(y.cwiseQuotient(f), r) != core::EvalStatus::ok) break;
     const double plane = normal.dot(y - anchor);
     if (r.lpNorm<Eigen::Infinity>() <= tolerance && std::abs(plane) <= tolerance) return true;
     if (rf.size() > 0) r = r.cwiseProduct(rf);
-    // Linear convergence or none: a step that does not shrink the residual by 0.7 ends it.
+    // Linear convergence or none: two steps in a row that do not shrink the smallest residual
+    // by 0.7 end it (the first step on a crossed piece does not; the update after it does).
     const double norm = r.norm();
-    if (norm < previous) best = y;
-    if (!(norm <= 0.7 * previous)) break;
-    previous = norm;
-    core::Vector dx = -chord.pseudo_inverse * r;
-    dx += chord.null_space * (w * ((-plane - normal.dot(dx)) / w.squaredNorm()));
+    if (norm <= 0.7 * best_norm) {
+      without_progress = 0;
+    } else if (++without_progress >= 2) {
+      break;
+    }
+    if (norm < best_norm) {
+      best = y;
+      best_norm = norm;
+    }
+    if (iteration == 0 && kinks && kinks->cols() > 0) {
+      // J's columns along the kink directions, differenced at the start (one residual each).
+      const double h = 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
+      const Eigen::Index q = kinks->cols();
+      A.resize(m, q);
+      for (Eigen::Index i = 0; i < q; ++i) {
+        core::Vector ri;
+        if (problem_.residual((y + h * kinks->col(i)).cwiseQuotient(f), ri) != core::EvalStatus::ok)
+          return false;
+        if (rf.size() > 0) ri = ri.cwiseProduct(rf);
+        A.col(i) = (ri - r) / h - J * kinks->col(i);
+      }
+      C = *kinks;
+      PA = chord.solve(A);
+      RA = A - J * PA;
+    } else if (iteration > 0 && A.cols() < max_updates) {
+      const double length = dx.norm();
+      if (length > 0) {
+        const core::Vector c = dx / length;
+        const core::Vector Bc = J * c + A * (C.transpose() * c);
+        const core::Vector a = (r - r_previous) / length - Bc;
+        if (a.norm() > 1e-12 * (r - r_previous).norm() / length) {
+          const Eigen::Index q = A.cols();
+          A.conservativeResize(Eigen::NoChange, q + 1);
+          C.conservativeResize(Eigen::NoChange, q + 1);
+          PA.conservativeResize(Eigen::NoChange, q + 1);
+          RA.conservativeResize(Eigen::NoChange, q + 1);
+          A.col(q) = a;
+          C.col(q) = c;
+          PA.col(q) = chord.solve(a);
+          RA.col(q) = a - J * PA.col(q);
+        }
+      }
+    }
+    // The step dx = -P (r + A theta) + N c with theta = C^T dx and normal . dx = -plane; the
+    // part of r + A theta outside J's range is made as small as it can be (rows scaled by 1/|J|
+    // to the others' units), and (theta, c) is the least-squares solution of least norm.
+    const core::Vector Pr = chord.solve(r);
+    const Eigen::Index q = A.cols();
+    if (q == 0) {
+      dx = -Pr;
+      dx += N * (w * ((-plane - normal.dot(dx)) / w.squaredNorm()));
+    } else {
+      core::Matrix S = core::Matrix::Zero(m + q + 1, q + k);
+      core::Vector rhs(m + q + 1);
+      S.topLeftCorner(m, q) = RA * row_scale;
+      rhs.head(m) = -(r - J * Pr) * row_scale;
+      S.block(m, 0, q, q) = core::Matrix::Identity(q, q) + C.transpose() * PA;
+      S.block(m, q, q, k) = -C.transpose() * N;
+      rhs.segment(m, q) = -C.transpose() * Pr;
+      S.block(m + q, 0, 1, q) = normal.transpose() * PA;
+      S.block(m + q, q, 1, k) = -w.transpose();
+      rhs(m + q) = plane - normal.dot(Pr);
+      const Eigen::CompleteOrthogonalDecomposition<core::Matrix> cod(S);
+      const core::Vector u = cod.solve(rhs);
+      dx = -Pr - PA * u.head(q) + N * u.tail(k);
+    }
+    r_previous = r;
     y += dx;
     if (!y.allFinite()) break;
   }
@@ -397,20 +500,23 @@ BranchPointDetector::Evaluation BranchPointDetector::evaluate(
   if (tangent_from_jacobian(e.jacobian, normal, options_.rank.relative_threshold, e.tangent) !=
       core::EvalStatus::ok)
     return e;
-  e.tau = bordered_test_function(e.jacobian, e.tangent, jacobian_scale_, &reference);
+  e.tau = bordered_test_function(e.jacobian, e.tangent, jacobian_scale_, &reference, true);
   e.ok = true;
   return e;
 }
 
 void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_change) {
   const auto started = std::chrono::steady_clock::now();
+  const core::EvaluationCounters& counters = problem_.base().counters();
+  const long jacobians_before = counters.jacobians, residuals_before = counters.residuals;
   const BranchPointOptions& o = options_.branch_points;
-  const TestFunctionValue& reference = polyline.front().tau;
-  // Located when |tau| is 1e-4 of the rank report's relative threshold: J is singular there at
+  // Located when |tau| is 1e-3 of the rank report's relative threshold: J is singular there at
   // the resolution the verification uses, with a margin, and the period of a contact-bar point
-  // within ~1e-8 (at 1e-3 of it, 1.9e-8 at T = 3.5 on 100 intervals). Near the root a step costs
-  // one Jacobian and a few residuals (tangent predictor from the nearest evaluation).
-  const double located_value = 1e-4 * options_.rank.relative_threshold;
+  // within ~3e-8 (at 100 intervals: 3.6 + 2.8e-9, 3.5 - 3.9e-10, 3.2 - 2.8e-8). Below that the
+  // finite-difference noise of the test function (4e-9..8e-9 at T = 3.6) stalls the iteration:
+  // at 1e-4 of it the location spent 6 more evaluations there for nothing. Near the root a
+  // step costs one Jacobian and a few residuals (tangent predictor from the nearest evaluation).
+  const double located_value = 1e-3 * options_.rank.relative_threshold;
   BranchPointReport report;
   report.sign_change = sign_change;
   // Each correction starts with chord steps on the last Jacobian evaluated (Chord): the
@@ -464,22 +570,81 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
   // singular triplet stopped following the reference's).
   std::vector<std::pair<double, double>> seen;  // (s, |tau|)
   for (const Sample& p : polyline) seen.emplace_back(p.s, std::abs(p.tau.value));
+  // The test function's value at the known point (sample or evaluation) nearest to s: the
+  // reference that orients an evaluation at s (and starts its inverse iteration). Each value is
+  // oriented like its reference's, so the values of a chain of continued links share one sign
+  // convention, and a sign change between any two of them is a crossing.
+  const auto tau_near = [&](double s) {
+    const TestFunctionValue* out = &polyline.front().tau;
+    double distance = std::numeric_limits<double>::infinity();
+    for (const Sample& p : polyline)
+      if (std::abs(p.s - s) < distance) {
+        distance = std::abs(p.s - s);
+        out = &p.tau;
+      }
+    for (const Evaluation& e : done)
+      if (std::abs(e.s - s) < distance) {
+        distance = std::abs(e.s - s);
+        out = &e.tau;
+      }
+    return *out;
+  };
   int steps = 0;
+  // Secant steps on the signed test function, regula falsi (Illinois: the stale end's value
+  // halved) once two values of opposite signs bracket the root. A sign change starts bracketed
+  // by its two samples. A dip starts from its smallest sample and an evaluation at 1 % of the
+  // way towards its smaller neighbour: near the root tau is linear in s over a short stretch
+  // only (other singular values take over farther out), so the secant through the two
+  // extrapolates to it where a fit through the three samples does not (on the contact bar at
+  // 100 intervals the V through the samples of the dip at T = 3.6 put it 0.022 off, 4.7 times
+  // the distance of the smallest sample; the secant through that sample and one 1e-3 away put
+  // it 1e-6 off).
+  bool root_finding = sign_change;
+  bool bracketed = sign_change;
+  double s_prev = 0, f_prev = 0, s_last = 0, f_last = 0;
+  double s_min = polyline.front().s, s_max = polyline.back().s;
   if (sign_change) {
-    // Illinois: regula falsi with the stale end's value halved.
-    double sa = polyline[0].s, fa = polyline[0].tau.value;
-    double sb = polyline[1].s, fb = polyline[1].tau.value;
+    s_prev = polyline[0].s;
+    f_prev = polyline[0].tau.value;
+    s_last = polyline[1].s;
+    f_last = polyline[1].tau.value;
+  } else if (polyline.size() == 3) {
+    const Sample& middle = polyline[1];
+    const bool right = std::abs(polyline[2].tau.value) < std::abs(polyline[0].tau.value);
+    const double delta = 0.01 * (right ? polyline[2].s - middle.s : polyline[0].s - middle.s);
+    const double s = middle.s + delta;
+    Evaluation e = evaluate(polyline, s, middle.tau, chord.get(), last(), nearest(s));
+    ++steps;
+    if (e.ok) {
+      keep(e, s);
+      seen.emplace_back(s, std::abs(e.tau.value));
+      s_prev = middle.s;
+      f_prev = middle.tau.value;
+      s_last = s;
+      f_last = e.tau.value;
+      root_finding = e.tau.continued;
+      bracketed = f_prev * f_last < 0;
+    }
+  }
+  if (root_finding) {
     // A root brings |tau| down superlinearly; a sign change that is a jump of tau (the
-    // finite-difference Jacobian across a change of the contact sequence) does not: three
-    // evaluations in a row that do not halve the smallest |tau| end the iteration.
-    double smallest = std::min(std::abs(fa), std::abs(fb));
+    // finite-difference Jacobian across a change of the contact sequence) or a dip that is not
+    // a root does not: three evaluations in a row that do not halve the smallest |tau| end the
+    // iteration.
+    double smallest = std::min(std::abs(f_prev), std::abs(f_last));
     int stale = 0;
-    while (steps < o.max_location_steps && std::abs(sb - sa) > o.location_tolerance && stale < 3 &&
+    bool left_range = false;
+    while (steps < o.max_location_steps && std::abs(s_last - s_prev) > o.location_tolerance && stale < 3 &&
            !(std::abs(best_value) <= located_value)) {
-      double s = (sa * fb - sb * fa) / (fb - fa);
-      const double lo = std::min(sa, sb), hi = std::max(sa, sb);
-      if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
-      Evaluation e = evaluate(polyline, s, reference, chord.get(), last(), nearest(s));
+      double s = (s_prev * f_last - s_last * f_prev) / (f_last - f_prev);
+      if (bracketed) {
+        const double lo = std::min(s_prev, s_last), hi = std::max(s_prev, s_last);
+        if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
+      } else if (!(s > s_min && s < s_max)) {
+        left_range = true;
+        break;
+      }
+      Evaluation e = evaluate(polyline, s, tau_near(s), chord.get(), last(), nearest(s));
       ++steps;
       if (!e.ok) break;
       keep(e, s);
@@ -495,17 +660,21 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
         seen.clear();
         break;
       }
-      if (e.tau.value * fb < 0) {
-        sa = sb;
-        fa = fb;
+      if (e.tau.value * f_last < 0) {
+        bracketed = true;
+        s_prev = s_last;
+        f_prev = f_last;
+      } else if (bracketed) {
+        f_prev *= 0.5;
       } else {
-        fa *= 0.5;
+        s_prev = s_last;
+        f_prev = f_last;
       }
-      sb = s;
-      fb = e.tau.value;
+      s_last = s;
+      f_last = e.tau.value;
     }
-    if (std::abs(sb - sa) <= o.location_tolerance || stale >= 3 ||
-        std::abs(best_value) <= located_value)
+    if (!left_range && (std::abs(s_last - s_prev) <= o.location_tolerance || stale >= 3 ||
+                        std::abs(best_value) <= located_value))
       seen.clear();
   }
   // Minimise |tau| from the smallest value seen and its neighbours: |tau| ~ |s - s*| near a
@@ -544,7 +713,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
         if (std::abs(s - sb) < nudge) s = right_larger ? sb + nudge : sb - nudge;
         if (!(s > sa && s < sc)) s = right_larger ? 0.5 * (sb + sc) : 0.5 * (sa + sb);
       }
-      Evaluation e = evaluate(polyline, s, reference, chord.get(), last(), nearest(s));
+      Evaluation e = evaluate(polyline, s, tau_near(s), chord.get(), last(), nearest(s));
       ++steps;
       if (!e.ok) break;
       keep(e, s);
@@ -591,6 +760,8 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
     report.after_point = polyline[polyline.size() - 2].index;
   if (best_done >= 0) best_chord = done[static_cast<std::size_t>(best_done)].chord;
   verify(report, best_z, best_tangent, best_jacobian, best_chord.get());
+  report.jacobian_evaluations = counters.jacobians - jacobians_before;
+  report.residual_evaluations = counters.residuals - residuals_before;
   report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   found_.push_back(std::move(report));
@@ -633,10 +804,14 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
   // through the stepped point orthogonal to d. A direction is real when the corrected point is
   // a solution within h / drift_ratio of z: the hyperplane, which misses the traced branch near
   // z, met another family near the stepped point. Its secant from z gives the angle to t. Each
-  // probe first takes chord steps on J (one residual each; d is in J's null space, so the
-  // hyperplane row is met exactly), then, when they stall, the loop's corrector (its tolerance
-  // and iteration budget, fresh Jacobians; the verifier's 60 linear iterations made failed
-  // probes the main cost of a branch point, measured on the contact bar at 100 intervals).
+  // probe first takes chord steps on J with J's columns along the learned kinks re-differenced
+  // at the stepped point and secant updates (chord_correct: one residual each; d is in J's null
+  // space, so the hyperplane row is met exactly), then, when they stall, the loop's corrector
+  // (its tolerance and iteration budget, fresh Jacobians; the verifier's 60 linear iterations
+  // made failed probes the main cost of a branch point, measured on the contact bar at 100
+  // intervals). There, stepping 1e-3 off a located point crosses a kink of F in every direction:
+  // the chord steps alone finished none of 62 probes, each then took a Jacobian (about 20
+  // residuals); with the kink learned at the first probe, 56 of 62 finish in 4-9 residuals.
   std::optional<Chord> own_chord;
   if (!chord_of_j) own_chord.emplace(J, null_cutoff());
   const Chord& chord = chord_of_j ? *chord_of_j : *own_chord;
@@ -645,11 +820,15 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
   double smallest = std::numeric_limits<double>::infinity();
   int attached = 0;
   int subspace_done = 0, subspace_failed = 0;
+  // Directions along which J changes between the located point and its probes (learned below).
+  core::Matrix kinks(z.size(), 0);
+  constexpr Eigen::Index max_kinks = 4;
+  int learned = 0;
   for (int i = 0; i < std::min(candidates, options_.branch_points.max_probes); ++i) {
     const core::Vector d = svd.matrixU().col(i);
     const core::Vector stepped = z + h * d;
     core::Vector y = stepped;
-    const bool okc = chord_correct(chord, d, stepped, y);
+    const bool okc = chord_correct(chord, d, stepped, y, &kinks);
     // The subspace stage is skipped once it has failed on at least two of this point's probes
     // and on more than two thirds of them (on the contact bar at 100 intervals it finished
     // 34 of 62 probes, 2 of 19 at T = 3.2).
@@ -671,6 +850,31 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
     }
     if ((y - z).norm() > h / v.drift_ratio) continue;
     ++attached;
+    if (!okc && learned < 3) {
+      // The probe needed fresh Jacobians: J(y) differs from J where the step crossed a kink of
+      // F. Its leading right singular vectors (singular values above 1e-2 of the largest, at
+      // most three; from the eigenvectors of D^T D, D = J(y) - J) are differenced at the next
+      // probes' starts. On the contact bar at 100 intervals D has one such direction, the same
+      // at every probe of a point (the period's column: its second singular value is 1e-5..
+      // 1e-2 of its first, 200..300 against |J| = 1.1e4).
+      ++learned;
+      core::Matrix Jy;
+      if (problem_.jacobian(y.cwiseQuotient(f), Jy) == core::EvalStatus::ok) {
+        const core::Matrix D = in_unit_scale(Jy) - J;
+        const Eigen::SelfAdjointEigenSolver<core::Matrix> eig(D.transpose() * D);
+        const core::Vector& l = eig.eigenvalues();  // ascending
+        const Eigen::Index n = l.size();
+        for (Eigen::Index j = n - 1; j >= std::max<Eigen::Index>(0, n - 3); --j) {
+          if (!(l(j) > 1e-4 * l(n - 1) && l(j) > 1e-12 * J.squaredNorm())) break;
+          if (kinks.cols() >= max_kinks) break;
+          core::Vector b = eig.eigenvectors().col(j);
+          for (int pass = 0; pass < 2; ++pass) b -= kinks * (kinks.transpose() * b);
+          if (!(b.norm() > 0.1)) continue;  // already known
+          kinks.conservativeResize(Eigen::NoChange, kinks.cols() + 1);
+          kinks.col(kinks.cols() - 1) = b.normalized();
+        }
+      }
+    }
     const core::Vector x = y.cwiseProduct(problem_.unit_scale());
     report.attached_points.push_back(x);
     const core::Vector secant = y - z;

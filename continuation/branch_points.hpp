@@ -14,15 +14,19 @@
 //   - a sign change between consecutive points, or a dip (|tau_k| below dip_ratio times both
 //     neighbours: a sampled minimum, whose depth depends on how close a step lands) brackets a
 //     candidate;
-//   - it is located on the branch by an Illinois secant iteration on the signed test function
-//     (sign change) or by a safeguarded V-fit (|tau| ~ |s - s*| near a simple crossing) with
-//     golden-section fall-back (dip), each evaluation a point corrected on the hyperplane
-//     orthogonal to the bracket's polyline (chord steps on the last Jacobian first, then
-//     Gauss-Newton that keeps its Jacobian while it contracts); it ends when |tau| is below 1e-4
-//     of the rank threshold, the bracket below location_tolerance, or |tau| stops
-//     falling;
+//   - it is located on the branch by secant steps on the signed test function, each value
+//     oriented by the nearest known one's singular vectors, from the sign change's two samples
+//     or from a dip's smallest sample and a point 1 % of the way to its smaller neighbour,
+//     Illinois regula falsi once bracketed; when the vectors stop following each other, by a
+//     safeguarded V-fit of |tau| (|tau| ~ |s - s*| near a simple crossing) with golden-section
+//     fall-back. Each evaluation is a point corrected on the hyperplane orthogonal to the
+//     bracket's polyline (chord steps on the last Jacobian with secant updates first, then
+//     Gauss-Newton that keeps its Jacobian while it contracts); it ends when |tau| is below 1e-3
+//     of the rank threshold, the bracket below location_tolerance, or |tau| stops falling;
 //   - the located point is verified with the rank report and probes on the located point's
-//     Jacobian: dimension = verified dimension - 1 (the directions beyond the traced tangent),
+//     Jacobian, whose columns along the kinks of F that earlier probes crossed are re-differenced
+//     at each probe's start: dimension = verified dimension - 1 (the directions beyond the traced
+//     tangent),
 //     and each extra direction is probed once more to find the attached family's secant, whose
 //     angle to the traced tangent is tangent_angle.
 //
@@ -64,6 +68,8 @@ struct TestFunctionSample {
 // Test function of J (m x n) and the unit tangent t: the smallest singular value of
 // [J / scale; t^T]. With a reference (the previous point's value), the singular vectors are
 // oriented like the reference's and the value is signed; without one it is positive.
+// iterate: by a Krylov basis of inverse iteration on the QR factor, started from the
+// reference's right vector (the SVD when it does not converge); else by the SVD.
 TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vector& tangent,
                                          double scale, const TestFunctionValue* reference,
                                          bool iterate = false);
@@ -105,10 +111,12 @@ class BranchPointDetector {
   core::Matrix in_unit_scale(const core::Matrix& J) const;
   // Singular values at most this count as zero (the rank report's threshold, verify()).
   double null_cutoff() const;
-  // Chord steps (one residual each) onto F = 0 and normal . (y - anchor) = 0, unit scale; false
-  // when they do not converge to the verifier's corrector tolerance.
+  // Chord steps (one residual each) onto F = 0 and normal . (y - anchor) = 0, unit scale, with
+  // secant (good Broyden) updates of the chord's J; kinks (n x q, orthonormal): directions along
+  // which J is re-differenced at the start (q residuals). False when they do not converge to the
+  // verifier's corrector tolerance.
   bool chord_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
-                     core::Vector& y) const;
+                     core::Vector& y, const core::Matrix* kinks = nullptr) const;
   // Gauss-Newton on J with its columns along J's null space N re-differenced at an iterate
   // (N.cols() residuals instead of a Jacobian's n), kept while its steps halve |F| (one residual
   // each), onto the same constraints; at most max_differences differencings.

@@ -122,8 +122,8 @@ TEST(BorderedTestFunction, ChangesSignAcrossASimpleBranchPoint) {
   EXPECT_TRUE(after.continued);
 }
 
-// The accepted points' test function comes from inverse iteration on a QR factor (iterate =
-// true), the location's from the SVD; the SVD is the oracle. Matrices [J; t^T] of 41 x 20 with
+// The test function comes from a Krylov basis of inverse iteration on a QR factor (iterate =
+// true; the SVD when it does not converge); the SVD is the oracle. Matrices [J; t^T] of 41 x 20 with
 // chosen singular values: a regular point (smallest 1e-2, gap 10), one at a located branch
 // point (1e-9) and a cluster (1e-6 and 1.000001e-6, where the iteration falls back to the SVD or
 // converges to the same value). Both are backward stable, so the values agree to a few
@@ -161,6 +161,32 @@ TEST(BorderedTestFunction, InverseIterationAgreesWithTheSvd) {
     const auto iterated_ref = continuation::bordered_test_function(J, t, 0.0, &svd, true);
     EXPECT_NEAR(iterated_ref.value, svd_ref.value, 1e-13) << smallest;
   }
+}
+
+// Near a branch point of the contact bar some twenty singular values of [J; t^T] vanish together;
+// the Krylov basis of inverse iteration resolves the smallest of such a cluster (here 19 values
+// spread geometrically over 1e-9..1e-7, the rest 0.2..1) where one vector converges as
+// (1e-9 / 1.3e-9)^2 per step. The SVD is the oracle: the Ritz value lies within its residual,
+// accepted at 1e-4 of the value (plus 1e-12 |A|_F, |A|_F ~ 3), of a singular value, and it is
+// the smallest one when it is below the second (1.29e-9).
+TEST(BorderedTestFunction, KrylovResolvesTheSmallestOfACluster) {
+  const Eigen::Index m = 60, n = 30;
+  std::srand(11);
+  const core::Matrix U =
+      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(m + 1, n)).householderQ() *
+      core::Matrix::Identity(m + 1, n);
+  const core::Matrix V =
+      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(n, n)).householderQ();
+  core::Vector sigma = core::Vector::LinSpaced(n, 1.0, 0.2);
+  for (Eigen::Index i = 0; i < 19; ++i) sigma[n - 1 - i] = 1e-9 * std::pow(100.0, i / 18.0);
+  const core::Matrix bordered = U * sigma.asDiagonal() * V.transpose();
+  const double t_norm = bordered.row(m).norm();
+  const core::Matrix J = bordered.topRows(m) / t_norm;
+  const core::Vector t = bordered.row(m).transpose() / t_norm;
+  const auto svd = continuation::bordered_test_function(J, t, 0.0, nullptr, false);
+  const auto krylov = continuation::bordered_test_function(J, t, 0.0, nullptr, true);
+  EXPECT_NEAR(svd.value, 1e-9 / t_norm, 1e-15);
+  EXPECT_NEAR(krylov.value, svd.value, 1e-4 * svd.value + 1e-12 * 3);
 }
 
 // The line x = 0 traced upwards in lambda crosses x = lambda - 1 at (0, 1): one candidate,
