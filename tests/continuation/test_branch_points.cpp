@@ -51,6 +51,28 @@ class TranscriticalInGrowingUnits : public algebraic::Transcritical,
   bool enabled_;
 };
 
+// J (m x n) and t such that [J; t^T / |t|] = (U diag(sigma) V^T) / |t| for random orthonormal U
+// (m + 1 x n) and V (seeded): bordered_test_function normalises t, so the whole matrix is
+// scaled by the bordered row's norm t_norm, and its singular values are sigma / t_norm.
+struct BorderedParts {
+  core::Matrix J;
+  core::Vector t;
+  double t_norm;
+};
+BorderedParts bordered_with_singular_values(Eigen::Index m, const core::Vector& sigma,
+                                            unsigned seed) {
+  const Eigen::Index n = sigma.size();
+  std::srand(seed);
+  const core::Matrix U =
+      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(m + 1, n)).householderQ() *
+      core::Matrix::Identity(m + 1, n);
+  const core::Matrix V =
+      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(n, n)).householderQ();
+  const core::Matrix bordered = U * sigma.asDiagonal() * V.transpose();
+  const double t_norm = bordered.row(m).norm();
+  return {bordered.topRows(m) / t_norm, bordered.row(m).transpose() / t_norm, t_norm};
+}
+
 }  // namespace
 
 // The detector keeps its samples in the unit scale: a point added in other units (the loop's,
@@ -130,24 +152,13 @@ TEST(BorderedTestFunction, ChangesSignAcrossASimpleBranchPoint) {
 // round-offs of |A| ~ 1 (1e-13 allows ~500 eps); the right vectors, where the gap separates
 // them (>= 1e-2), to round-off over the gap (1 - |v . v'| <= 1e-10).
 TEST(BorderedTestFunction, InverseIterationAgreesWithTheSvd) {
-  const Eigen::Index m = 40, n = 20;
-  std::srand(7);
-  const core::Matrix U =
-      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(m + 1, n)).householderQ() *
-      core::Matrix::Identity(m + 1, n);
-  const core::Matrix V =
-      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(n, n)).householderQ();
+  const Eigen::Index n = 20;
   for (const auto& [smallest, second] :
        {std::pair{1e-2, 1e-1}, std::pair{1e-9, 1e-1}, std::pair{1e-6, 1.000001e-6}}) {
     core::Vector sigma = core::Vector::LinSpaced(n, 1.0, 0.2);
     sigma[n - 2] = second;
     sigma[n - 1] = smallest;
-    const core::Matrix bordered = U * sigma.asDiagonal() * V.transpose();
-    // Split into J and t so that bordered_test_function rebuilds [J; t^T] (t is normalised
-    // there: scale the whole matrix by |t| first).
-    const double t_norm = bordered.row(m).norm();
-    const core::Matrix J = bordered.topRows(m) / t_norm;
-    const core::Vector t = bordered.row(m).transpose() / t_norm;
+    const auto [J, t, t_norm] = bordered_with_singular_values(40, sigma, 7);
     const auto svd = continuation::bordered_test_function(J, t, 0.0, nullptr, false);
     const auto iterated = continuation::bordered_test_function(J, t, 0.0, nullptr, true);
     EXPECT_NEAR(iterated.value, svd.value, 1e-13) << smallest;
@@ -170,19 +181,10 @@ TEST(BorderedTestFunction, InverseIterationAgreesWithTheSvd) {
 // accepted at 1e-4 of the value (plus 1e-12 |A|_F, |A|_F ~ 3), of a singular value, and it is
 // the smallest one when it is below the second (1.29e-9).
 TEST(BorderedTestFunction, KrylovResolvesTheSmallestOfACluster) {
-  const Eigen::Index m = 60, n = 30;
-  std::srand(11);
-  const core::Matrix U =
-      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(m + 1, n)).householderQ() *
-      core::Matrix::Identity(m + 1, n);
-  const core::Matrix V =
-      Eigen::HouseholderQR<core::Matrix>(core::Matrix::Random(n, n)).householderQ();
+  const Eigen::Index n = 30;
   core::Vector sigma = core::Vector::LinSpaced(n, 1.0, 0.2);
   for (Eigen::Index i = 0; i < 19; ++i) sigma[n - 1 - i] = 1e-9 * std::pow(100.0, i / 18.0);
-  const core::Matrix bordered = U * sigma.asDiagonal() * V.transpose();
-  const double t_norm = bordered.row(m).norm();
-  const core::Matrix J = bordered.topRows(m) / t_norm;
-  const core::Vector t = bordered.row(m).transpose() / t_norm;
+  const auto [J, t, t_norm] = bordered_with_singular_values(60, sigma, 11);
   const auto svd = continuation::bordered_test_function(J, t, 0.0, nullptr, false);
   const auto krylov = continuation::bordered_test_function(J, t, 0.0, nullptr, true);
   EXPECT_NEAR(svd.value, 1e-9 / t_norm, 1e-15);
