@@ -1,6 +1,5 @@
 #include "continuation/branch_points.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -77,6 +76,30 @@ bool smallest_singular_triplet(const core::Matrix& A, const core::Vector& start,
     }
   }
   return false;
+}
+
+// The `count` leading singular values (descending) and right singular vectors of A by subspace
+// iteration on A^T A with a block of count + 3 vectors (three steps from a fixed, deterministic
+// start, then the Ritz values of A on the block): O(m n) per step where an SVD or eigensolver
+// of A^T A is O(n^3) (1001 unknowns at 1000 intervals). The leading values wanted here stand
+// 1e2..1e5 above the rest (a kink's rank-one jump), so three steps resolve them to far more
+// than the 1e-2 they are compared at.
+void leading_right_singular(const core::Matrix& A, Eigen::Index count, core::Vector& sigma,
+                            core::Matrix& right) {
+  const Eigen::Index n = A.cols(), block = std::min<Eigen::Index>(n, count + 3);
+  core::Matrix X(n, block);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (Eigen::Index j = 0; j < block; ++j)
+      X(i, j) = std::cos(0.7 * static_cast<double>((i + 1) * (j + 1)) + 0.3 * static_cast<double>(j));
+  for (int step = 0; step < 3; ++step) {
+    const core::Matrix Y = A.transpose() * (A * X);
+    const Eigen::HouseholderQR<core::Matrix> qr(Y);
+    X = qr.householderQ() * core::Matrix::Identity(n, block);
+  }
+  const Eigen::JacobiSVD<core::Matrix> ritz(A * X, Eigen::ComputeThinV);
+  const Eigen::Index kept = std::min<Eigen::Index>(count, block);
+  sigma = ritz.singularValues().head(kept);
+  right = X * ritz.matrixV().leftCols(kept);
 }
 
 }  // namespace
@@ -853,21 +876,20 @@ void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& 
     if (!okc && learned < 3) {
       // The probe needed fresh Jacobians: J(y) differs from J where the step crossed a kink of
       // F. Its leading right singular vectors (singular values above 1e-2 of the largest, at
-      // most three; from the eigenvectors of D^T D, D = J(y) - J) are differenced at the next
-      // probes' starts. On the contact bar at 100 intervals D has one such direction, the same
+      // most three, of D = J(y) - J) are differenced at the next probes' starts. On the contact bar at 100 intervals D has one such direction, the same
       // at every probe of a point (the period's column: its second singular value is 1e-5..
       // 1e-2 of its first, 200..300 against |J| = 1.1e4).
       ++learned;
       core::Matrix Jy;
       if (problem_.jacobian(y.cwiseQuotient(f), Jy) == core::EvalStatus::ok) {
         const core::Matrix D = in_unit_scale(Jy) - J;
-        const Eigen::SelfAdjointEigenSolver<core::Matrix> eig(D.transpose() * D);
-        const core::Vector& l = eig.eigenvalues();  // ascending
-        const Eigen::Index n = l.size();
-        for (Eigen::Index j = n - 1; j >= std::max<Eigen::Index>(0, n - 3); --j) {
-          if (!(l(j) > 1e-4 * l(n - 1) && l(j) > 1e-12 * J.squaredNorm())) break;
+        core::Vector sigma;
+        core::Matrix directions;
+        leading_right_singular(D, 3, sigma, directions);
+        for (Eigen::Index j = 0; j < sigma.size(); ++j) {
+          if (!(sigma(j) > 1e-2 * sigma(0) && sigma(j) > 1e-6 * J.norm())) break;
           if (kinks.cols() >= max_kinks) break;
-          core::Vector b = eig.eigenvectors().col(j);
+          core::Vector b = directions.col(j);
           for (int pass = 0; pass < 2; ++pass) b -= kinks * (kinks.transpose() * b);
           if (!(b.norm() > 0.1)) continue;  // already known
           kinks.conservativeResize(Eigen::NoChange, kinks.cols() + 1);
