@@ -97,7 +97,7 @@ void leading_right_singular(const core::Matrix& A, Eigen::Index count, core::Vec
     X = qr.householderQ() * core::Matrix::Identity(n, block);
   }
   const Eigen::JacobiSVD<core::Matrix> ritz(A * X, Eigen::ComputeThinV);
-  const Eigen::Index kept = std::min<Eigen::Index>(count, block);
+  const Eigen::Index kept = std::min<Eigen::Index>(count, ritz.singularValues().size());
   sigma = ritz.singularValues().head(kept);
   right = X * ritz.matrixV().leftCols(kept);
 }
