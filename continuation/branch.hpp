@@ -118,6 +118,9 @@ struct Branch {
   std::vector<BranchPointReport> branch_points;
   StopReason reason = StopReason::max_points;
   std::string message;  // human-readable: reason, the point and the numbers involved
+  // A resumed run: branch_points holds the candidates with after_point >= this (the earlier
+  // run's rows below it stand; write_after_run merges them); -1 when the run did not resume.
+  int branch_points_from = -1;
   // True when the branch ended for a reason other than reaching its planned end
   // (max_points or a bound).
   bool ended_early() const {

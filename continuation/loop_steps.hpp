@@ -185,6 +185,8 @@ class LoopSteps {
   double arclength() const { return arclength_; }
   // Adds a located candidate to the branch and reports it (hooks.on_branch_point).
   void add_branch_point(BranchPointReport report);
+  // A resumed run locates again from this after_point on (Branch::branch_points_from).
+  void branch_points_from(int after_point) { branch_.branch_points_from = after_point; }
 
   // Records y, corrected from the last point x with step ds: the arclength grows by |y - x|.
   // state: the loop's state after y (its index, arclength, scale and switch index are filled

@@ -280,16 +280,36 @@ Branch whole_branch(const std::filesystem::path& dir, const core::Problem& probl
   return whole;
 }
 
-// Rows of `saved` whose `column` is below `below`, then those of `fresh`; `fresh` alone when
-// the columns differ and fresh has rows (an empty table may lack the description columns).
+// Rows of `saved` whose `column` is below `below`, then those of `fresh`, in the layout of the
+// one whose columns include the other's (cells of a missing column NaN): a table whose rows are
+// all unverified candidates lacks the description columns (frequency_ratio, ...), and it may be
+// either. `fresh` alone when neither layout includes the other.
 core::Table merge_saved_rows(const core::Table& saved, const core::Table& fresh,
                              const std::string& column, double below) {
-  if (saved.columns() != fresh.columns() && fresh.rows() > 0) return fresh;
-  core::Table merged(saved.columns());
+  const auto includes = [](const core::Table& a, const core::Table& b) {
+    for (const std::string& c : b.columns())
+      if (std::find(a.columns().begin(), a.columns().end(), c) == a.columns().end()) return false;
+    return true;
+  };
+  const core::Table* layout = includes(saved, fresh)   ? &saved
+                              : includes(fresh, saved) ? &fresh
+                                                       : nullptr;
+  if (!layout) return fresh;
+  core::Table merged(layout->columns());
+  const auto add = [&](const core::Table& from, std::size_t i) {
+    std::vector<core::Table::Cell> cells;
+    for (const std::string& c : layout->columns()) {
+      const auto at = std::find(from.columns().begin(), from.columns().end(), c);
+      cells.push_back(at == from.columns().end()
+                          ? core::Table::Cell(std::numeric_limits<double>::quiet_NaN())
+                          : from.cells(i)[static_cast<std::size_t>(at - from.columns().begin())]);
+    }
+    merged.add_cells(std::move(cells));
+  };
   const std::vector<double> key = saved.column(column);
   for (std::size_t i = 0; i < saved.rows(); ++i)
-    if (key[i] < below) merged.add_cells(saved.cells(i));
-  for (std::size_t i = 0; i < fresh.rows(); ++i) merged.add_cells(fresh.cells(i));
+    if (key[i] < below) add(saved, i);
+  for (std::size_t i = 0; i < fresh.rows(); ++i) add(fresh, i);
   return merged;
 }
 
@@ -305,7 +325,8 @@ void write_after_run(
   const std::filesystem::path saved = out / "branch_points.csv";
   if (resumed && std::filesystem::exists(saved))
     rows = merge_saved_rows(core::Table::read_csv(saved), rows, "after_point",
-                            branch.points.front().index);
+                            branch.branch_points_from >= 0 ? branch.branch_points_from
+                                                           : branch.points.front().index);
   rows.write_csv(saved);
 }
 

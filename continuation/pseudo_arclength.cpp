@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/QR>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -124,8 +125,14 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
     keep_base(from->jacobian_point);
     if (detector) {
       // The detector is restored as it was before the saved point was added, then the point is
-      // added again from its Jacobian (the same bits: the same z).
+      // added again from its Jacobian (the same bits: the same z). That locates again what
+      // adding it had located in the earlier run: the candidates bracketed by the saved samples
+      // (at most the last two) and the point, so with after_point >= index - samples. Those
+      // rows of the earlier run are replaced by these, the ones before stand (an interrupted
+      // run may have stopped before writing them).
       detector->restore(from->samples, from->jacobian_scale);
+      steps.branch_points_from(from->index -
+                               static_cast<int>(std::min<std::size_t>(from->samples.size(), 2)));
       if (problem.jacobian(x, J) != core::EvalStatus::ok)
         return steps.end(StopReason::evaluation_failed,
                          fmt::format("the Jacobian could not be evaluated at the saved point {} "
