@@ -598,19 +598,11 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
   // oriented like its reference's, so the values of a chain of continued links share one sign
   // convention, and a sign change between any two of them is a crossing.
   const auto tau_near = [&](double s) {
-    const TestFunctionValue* out = &polyline.front().tau;
-    double distance = std::numeric_limits<double>::infinity();
+    if (const Evaluation* e = nearest(s)) return e->tau;
+    const Sample* closest = &polyline.front();
     for (const Sample& p : polyline)
-      if (std::abs(p.s - s) < distance) {
-        distance = std::abs(p.s - s);
-        out = &p.tau;
-      }
-    for (const Evaluation& e : done)
-      if (std::abs(e.s - s) < distance) {
-        distance = std::abs(e.s - s);
-        out = &e.tau;
-      }
-    return *out;
+      if (std::abs(p.s - s) < std::abs(closest->s - s)) closest = &p;
+    return closest->tau;
   };
   int steps = 0;
   // Secant steps on the signed test function, regula falsi (Illinois: the stale end's value
@@ -625,7 +617,7 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
   bool root_finding = sign_change;
   bool bracketed = sign_change;
   double s_prev = 0, f_prev = 0, s_last = 0, f_last = 0;
-  double s_min = polyline.front().s, s_max = polyline.back().s;
+  const double s_min = polyline.front().s, s_max = polyline.back().s;
   if (sign_change) {
     s_prev = polyline[0].s;
     f_prev = polyline[0].tau.value;
