@@ -78,6 +78,12 @@ bool smallest_singular_triplet(const core::Matrix& A, const core::Vector& start,
   return false;
 }
 
+// Forward-difference step for J's columns along unit directions at y (scaled unknowns): the
+// square root of the machine epsilon, relative to y's largest entry once that exceeds 1.
+double difference_step(const core::Vector& y) {
+  return 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
+}
+
 // The `count` leading singular values (descending) and right singular vectors of A by subspace
 // iteration on A^T A with a block of count + 3 vectors (three steps from a fixed, deterministic
 // start, then the Ritz values of A on the block): O(m n) per step where an SVD or eigensolver
@@ -234,7 +240,7 @@ bool BranchPointDetector::chord_correct(const Chord& chord, const core::Vector& 
     }
     if (iteration == 0 && kinks && kinks->cols() > 0) {
       // J's columns along the kink directions, differenced at the start (one residual each).
-      const double h = 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
+      const double h = difference_step(y);
       const Eigen::Index q = kinks->cols();
       A.resize(m, q);
       for (Eigen::Index i = 0; i < q; ++i) {
@@ -422,7 +428,7 @@ bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vecto
       // (Re-)difference along N at y (one residual each).
       if (differenced == max_differences) return false;
       ++differenced;
-      const double h = 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
+      const double h = difference_step(y);
       core::Matrix JN(r.size(), N.cols());
       for (Eigen::Index k = 0; k < N.cols(); ++k) {
         core::Vector rk;
