@@ -5,9 +5,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <numbers>
+#include <thread>
 
 #include "continuation/pseudo_arclength.hpp"
 #include "core/bordered_system.hpp"
@@ -179,23 +185,97 @@ struct BranchPointDetector::Evaluation {
   mutable std::shared_ptr<const Chord> chord;
 };
 
-const BranchPointDetector::Chord& BranchPointDetector::chord_of(const Evaluation& e) const {
-  if (!e.chord) e.chord = std::make_shared<const Chord>(e.jacobian, null_cutoff());
-  return *e.chord;
+namespace {
+
+// The loop's units relative to the unit scale (ScaledProblem::scale() ./ unit_scale()).
+core::Vector factor_of(const ScaledProblem& problem) {
+  return problem.scale().cwiseQuotient(problem.unit_scale());
 }
 
-core::Vector BranchPointDetector::factor() const {
-  return problem_.scale().cwiseQuotient(problem_.unit_scale());
-}
-
-core::Matrix BranchPointDetector::in_unit_scale(const core::Matrix& J) const {
-  core::Matrix out = J * factor().cwiseInverse().asDiagonal();
-  const core::Vector& rf = problem_.residual_factor();
+// J of the problem (its current units) in the unit scale.
+core::Matrix jacobian_in_unit_scale(const ScaledProblem& problem, const core::Matrix& J) {
+  core::Matrix out = J * factor_of(problem).cwiseInverse().asDiagonal();
+  const core::Vector& rf = problem.residual_factor();
   if (rf.size() > 0) out = rf.asDiagonal() * out;
   return out;
 }
 
-bool BranchPointDetector::chord_correct(const Chord& chord, const core::Vector& normal,
+}  // namespace
+
+// What a location needs of the detector, copied when the candidate is bracketed: the loop goes
+// on (and its units change) while the worker locates it.
+struct BranchPointDetector::Job {
+  std::vector<Sample> polyline;
+  bool sign_change = false;
+  core::Matrix last_jacobian;  // the last sample's, unit scale
+  double jacobian_scale = 0;
+  core::Vector scale, residual_factor;  // the loop's units then (ScaledProblem::set_units)
+};
+
+// Locates a bracketed candidate and verifies it (the header's 'Detection, location,
+// verification'). One per detector, on the loop's thread or on the worker's, which runs the jobs
+// in the order they were bracketed: what it learns from one candidate to the next (the
+// residuals a Jacobian took) comes in the same order either way, so the rows are the same bits.
+class BranchPointDetector::Locator {
+ public:
+  // problem: the view the candidates are corrected in; own: the same view when the locator sets
+  // its units job by job (the worker's copy of the problem), null on the loop's thread (the
+  // loop's view already has the job's units).
+  Locator(const ScaledProblem& problem, ScaledProblem* own, const ContinuationOptions& options,
+          const ContinuationHooks& hooks);
+  // Locates and verifies the job's candidate; appends its report (when one is made) to found.
+  void run(Job job, std::vector<BranchPointReport>& found);
+
+ private:
+  core::Vector factor() const { return factor_of(problem_); }
+  core::Matrix in_unit_scale(const core::Matrix& J) const {
+    return jacobian_in_unit_scale(problem_, J);
+  }
+  // Singular values at most this count as zero (the rank report's threshold, verify()).
+  double null_cutoff() const;
+  // Chord steps (one residual each) onto F = 0 and normal . (y - anchor) = 0, unit scale, with
+  // secant (good Broyden) updates of the chord's J; kinks (n x q, orthonormal): directions along
+  // which J is re-differenced at the start (q residuals). False when they do not converge to the
+  // verifier's corrector tolerance.
+  bool chord_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
+                     core::Vector& y, const core::Matrix* kinks = nullptr) const;
+  // Gauss-Newton on J with its columns along J's null space N re-differenced at an iterate
+  // (N.cols() residuals instead of a Jacobian's n), kept while its steps halve |F| (one residual
+  // each), onto the same constraints; at most max_differences differencings.
+  bool subspace_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
+                        core::Vector& y, int max_differences) const;
+  // The point on the hyperplane through the bracket's polyline at s, orthogonal to it, and its
+  // test function. Starts from near (a corrected evaluation nearer than the samples: tangent
+  // predictor, chord steps on its Jacobian) or else from the samples' cubic Hermite interpolant
+  // (chord steps on the last evaluation's Jacobian, or on initial before the first).
+  // initial: the chord of the last sample's Jacobian, used until a first evaluation (last) is
+  // made.
+  Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref,
+                      const Chord* initial, const Evaluation* last, const Evaluation* near);
+  // The chord of e's Jacobian, made on first use.
+  const Chord& chord_of(const Evaluation& e) const;
+  void locate(const std::vector<Sample>& polyline, bool sign_change);
+  // chord_of_j: J's Chord when the location made it (nullptr: made here).
+  void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,
+              core::Matrix J, const Chord* chord_of_j = nullptr);
+
+  const ScaledProblem& problem_;
+  ScaledProblem* own_;
+  const ContinuationOptions& options_;
+  const ContinuationHooks& hooks_;
+  double jacobian_scale_ = 0;
+  core::Matrix last_jacobian_;
+  long jacobian_residuals_ = 0;  // residuals the last Jacobian evaluate() computed took (0: none)
+  std::unique_ptr<core::Corrector> finisher_, probe_finisher_;  // after chord steps stall
+  std::vector<BranchPointReport>* found_ = nullptr;              // run()'s
+};
+
+const BranchPointDetector::Chord& BranchPointDetector::Locator::chord_of(const Evaluation& e) const {
+  if (!e.chord) e.chord = std::make_shared<const Chord>(e.jacobian, null_cutoff());
+  return *e.chord;
+}
+
+bool BranchPointDetector::Locator::chord_correct(const Chord& chord, const core::Vector& normal,
                                         const core::Vector& anchor, core::Vector& y,
                                         const core::Matrix* kinks) const {
   const core::Matrix& J = chord.jacobian;
@@ -303,10 +383,10 @@ bool BranchPointDetector::chord_correct(const Chord& chord, const core::Vector& 
   return false;
 }
 
-BranchPointDetector::BranchPointDetector(const ScaledProblem& problem,
-                                         const ContinuationOptions& options,
-                                         const ContinuationHooks& hooks, core::Corrector& corrector)
-    : problem_(problem), options_(options), hooks_(hooks), corrector_(corrector) {
+BranchPointDetector::Locator::Locator(const ScaledProblem& problem, ScaledProblem* own,
+                                      const ContinuationOptions& options,
+                                      const ContinuationHooks& hooks)
+    : problem_(problem), own_(own), options_(options), hooks_(hooks) {
   // What the chord steps leave is finished by Gauss-Newton that keeps its Jacobian while it
   // contracts (core::NewtonOptions::reuse_jacobian), to the verifier's tolerance: a located
   // point's correction within max_iterations 10, a probe's within 5 (the probes that converged
@@ -320,42 +400,213 @@ BranchPointDetector::BranchPointDetector(const ScaledProblem& problem,
   probe_finisher_ = core::make_corrector("eigen", newton);
 }
 
-BranchPointDetector::~BranchPointDetector() = default;
+void BranchPointDetector::Locator::run(Job job, std::vector<BranchPointReport>& found) {
+  if (own_) own_->set_units(job.scale, job.residual_factor);
+  last_jacobian_ = std::move(job.last_jacobian);
+  jacobian_scale_ = job.jacobian_scale;
+  found_ = &found;
+  locate(job.polyline, job.sign_change);
+  found_ = nullptr;
+}
+
+double BranchPointDetector::Locator::null_cutoff() const {
+  // The rank report's: relative to the branch's Jacobian scale (verify()).
+  return options_.rank.relative_threshold * jacobian_scale_;
+}
+
+// A thread that runs tasks in the order they were pushed. wait() returns when every task pushed
+// has run, and rethrows the first exception a task threw (the later tasks still run: the branch
+// goes on and reports it when it asks). The destructor drops the tasks not begun.
+class BranchPointDetector::SerialQueue {
+ public:
+  SerialQueue() : thread_([this] { run(); }) {}
+  ~SerialQueue() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  void push(std::function<void()> task) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      tasks_.push_back(std::move(task));
+    }
+    wake_.notify_one();
+  }
+  void wait() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    idle_.wait(lock, [&] { return tasks_.empty() && !busy_; });
+    if (error_) std::rethrow_exception(error_);
+  }
+  void rethrow() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  void run() {
+    for (;;) {
+      std::function<void()> task;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [&] { return stop_ || !tasks_.empty(); });
+        if (stop_) return;
+        task = std::move(tasks_.front());
+        tasks_.pop_front();
+        busy_ = true;
+      }
+      std::exception_ptr thrown;
+      try {
+        task();
+      } catch (...) {
+        thrown = std::current_exception();
+      }
+      {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (thrown && !error_) error_ = thrown;
+        busy_ = false;
+      }
+      idle_.notify_all();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_;  // a task came, or stop
+  std::condition_variable idle_;  // a task ended
+  std::deque<std::function<void()>> tasks_;
+  bool busy_ = false, stop_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;  // last: started once the rest exists
+};
+
+// What add() hands over: the point and its Jacobian in the loop's units of that moment.
+struct BranchPointDetector::Point {
+  int index = 0;
+  core::Vector z, tangent;
+  core::Matrix jacobian;
+  double arclength = 0;
+  core::Vector scale, residual_factor;  // ScaledProblem::scale(), residual_factor() then
+};
+
+BranchPointDetector::BranchPointDetector(const ScaledProblem& problem,
+                                         const ContinuationOptions& options,
+                                         const ContinuationHooks& hooks, core::Corrector&)
+    : problem_(problem), options_(options) {
+  std::unique_ptr<core::Problem> copy =
+      options.branch_points.background ? problem.base().clone() : nullptr;
+  if (!copy) {
+    locator_ = std::make_unique<Locator>(problem, nullptr, options, hooks);
+    return;
+  }
+  worker_base_ = std::move(copy);
+  worker_problem_ = std::make_unique<ScaledProblem>(*worker_base_, problem);
+  locator_ = std::make_unique<Locator>(*worker_problem_, worker_problem_.get(), options, hooks);
+  locating_ = std::make_unique<SerialQueue>();
+  sampling_ = std::make_unique<SerialQueue>();
+}
+
+BranchPointDetector::~BranchPointDetector() {
+  // A loop that ends normally has waited (finish()); one that threw leaves the tasks not begun.
+  // The sampling thread pushes onto the locating one: it stops first.
+  sampling_.reset();
+  locating_.reset();
+}
+
+void BranchPointDetector::wait_for_samples() const {
+  if (sampling_) sampling_->wait();
+}
+
+const std::vector<TestFunctionSample>& BranchPointDetector::samples() const {
+  wait_for_samples();
+  return samples_;
+}
+
+double BranchPointDetector::jacobian_scale() const {
+  wait_for_samples();
+  return jacobian_scale_;
+}
 
 double BranchPointDetector::last_value() const {
+  wait_for_samples();
   return samples_.empty() ? std::numeric_limits<double>::quiet_NaN() : samples_.back().tau.value;
 }
 
 void BranchPointDetector::restore(std::vector<TestFunctionSample> samples, double jacobian_scale) {
+  wait_for_samples();
   samples_ = std::move(samples);
   jacobian_scale_ = jacobian_scale;
   last_jacobian_.resize(0, 0);
 }
 
 std::vector<BranchPointReport> BranchPointDetector::take() {
+  if (sampling_) sampling_->rethrow();
+  if (locating_) locating_->rethrow();
+  const std::lock_guard<std::mutex> lock(found_mutex_);
   std::vector<BranchPointReport> out = std::move(found_);
   found_.clear();
   return out;
 }
 
-double BranchPointDetector::null_cutoff() const {
-  // The rank report's: relative to the branch's Jacobian scale (verify()).
-  return options_.rank.relative_threshold * jacobian_scale_;
+std::vector<BranchPointReport> BranchPointDetector::finish() {
+  if (sampling_) sampling_->wait();  // its brackets are on the locating queue by then
+  if (locating_) locating_->wait();
+  return take();
+}
+
+void BranchPointDetector::submit(std::vector<Sample> polyline, bool sign_change,
+                                 const core::Vector& scale, const core::Vector& residual_factor) {
+  Job job;
+  job.polyline = std::move(polyline);
+  job.sign_change = sign_change;
+  job.last_jacobian = last_jacobian_;
+  job.jacobian_scale = jacobian_scale_;
+  job.scale = scale;
+  job.residual_factor = residual_factor;
+  const auto run = [this](Job& j) {
+    std::vector<BranchPointReport> out;
+    locator_->run(std::move(j), out);
+    const std::lock_guard<std::mutex> lock(found_mutex_);
+    for (BranchPointReport& r : out) found_.push_back(std::move(r));
+  };
+  if (!locating_) {
+    run(job);
+    return;
+  }
+  locating_->push([run, job = std::move(job)]() mutable { run(job); });
 }
 
 void BranchPointDetector::add(int index, const core::Vector& z, const core::Vector& tangent,
                               const core::Matrix& J, double arclength) {
+  Point p;
+  p.index = index;
+  p.z = z;
+  p.tangent = tangent;
+  p.jacobian = J;
+  p.arclength = arclength;
+  p.scale = problem_.scale();
+  p.residual_factor = problem_.residual_factor();
+  if (!sampling_) {
+    sample(std::move(p));
+    return;
+  }
+  sampling_->push([this, p = std::move(p)]() mutable { sample(std::move(p)); });
+}
+
+void BranchPointDetector::sample(Point p) {
   // Everything the detector keeps and compares is in the unit scale (scaled_problem.hpp): the
   // loop's units may follow the point (LocalScale), and a test function of J in the point's own
   // units would change from sample to sample with the units alone (the period column and the
   // equations in units of the amplitude).
-  const core::Vector f = factor();
+  const core::Vector f = p.scale.cwiseQuotient(problem_.unit_scale());
   Sample sample;
-  sample.index = index;
-  sample.z = z.cwiseProduct(f);
-  sample.tangent = tangent.cwiseProduct(f).normalized();
-  sample.s = arclength;
-  last_jacobian_ = in_unit_scale(J);
+  sample.index = p.index;
+  sample.z = p.z.cwiseProduct(f);
+  sample.tangent = p.tangent.cwiseProduct(f).normalized();
+  sample.s = p.arclength;
+  last_jacobian_ = p.jacobian * f.cwiseInverse().asDiagonal();
+  if (p.residual_factor.size() > 0) last_jacobian_ = p.residual_factor.asDiagonal() * last_jacobian_;
   // One scale for the whole branch (J may vanish at a branch point: a per-point norm would hide
   // it): the Frobenius norm of the first point's Jacobian.
   if (!(jacobian_scale_ > 0))
@@ -369,7 +620,7 @@ void BranchPointDetector::add(int index, const core::Vector& z, const core::Vect
     const Sample& a = samples_[k - 2];
     const Sample& b = samples_[k - 1];
     if (b.tau.continued && a.tau.value * b.tau.value < 0) {
-      locate({a, b}, true);
+      submit({a, b}, true, p.scale, p.residual_factor);
       samples_.erase(samples_.begin(), samples_.end() - 1);
       return;
     }
@@ -378,13 +629,13 @@ void BranchPointDetector::add(int index, const core::Vector& z, const core::Vect
     const double fa = std::abs(samples_[0].tau.value), fb = std::abs(samples_[1].tau.value),
                  fc = std::abs(samples_[2].tau.value);
     if (fb < options_.branch_points.dip_ratio * std::min(fa, fc)) {
-      locate(samples_, false);
+      submit(samples_, false, p.scale, p.residual_factor);
       samples_.erase(samples_.begin(), samples_.end() - 1);
     }
   }
 }
 
-bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vector& normal,
+bool BranchPointDetector::Locator::subspace_correct(const Chord& chord, const core::Vector& normal,
                                            const core::Vector& anchor, core::Vector& y_io,
                                            int max_differences) const {
   // On failure y_io is left as it was.
@@ -469,7 +720,7 @@ bool BranchPointDetector::subspace_correct(const Chord& chord, const core::Vecto
   return false;
 }
 
-BranchPointDetector::Evaluation BranchPointDetector::evaluate(
+BranchPointDetector::Evaluation BranchPointDetector::Locator::evaluate(
     const std::vector<Sample>& polyline, double s, const TestFunctionValue& reference,
     const Chord* initial, const Evaluation* last, const Evaluation* near) {
   Evaluation e;
@@ -534,7 +785,7 @@ BranchPointDetector::Evaluation BranchPointDetector::evaluate(
   return e;
 }
 
-void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_change) {
+void BranchPointDetector::Locator::locate(const std::vector<Sample>& polyline, bool sign_change) {
   const auto started = std::chrono::steady_clock::now();
   const core::EvaluationCounters& counters = problem_.base().counters();
   const long jacobians_before = counters.jacobians, residuals_before = counters.residuals;
@@ -785,10 +1036,10 @@ void BranchPointDetector::locate(const std::vector<Sample>& polyline, bool sign_
   report.residual_evaluations = counters.residuals - residuals_before;
   report.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  found_.push_back(std::move(report));
+  found_->push_back(std::move(report));
 }
 
-void BranchPointDetector::verify(BranchPointReport& report, const core::Vector& z,
+void BranchPointDetector::Locator::verify(BranchPointReport& report, const core::Vector& z,
                                  const core::Vector& tangent, core::Matrix J,
                                  const Chord* chord_of_j) {
   // z, tangent and J in the unit scale; the loop's problem in its current units.

@@ -30,12 +30,21 @@
 //     and each extra direction is probed once more to find the attached family's secant, whose
 //     angle to the traced tangent is tangent_angle.
 //
+// Where: the test function and the brackets on the loop's thread at each point (the restart
+// state holds the samples); location and verification on a second thread, on the problem's
+// clone() set to the loop's units of the moment the candidate was bracketed, in the order of the
+// brackets (options.branch_points.background; without a clone, on the loop's thread). Either way
+// the rows are the same bits; take() returns those finished, finish() waits for the rest (the
+// loop calls it when the branch ends, LoopSteps::add_pending_branch_points).
+//
 //   BranchPointDetector detector(scaled_problem, options, hooks, corrector);
 //   detector.add(index, z, tangent, J, arclength);   // after every accepted point
 //   for (BranchPointReport& r : detector.take()) use(r.x, r.attached_dimension, r.tangent_angle);
+//   for (BranchPointReport& r : detector.finish()) use(r);   // when the branch ends
 #pragma once
 
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -90,63 +99,55 @@ class BranchPointDetector {
   // previous points.
   void add(int index, const core::Vector& z, const core::Vector& tangent, const core::Matrix& J,
            double arclength);
-  // Located candidates so far (in the problem's own unknowns), in order; cleared.
+  // Located candidates so far (in the problem's own unknowns), in order; cleared. Does not wait
+  // for the worker's pending candidates.
   std::vector<BranchPointReport> take();
+  // The rest: waits until every candidate handed to the worker is located and verified, then
+  // take(). Rethrows what a location threw on the worker.
+  std::vector<BranchPointReport> finish();
   // Test-function value at the last added point (NaN before the first).
   double last_value() const;
   // What add() remembers between points, for a restart that must continue bit for bit: the
   // samples kept (points and tangents in the unit scale) and the Jacobian scale (0 before the
   // first point). restore() puts them back.
-  const std::vector<TestFunctionSample>& samples() const { return samples_; }
-  double jacobian_scale() const { return jacobian_scale_; }
+  // They wait for the sampling thread to take every point added (one step of the loop's is
+  // ample time for it).
+  const std::vector<TestFunctionSample>& samples() const;
+  double jacobian_scale() const;
   void restore(std::vector<TestFunctionSample> samples, double jacobian_scale);
 
  private:
   using Sample = TestFunctionSample;
   struct Evaluation;
   struct Chord;
-  // The loop's units relative to the unit scale (ScaledProblem::scale() ./ unit_scale()).
-  core::Vector factor() const;
-  // J of the loop's problem (its current units) in the unit scale.
-  core::Matrix in_unit_scale(const core::Matrix& J) const;
-  // Singular values at most this count as zero (the rank report's threshold, verify()).
-  double null_cutoff() const;
-  // Chord steps (one residual each) onto F = 0 and normal . (y - anchor) = 0, unit scale, with
-  // secant (good Broyden) updates of the chord's J; kinks (n x q, orthonormal): directions along
-  // which J is re-differenced at the start (q residuals). False when they do not converge to the
-  // verifier's corrector tolerance.
-  bool chord_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
-                     core::Vector& y, const core::Matrix* kinks = nullptr) const;
-  // Gauss-Newton on J with its columns along J's null space N re-differenced at an iterate
-  // (N.cols() residuals instead of a Jacobian's n), kept while its steps halve |F| (one residual
-  // each), onto the same constraints; at most max_differences differencings.
-  bool subspace_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
-                        core::Vector& y, int max_differences) const;
-  // The point on the hyperplane through the bracket's polyline at s, orthogonal to it, and its
-  // test function. Starts from near (a corrected evaluation nearer than the samples: tangent
-  // predictor, chord steps on its Jacobian) or else from the samples' cubic Hermite interpolant
-  // (chord steps on the last evaluation's Jacobian, or on initial before the first).
-  // initial: the chord of the last sample's Jacobian, used until a first evaluation (last) is
-  // made.
-  Evaluation evaluate(const std::vector<Sample>& polyline, double s, const TestFunctionValue& ref,
-                      const Chord* initial, const Evaluation* last, const Evaluation* near);
-  // The chord of e's Jacobian, made on first use.
-  const Chord& chord_of(const Evaluation& e) const;
-  void locate(const std::vector<Sample>& polyline, bool sign_change);
-  // chord_of_j: J's Chord when the location made it (nullptr: made here).
-  void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,
-              core::Matrix J, const Chord* chord_of_j = nullptr);
+  class Locator;      // locates and verifies one candidate (branch_points.cpp)
+  struct Job;         // what it needs of the detector: the bracket's samples, J, the units then
+  struct Point;       // what add() hands over: the point, its J, the units then
+  class SerialQueue;  // a thread that runs tasks in order
+  // The test function at the point, and the brackets it closes (submit): on the sampling thread,
+  // or here without one.
+  void sample(Point p);
+  // Hands a bracketed candidate to the locating thread, or locates it here without one.
+  void submit(std::vector<Sample> polyline, bool sign_change, const core::Vector& scale,
+              const core::Vector& residual_factor);
+  void wait_for_samples() const;
 
   const ScaledProblem& problem_;
   const ContinuationOptions& options_;
-  const ContinuationHooks& hooks_;
-  core::Corrector& corrector_;
+  // The sampling thread's (the caller's without one); read after wait_for_samples().
   std::vector<Sample> samples_;  // the last three points
-  std::vector<BranchPointReport> found_;
   double jacobian_scale_ = 0;    // Frobenius norm of the first point's Jacobian (unit scale)
   core::Matrix last_jacobian_;   // the last sample's, unit scale (empty after restore())
-  long jacobian_residuals_ = 0;  // residuals the last Jacobian evaluate() computed took (0: none)
-  std::unique_ptr<core::Corrector> finisher_, probe_finisher_;  // after chord steps stall
+  std::mutex found_mutex_;
+  std::vector<BranchPointReport> found_;  // located, not yet taken
+  // With a clone() of the problem (options.branch_points.background): the copy and its view,
+  // which the locator corrects in, and the two threads. Declared in this order so that the
+  // sampling thread, which pushes onto the locating one, stops first.
+  std::unique_ptr<core::Problem> worker_base_;
+  std::unique_ptr<ScaledProblem> worker_problem_;
+  std::unique_ptr<Locator> locator_;
+  std::unique_ptr<SerialQueue> locating_;
+  std::unique_ptr<SerialQueue> sampling_;
 };
 
 }  // namespace backbone::continuation

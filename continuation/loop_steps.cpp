@@ -111,6 +111,10 @@ void LoopSteps::push(BranchPoint point) {
 }
 
 Branch LoopSteps::take() {
+  if (pending_branch_points_) {
+    for (BranchPointReport& report : pending_branch_points_()) add_branch_point(std::move(report));
+    pending_branch_points_ = nullptr;
+  }
   for (std::size_t i = 0; i < branch_.points.size(); ++i)
     branch_.points[i].x = branch_.points[i].x.cwiseProduct(point_scales_[i]);
   point_scales_.clear();

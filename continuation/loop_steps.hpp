@@ -34,6 +34,7 @@
 #pragma once
 
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -185,6 +186,11 @@ class LoopSteps {
   double arclength() const { return arclength_; }
   // Adds a located candidate to the branch and reports it (hooks.on_branch_point).
   void add_branch_point(BranchPointReport report);
+  // Candidates still being located when the branch ends (the detector's worker): take() adds
+  // what this returns (it waits for them) before it hands the branch over.
+  void add_pending_branch_points(std::function<std::vector<BranchPointReport>()> pending) {
+    pending_branch_points_ = std::move(pending);
+  }
   // A resumed run locates again from this after_point on (Branch::branch_points_from).
   void branch_points_from(int after_point) { branch_.branch_points_from = after_point; }
 
@@ -227,6 +233,7 @@ class LoopSteps {
   int first_index_ = 0;
   double arclength_ = 0;
   int switch_index_ = -1;
+  std::function<std::vector<BranchPointReport>()> pending_branch_points_;
 };
 
 }  // namespace backbone::continuation

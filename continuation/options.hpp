@@ -64,6 +64,10 @@ struct BranchPointOptions {
   // and the follow starts (the probe points) sit one step from the located point
   // (continuation/README.md, 'Branch points').
   double probe_step = 1e-3;
+  // Locate and verify the candidates on a second thread while the loop goes on, when the
+  // problem has a clone() (core/problem.hpp); else, or false, on the loop's thread. The rows are
+  // the same bits either way (branch_points.hpp: BranchPointDetector::Locator).
+  bool background = true;
   void validate() const;  // InputError naming branch_points.<field>
 };
 

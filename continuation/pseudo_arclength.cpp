@@ -64,7 +64,10 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
   const double threshold = options.rank.relative_threshold;
   LoopSteps steps(problem, corrector, options, hooks, start);
   std::optional<BranchPointDetector> detector;
-  if (options.branch_points.detect) detector.emplace(problem, options, hooks, corrector);
+  if (options.branch_points.detect) {
+    detector.emplace(problem, options, hooks, corrector);
+    steps.add_pending_branch_points([&detector] { return detector->finish(); });
+  }
   core::Vector x, tangent, previous;
   core::Matrix J;
   // Chord corrections (options.chord_corrections): the base's Jacobian at x, which the next

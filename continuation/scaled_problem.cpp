@@ -33,6 +33,24 @@ ScaledProblem::ScaledProblem(const core::Problem& base, core::Vector scale)
   if (local_ && !local_->local_scale_enabled()) local_ = nullptr;
 }
 
+ScaledProblem::ScaledProblem(const core::Problem& base, const ScaledProblem& like)
+    : base_(base),
+      local_(like.local_ ? dynamic_cast<const LocalScale*>(&base) : nullptr),
+      unit_scale_(like.unit_scale_),
+      scale_(like.scale_),
+      residual_factor_(like.residual_factor_) {
+  if (base.num_unknowns() != like.num_unknowns() || base.num_equations() != like.num_equations())
+    throw core::InputError("problem", "a view of another base must have the same sizes");
+}
+
+void ScaledProblem::set_units(const core::Vector& scale, const core::Vector& residual_factor) {
+  check_positive("scale", scale, num_unknowns());
+  if (residual_factor.size() > 0)
+    check_positive("residual_factor", residual_factor, num_equations());
+  scale_ = scale;
+  residual_factor_ = residual_factor;
+}
+
 core::Vector ScaledProblem::local_factor_at(const core::Vector& x) const {
   if (!local_) return core::Vector::Ones(num_unknowns());
   core::Vector factor = local_->local_scale_factor(x);

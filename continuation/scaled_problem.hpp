@@ -63,6 +63,9 @@ class ScaledProblem : public core::Problem {
   // norm is then the base's weighted Euclidean norm of the raw unknowns). The step weights are
   // the base's in both cases.
   ScaledProblem(const core::Problem& base, core::Vector scale);
+  // The same view (unit scale, current units) of another base with the same unknowns: a
+  // clone() of like's base, evaluated on another thread (branch_points.hpp).
+  ScaledProblem(const core::Problem& base, const ScaledProblem& like);
   int num_unknowns() const override { return base_.num_unknowns(); }
   int num_equations() const override { return base_.num_equations(); }
   std::string name() const override { return base_.name(); }
@@ -88,6 +91,9 @@ class ScaledProblem : public core::Problem {
   core::Vector local_residual_factor_at(const core::Vector& x) const;
   // Units s ./ w .* factor from now on, F divided by residual_factor (empty: as the base's).
   void set_factor(const core::Vector& factor, const core::Vector& residual_factor = {});
+  // The units another view of the same unknowns had (its scale() and residual_factor()), bit for
+  // bit: work handed to another thread sees the units of the moment it was handed over.
+  void set_units(const core::Vector& scale, const core::Vector& residual_factor);
   // The residual factor set last (empty: none), e.g. to convert a Jacobian back to the unit
   // scale: J_unit = diag(residual_factor) J_z diag(1 ./ factor).
   const core::Vector& residual_factor() const { return residual_factor_; }

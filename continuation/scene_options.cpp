@@ -57,6 +57,9 @@ po::options_description continuation_keys(const po::options_description& problem
   add("detect_branch_points", po::value<bool>()->default_value(false),
       "arclength: evaluate the branch-point test function at every point, locate and verify "
       "candidates (trace writes branch_points.csv)");
+  add("locate_in_background", po::value<bool>()->default_value(true),
+      "locate and verify branch-point candidates on a second thread while the trace goes on "
+      "(problems with core::Problem::clone; the same rows either way)");
   add("follow", po::value<std::string>()->default_value("none"),
       "arclength: none, all or K: switch onto the family attached at every verified (or the K-th, "
       "1-based row of branch_points.csv) branch point and trace it towards growing energy into "
@@ -153,6 +156,7 @@ RunSettings read_run_settings(const core::Scene& scene) {
                 : o.branch_points.detect ? Predictor::tangent
                                          : Predictor::quadratic;
   o.branch_points.max_turn_degrees = scene.non_negative("max_turn_degrees");
+  o.branch_points.background = scene.flag("locate_in_background");
   read_bounds(scene, o);
   o.validate();
   run.newton = scene.choice("newton", {"eigen", "kinsol"});

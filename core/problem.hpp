@@ -22,6 +22,7 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -87,6 +88,7 @@ using Observables = std::vector<std::pair<std::string, double>>;
 
 class Problem {
  public:
+  Problem() = default;
   virtual ~Problem() = default;
 
   virtual int num_unknowns() const = 0;
@@ -127,7 +129,17 @@ class Problem {
   const EvaluationCounters& counters() const { return counters_; }
   void reset_counters() const { counters_.reset(); }
 
+  // An independent copy of this problem that another thread may evaluate while this one is
+  // evaluated (its own counters and caches), or nullptr, the default. Work that can run beside
+  // the caller's (the branch-point location on a second core, continuation/README.md 'Branch
+  // points') runs on the caller's thread when there is no copy. A problem whose members are
+  // values or shared immutable data implements it as make_unique<Self>(*this).
+  virtual std::unique_ptr<Problem> clone() const { return nullptr; }
+
  protected:
+  // A copy counts its own evaluations from zero (clone()).
+  Problem(const Problem&) {}
+  Problem& operator=(const Problem&) { return *this; }
   virtual EvalStatus compute_residual(const Vector& x, Vector& r) const = 0;
   // Default: forward finite differences, default_jacobian_threads() threads: compressed
   // (compressed_finite_difference_jacobian) when jacobian_pattern(x) gives a pattern, else

@@ -16,6 +16,10 @@ std::vector<continuation::ProblemJob> bench_cases() {
        "mode 1 branch cost vs closed-form error over N, steps per period, formulation, "
        "corrector and threads; the FD Jacobian with 1 and 2 threads",
        bench_mode1_scaling},
+      {"branch_point_cost",
+       "what branch-point detection adds to the mode-1 trace at 100 intervals (wall and CPU, "
+       "second thread or not) against the located periods' accuracy",
+       bench_branch_point_cost},
   };
 }
 

@@ -21,6 +21,12 @@
 //                      Jacobians and CPU ms per point, worst closed-form error, the exponent of
 //                      ms per point over N >= 40; the FD Jacobian alone at N = 200 with 1 and 2
 //                      threads (bench_branch_scaling.hpp).
+//   branch_point_cost  mode 1 of the paper scene at 100 intervals to E = 1e-2, in-process, without
+//                      branch-point detection, with it (candidates located on a second thread)
+//                      and with it on the loop's thread, rounds alternated
+//                      (BACKBONE_BRANCH_POINT_COST_RUNS, default 7): median wall and CPU seconds
+//                      and what detection adds, candidates, verified ones and their periods'
+//                      offsets from 3.6 / 3.5 / 3.25 / 3.2 L/c, the worst closed-form error.
 //
 //   for (const continuation::ProblemJob& job : contact_bar::bench_cases())
 //     if (job.name == "bouncing_bar") status = job.run("results/bench");
@@ -33,7 +39,7 @@
 
 namespace backbone::contact_bar {
 
-// The five cases above, in that order (`backbone bench` runs them all).
+// The six cases above, in that order (`backbone bench` runs them all).
 std::vector<continuation::ProblemJob> bench_cases();
 
 // The cases one by one (what bench_cases() calls).
@@ -42,5 +48,6 @@ int bench_bouncing_bar(const std::filesystem::path& out);
 int bench_mode1_convergence(const std::filesystem::path& out);
 int bench_formulations(const std::filesystem::path& out);
 int bench_mode1_scaling(const std::filesystem::path& out);
+int bench_branch_point_cost(const std::filesystem::path& out);
 
 }  // namespace backbone::contact_bar

@@ -56,6 +56,7 @@ InProcessTrace trace_in_process(const continuation::ProblemPlugin& plugin, const
           : core::Vector::Unit(periodic->num_unknowns(), periodic->period_index());
   continuation::ContinuationHooks hooks;
   hooks.reject_point = setup.reject_point;
+  hooks.describe_branch_point = setup.describe_branch_point;  // as trace's (when detecting)
 
   InProcessTrace t;
   const double cpu_start = process_cpu_seconds();

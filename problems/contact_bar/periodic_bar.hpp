@@ -92,6 +92,10 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continu
                          OrbitOptions options);
 
   std::string name() const override { return "contact_bar"; }
+  // A copy sharing the (immutable, thread-safe) solver: the branch-point location's second core.
+  std::unique_ptr<core::Problem> clone() const override {
+    return std::make_unique<ContactBarOrbitProblem>(*this);
+  }
   int state_size() const override { return options_.state_size(); }
   // M = test_elements (state_size() when 0).
   int num_equations() const override {

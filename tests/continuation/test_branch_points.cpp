@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <utility>
 
@@ -127,6 +128,59 @@ TEST(BranchPoints, LocatedInUnitsThatFollowThePoint) {
   }
   EXPECT_NEAR(last_lambda[0], 9 * 0.13, 1e-12);
   EXPECT_GT(last_lambda[1], 1.5 * last_lambda[0]);  // steps of (1 + lambda^2) ds
+}
+
+// With a clone() the candidates are located on a second thread (BranchPointOptions::background),
+// in a copy of the problem set to the loop's units of the moment each was bracketed: the reports
+// and the branch must be the bits the loop's own thread gives, in units that follow the point and
+// with two candidates queued (the axis meets the circle twice, algebraic.hpp). These small
+// problems run the worker under the sanitizers (.ci/sanitize); the contact bar's CLI test
+// (SecondThreadGivesTheRowsOfTheLoopsOwnBitForBit) is the one whose rows move when the worker
+// misses the loop's units (measured: 42 differing values; here the two-unknown problems give the
+// same bits in either units).
+template <class P>
+class Cloned : public P {
+ public:
+  using P::P;
+  std::unique_ptr<core::Problem> clone() const override {
+    return std::make_unique<Cloned>(*this);
+  }
+};
+
+// The branch with detection on the loop's thread and on the worker's: the same bits.
+void expect_same_on_both_threads(const core::Problem& problem, const core::Vector& start,
+                                 continuation::ContinuationOptions o, std::size_t candidates) {
+  ASSERT_NE(problem.clone(), nullptr);
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  Branch runs[2];
+  for (bool background : {false, true}) {
+    o.branch_points.background = background;
+    runs[background] = continuation::pseudo_arclength(problem, start, vec({0, 1}), *newton, o);
+  }
+  ASSERT_EQ(runs[0].branch_points.size(), candidates);
+  ASSERT_EQ(runs[1].branch_points.size(), candidates);
+  for (std::size_t i = 0; i < candidates; ++i) {
+    const auto& a = runs[0].branch_points[i];
+    const auto& b = runs[1].branch_points[i];
+    EXPECT_TRUE(a.x == b.x) << i;
+    EXPECT_EQ(a.attached_dimension, b.attached_dimension) << i;
+    EXPECT_EQ(a.tangent_angle, b.tangent_angle) << i;
+    EXPECT_EQ(a.after_point, b.after_point) << i;
+    EXPECT_EQ(a.jacobian_evaluations, b.jacobian_evaluations) << i;
+    EXPECT_EQ(a.residual_evaluations, b.residual_evaluations) << i;
+  }
+  ASSERT_EQ(runs[0].points.size(), runs[1].points.size());
+  for (std::size_t i = 0; i < runs[0].points.size(); ++i) {
+    EXPECT_TRUE(runs[0].points[i].x == runs[1].points[i].x) << i;
+    EXPECT_EQ(runs[0].points[i].residual_evaluations, runs[1].points[i].residual_evaluations) << i;
+  }
+}
+
+TEST(BranchPoints, SecondThreadGivesTheLoopsOwnReports) {
+  expect_same_on_both_threads(Cloned<TranscriticalInGrowingUnits>(true), vec({0, 0}),
+                              detecting(0.13, 10), 1);
+  expect_same_on_both_threads(Cloned<algebraic::AxisAndCircle>(), vec({0, -1.6}),
+                              detecting(0.15, 24), 2);
 }
 
 // [J/s; t^T] of the transcritical on x = 0 is diag((lambda - 1)/s, 1): the signed test function

@@ -147,6 +147,36 @@ TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
 // (frequency_ratio, ...): the merge had then dropped the earlier rows. Periods agree with the
 // uninterrupted run's to the test function's noise (the resumed sample is recomputed in that
 // point's units, continuation/README.md 'Branch points'; measured <= 4e-8 relative).
+// The candidates are located and verified on a second thread (the worker has its own copy of
+// the problem, core::Problem::clone, and the loop's units of the moment each candidate was
+// bracketed): every row must be the same bits as the loop's own thread gives
+// (--locate_in_background false), the cost columns included but for the wall time, and so must
+// the branch. A worker that saw other units, another Jacobian or the loop's counters would move
+// the located periods and the counts.
+TEST(BranchPointsCli, SecondThreadGivesTheRowsOfTheLoopsOwnBitForBit) {
+  const std::string scene =
+      paper + " --branch mode1 --shooting_elements 100 --energy_max 1e-2 --detect_branch_points true";
+  const fs::path worker = cli::scratch("branch_points_cli", "worker");
+  const fs::path inline_ = cli::scratch("branch_points_cli", "inline");
+  ASSERT_EQ(cli::run("trace", scene, worker).code, 0);
+  ASSERT_EQ(cli::run("trace", scene + " --locate_in_background false", inline_).code, 0);
+  for (const char* file : {"branch_points.csv", "branch.csv"}) {
+    const Table a = Table::read_csv(worker / file), b = Table::read_csv(inline_ / file);
+    ASSERT_EQ(a.columns(), b.columns()) << file;
+    ASSERT_EQ(a.rows(), b.rows()) << file;
+    for (const std::string& column : a.columns()) {
+      if (column == "seconds") continue;
+      const auto x = a.column(column), y = b.column(column);
+      for (std::size_t i = 0; i < x.size(); ++i)  // NaN (an unverified row's ratio) matches NaN
+        EXPECT_TRUE(x[i] == y[i] || (std::isnan(x[i]) && std::isnan(y[i])))
+            << file << " " << column << " row " << i << ": " << x[i] << " vs " << y[i];
+    }
+  }
+  EXPECT_EQ(Table::read_csv(worker / "branch_points.csv").rows(), 6u);
+  fs::remove_all(worker);
+  fs::remove_all(inline_);
+}
+
 TEST(BranchPointsCli, ResumedRunNeitherRepeatsNorDropsCandidates) {
   const std::string scene =
       paper + " --branch mode1 --shooting_elements 100 --energy_max 1e-2 --detect_branch_points true";

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <thread>
 
 #include "continuation/pseudo_arclength.hpp"
 #include "continuation/scaled_problem.hpp"
@@ -249,6 +251,34 @@ TEST(ContactBarOrbit, JacobianWithTwoThreadsIsBitIdentical) {
   } catch (const core::InputError& e) {
     EXPECT_EQ(e.key(), "threads");
   }
+}
+
+// clone() (core/problem.hpp): a copy that another thread evaluates while the original is
+// evaluated gives the same bits (the same solver, the same x), and each counts only its own
+// evaluations (the branch-point worker's rows and the loop's per-point counts stay exact).
+TEST(ContactBarOrbit, CloneEvaluatesTheSameBitsOnAnotherThreadAndCountsItsOwn) {
+  const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
+  ContactBarOrbitProblem p(paper_setup(), event, grid(40, 40, 0, 80));
+  const Vector x = p.contact_family_guess(1, 3.0);
+  const std::unique_ptr<core::Problem> copy = p.clone();
+  ASSERT_NE(copy, nullptr);
+  EXPECT_EQ(copy->counters().residuals, 0);
+  Vector mine, theirs;
+  core::Matrix J_mine, J_theirs;
+  std::thread other([&] {
+    for (int i = 0; i < 5; ++i) ASSERT_EQ(copy->residual(x, theirs), core::EvalStatus::ok);
+    ASSERT_EQ(copy->jacobian(x, J_theirs), core::EvalStatus::ok);
+  });
+  for (int i = 0; i < 3; ++i) ASSERT_EQ(p.residual(x, mine), core::EvalStatus::ok);
+  ASSERT_EQ(p.jacobian(x, J_mine), core::EvalStatus::ok);
+  other.join();
+  EXPECT_TRUE(mine == theirs);
+  EXPECT_TRUE(J_mine == J_theirs);
+  EXPECT_GT(mine.norm(), 0);
+  // The Jacobian's own residuals come on top of the direct ones, the same number for both.
+  EXPECT_EQ(copy->counters().residuals - 5, p.counters().residuals - 3);
+  EXPECT_EQ(copy->counters().jacobians, 1);
+  EXPECT_EQ(p.counters().jacobians, 1);
 }
 
 TEST(ContactBarOrbit, TestElementsBelowTheUnknownsAreRejected) {
