@@ -147,9 +147,25 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
   } else {
     // One bordered system for every correction: F plus the arclength row, moved at each step.
     // The first point is the guess corrected on the hyperplane through it orthogonal to the hint.
-    const core::Vector hint = hint_in.normalized();
-    core::BorderedSystem first(problem, {core::BorderRow::linear(hint, guess, 0.0, "arclength")});
+    core::Vector hint = hint_in.normalized();
     x = guess;
+    // In the guess's own units when they follow the point and are not the unit scale there: a
+    // guess far above the unit (a saved point corrected again to continue a finished branch)
+    // cannot be corrected to the loop's tolerance in the unit scale, whose residual round-off
+    // grows with the amplitude (measured: mode 1 of the contact bar at 200 intervals, E = 1e-2,
+    // stalled at |F| = 4e-10 against the tolerance 1e-10; its points had converged in their
+    // own units, where F is divided by ~100).
+    if (follow_scale) {
+      const core::Vector at = problem.to_unknowns(guess);
+      const core::Vector f = problem.local_factor_at(at);
+      if ((f.array() != 1.0).any()) {
+        factor = f;
+        problem.set_factor(factor, problem.local_residual_factor_at(at));
+        x = guess.cwiseQuotient(factor);
+        hint = hint.cwiseQuotient(factor).normalized();
+      }
+    }
+    core::BorderedSystem first(problem, {core::BorderRow::linear(hint, x, 0.0, "arclength")});
     if (!steps.start(first, x, "")) return steps.take();
     if (problem.jacobian(x, J) != core::EvalStatus::ok ||
         tangent_from_jacobian(J, hint, threshold, tangent) != core::EvalStatus::ok) {
@@ -162,8 +178,8 @@ Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess,
     keep_base(problem.to_unknowns(x));
     auto state = std::make_shared<LoopState>();
     state->method = Method::arclength;
-    state->z = x;
-    state->tangent = tangent;
+    state->z = in_unit_scale(x);
+    state->tangent = in_unit_scale(tangent);
     state->ds = ds;
     state->jacobian_point = nearby_at;
     const std::shared_ptr<const LoopState> first_state = state;

@@ -213,6 +213,30 @@ TEST(TraceCli, ResumingABranchOnItsBoundAddsNothingUnlessTheBoundMoves) {
   fs::remove(done.string() + ".log");
 }
 
+// A finished branch far above the gap is extended from its last point, which has no loop state
+// (it was landed on the bound) and is corrected again: in its own amplitude units, where its
+// points converged. In the unit scale (gap units) mode 1 at 200 intervals and E = 1e-2 stalled at
+// |F| = 4.0e-10 against the tolerance 1e-10 (residual round-off ~100 times the amplitude units')
+// and the resumed run ended at once with newton_failed. Every extended point keeps the closed
+// form (mode 1: the trace's own check, closed_form_check.csv; 1e-8 is the bound).
+TEST(TraceCli, FinishedBranchFarAboveTheGapExtends) {
+  const fs::path done = cli::scratch("trace_cli", "extend");
+  ASSERT_EQ(cli::run("trace", paper + " --branch mode1 --shooting_elements 200 --energy_max 1e-2",
+                     done)
+                .code,
+            0);
+  const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
+                             done.string() + "' --energy_max 2e-2 > '" + done.string() +
+                             ".log' 2>&1";
+  ASSERT_EQ(std::system(resume.c_str()), 0) << file_text(done.string() + ".log");
+  const auto t = backbone::core::Table::read_csv(done / "branch.csv");
+  EXPECT_NEAR(t.column("energy").back(), 2e-2, 1e-12);
+  const auto check = backbone::core::Table::read_csv(done / "closed_form_check.csv");
+  for (double e : check.column("relative_error")) EXPECT_LE(e, 1e-8);
+  fs::remove_all(done);
+  fs::remove(done.string() + ".log");
+}
+
 // A resumed run reads the resolved scene.ini, where keys left at their defaults are comments: in
 // the amplitude units (mode 1's default) newton_tolerance is then still "not given" and the
 // branch keeps its own 1e-10 (problems/contact_bar/README.md, 'Cost'). When scene.ini listed
