@@ -493,7 +493,7 @@ struct BranchPointDetector::Point {
 BranchPointDetector::BranchPointDetector(const ScaledProblem& problem,
                                          const ContinuationOptions& options,
                                          const ContinuationHooks& hooks, core::Corrector&)
-    : problem_(problem), options_(options) {
+    : problem_(problem), options_(options), unit_scale_(problem.unit_scale()) {
   std::unique_ptr<core::Problem> copy =
       options.branch_points.background ? problem.base().clone() : nullptr;
   if (!copy) {
@@ -599,7 +599,7 @@ void BranchPointDetector::sample(Point p) {
   // loop's units may follow the point (LocalScale), and a test function of J in the point's own
   // units would change from sample to sample with the units alone (the period column and the
   // equations in units of the amplitude).
-  const core::Vector f = p.scale.cwiseQuotient(problem_.unit_scale());
+  const core::Vector f = p.scale.cwiseQuotient(unit_scale_);
   Sample sample;
   sample.index = p.index;
   sample.z = p.z.cwiseProduct(f);

@@ -132,8 +132,9 @@ class BranchPointDetector {
               const core::Vector& residual_factor);
   void wait_for_samples() const;
 
-  const ScaledProblem& problem_;
+  const ScaledProblem& problem_;  // read on the loop's thread only
   const ContinuationOptions& options_;
+  const core::Vector unit_scale_;  // problem_.unit_scale(), for the sampling thread
   // The sampling thread's (the caller's without one); read after wait_for_samples().
   std::vector<Sample> samples_;  // the last three points
   double jacobian_scale_ = 0;    // Frobenius norm of the first point's Jacobian (unit scale)
