@@ -44,6 +44,20 @@ std::string point_line(const BranchPoint& p) {
                      p.seconds);
 }
 
+std::string branch_point_line(const BranchPointReport& r) {
+  std::string observables;
+  for (const auto& [key, value] : r.observables)
+    observables += fmt::format(" {} {:.10g}", key, value);
+  std::string verdict =
+      r.verified() ? fmt::format("verified, attached dimension {} (nullity {})",
+                                 r.attached_dimension, r.nullity)
+                   : fmt::format("not verified (nullity {})", r.nullity);
+  for (const auto& [key, value] : r.attached_description)
+    if (r.verified()) verdict += fmt::format(" {} {:.6g}", key, value);
+  return fmt::format("branch point after point {}:{}  {}  {} Jacobians  {:.3f} s", r.after_point,
+                     observables, verdict, r.jacobian_evaluations, r.seconds);
+}
+
 std::string ProgressLine::text(const BranchPoint& point, double elapsed) {
   ++points_;
   const Bound* bound = options_.bounds.empty() ? nullptr : &options_.bounds.front();

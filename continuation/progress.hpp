@@ -23,6 +23,10 @@ namespace backbone::continuation {
 // One line per accepted point for a log: "point 12 period 3.1 ... dim 1  |F| 2e-11  newton 2
 // ds 2  0.021 s".
 std::string point_line(const BranchPoint& point);
+// One line per located branch-point candidate: "branch point after point 5: period 3.6 ...
+// verified, attached dimension 19 (nullity 20) frequency_ratio 8  12 Jacobians  0.055 s", or
+// "... not verified (nullity 1) ...".
+std::string branch_point_line(const BranchPointReport& report);
 
 class ProgressLine {
  public:

@@ -210,6 +210,13 @@ int run_trace(const std::vector<std::string>& args_in) {
   long rejected = 0;
   hooks.reject_point = setup.reject_point;
   hooks.describe_branch_point = setup.describe_branch_point;
+  // Located candidates as they come (from the detector's thread, a few points after the bracket
+  // that holds them; continuation/README.md, 'Branch points'), between the point lines.
+  hooks.on_branch_point = [&](const cont::BranchPointReport& r) {
+    progress.finish();
+    fmt::print("  {}\n", cont::branch_point_line(r));
+    std::fflush(stdout);
+  };
   hooks.on_attempt = [&](const cont::StepAttempt& a) {
     if (a.rejection.empty()) return;
     ++rejected;
@@ -225,6 +232,12 @@ int run_trace(const std::vector<std::string>& args_in) {
   const bool complete = !branch.points.empty() && !branch.ended_early();
   bool followed_complete = true;  // every followed branch reached its bound or budget
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
+  if (options.branch_points.detect) {
+    const auto verified = std::count_if(branch.branch_points.begin(), branch.branch_points.end(),
+                                        [](const cont::BranchPointReport& r) { return r.verified(); });
+    fmt::print("branch points located by this run: {} ({} verified; branch_points.csv)\n",
+               branch.branch_points.size(), verified);
+  }
   if (!branch.points.empty()) {
     // The figure and the extra outputs show the whole branch, saved points included.
     const core::Table table = core::Table::read_csv(out / "branch.csv");

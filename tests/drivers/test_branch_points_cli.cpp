@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "core/errors.hpp"
@@ -158,8 +159,27 @@ TEST(BranchPointsCli, SecondThreadGivesTheRowsOfTheLoopsOwnBitForBit) {
       paper + " --branch mode1 --shooting_elements 100 --energy_max 1e-2 --detect_branch_points true";
   const fs::path worker = cli::scratch("branch_points_cli", "worker");
   const fs::path inline_ = cli::scratch("branch_points_cli", "inline");
-  ASSERT_EQ(cli::run("trace", scene, worker).code, 0);
+  // The worker's run keeps its stdout: each candidate gets a line as it is located.
+  const std::string log = worker.string() + ".log";
+  ASSERT_EQ(std::system((std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace " + scene +
+                         " --out '" + worker.string() + "' > '" + log + "' 2>&1")
+                            .c_str()),
+            0);
   ASSERT_EQ(cli::run("trace", scene + " --locate_in_background false", inline_).code, 0);
+  {
+    std::ifstream in(log);
+    int lines = 0, verified_lines = 0;
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("  branch point after point ", 0) != 0) continue;
+      ++lines;
+      if (line.find(" verified, attached dimension ") != std::string::npos) ++verified_lines;
+    }
+    const Table t = Table::read_csv(worker / "branch_points.csv");
+    const auto verified = t.column("verified");
+    EXPECT_EQ(lines, static_cast<int>(t.rows()));
+    EXPECT_EQ(verified_lines, std::count(verified.begin(), verified.end(), 1.0));
+    fs::remove(log);
+  }
   for (const char* file : {"branch_points.csv", "branch.csv"}) {
     const Table a = Table::read_csv(worker / file), b = Table::read_csv(inline_ / file);
     ASSERT_EQ(a.columns(), b.columns()) << file;
