@@ -21,10 +21,10 @@
 //                      Jacobians and CPU ms per point, worst closed-form error, the exponent of
 //                      ms per point over N >= 40; the FD Jacobian alone at N = 200 with 1 and 2
 //                      threads (bench_branch_scaling.hpp).
-//   branch_point_cost  mode 1 of the paper scene at 100 intervals to E = 1e-2, in-process, without
-//                      branch-point detection, with it (candidates located on a second thread)
-//                      and with it on the loop's thread, rounds alternated
-//                      (BACKBONE_BRANCH_POINT_COST_RUNS, default 7): median wall and CPU seconds
+//   branch_point_cost  mode 1 of the paper scene at 100 and 200 intervals to E = 1e-2, in-process,
+//                      without branch-point detection, with it (candidates located on a second
+//                      thread) and with it on the loop's thread, rounds alternated
+//                      (BACKBONE_BRANCH_POINT_COST_RUNS, default 5): median wall and CPU seconds
 //                      and what detection adds, candidates, verified ones and their periods'
 //                      offsets from 3.6 / 3.5 / 3.25 / 3.2 L/c, the worst closed-form error.
 //
