@@ -25,12 +25,9 @@
 
 #include "continuation/bench_report.hpp"
 #include "continuation/plugin.hpp"
-#include "continuation/scene_options.hpp"
 #include "core/errors.hpp"
-#include "core/scene.hpp"
 #include "core/table.hpp"
 #include "problems/contact_bar/bench.hpp"
-#include "problems/contact_bar/bench_peers.hpp"
 #include "problems/contact_bar/bench_support.hpp"
 
 namespace backbone::contact_bar {
@@ -65,11 +62,6 @@ int bench_branch_point_cost(const std::filesystem::path& out) {
   continuation::PluginRegistry registry;
   register_plugin(registry);
   const continuation::ProblemPlugin* plugin = registry.find("contact_bar");
-  namespace po = boost::program_options;
-  po::options_description keys = plugin->scene_keys();
-  keys.add(continuation::continuation_keys(keys));
-  const std::filesystem::path paper =
-      contact_bar_peers_folder().parent_path() / "scenes" / "paper.ini";
   fmt::print(
       "bench branch_point_cost: mode 1 of the paper scene to E = 1e-2 at 100 and 200 intervals, "
       "without and with branch-point detection, {} rounds alternated "
@@ -92,8 +84,7 @@ int bench_branch_point_cost(const std::filesystem::path& out) {
         std::vector<std::string> args = {"--shooting_elements", std::to_string(elements),
                                          "--energy_max", "1e-2"};
         args.insert(args.end(), v.keys.begin(), v.keys.end());
-        const core::Scene scene =
-            core::read_scene(keys, paper.string(), args, po::options_description());
+        const core::Scene scene = bench::read_paper_scene(*plugin, args);
         v.last = bench::trace_in_process(*plugin, scene, "mode1");
         v.wall.push_back(v.last.wall_seconds);
         v.cpu.push_back(v.last.cpu_seconds);

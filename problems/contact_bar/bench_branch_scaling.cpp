@@ -17,7 +17,6 @@
 #include <thread>
 
 #include "continuation/bench_report.hpp"
-#include "continuation/scene_options.hpp"
 #include "core/errors.hpp"
 #include "core/finite_difference.hpp"
 #include "core/plot.hpp"
@@ -35,8 +34,6 @@ void register_plugin(continuation::PluginRegistry& registry);  // plugin.cpp
 
 namespace {
 
-namespace po = boost::program_options;
-
 double wall_seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -51,19 +48,14 @@ struct Mode1Scene {
 void read_mode1_scene(Mode1Scene& s, const Mode1BranchSettings& settings) {
   register_plugin(s.registry);
   s.plugin = s.registry.find("contact_bar");
-  po::options_description keys = s.plugin->scene_keys();
-  keys.add(continuation::continuation_keys(keys));
-  const std::filesystem::path paper =
-      contact_bar_peers_folder().parent_path() / "scenes" / "paper.ini";
-  s.scene = core::read_scene(
-      keys, paper.string(),
+  s.scene = bench::read_paper_scene(
+      *s.plugin,
       {"--start_offset", "0.25", "--energy_max", fmt::format("{:.17g}", settings.energy_max),
        "--shooting_elements", std::to_string(settings.elements), "--steps_per_period",
        std::to_string(settings.steps_per_period), "--formulation", settings.formulation, "--newton",
        settings.newton, "--test_elements", std::to_string(settings.test_elements), "--threads",
        std::to_string(settings.threads), "--rank_check_every",
-       std::to_string(settings.rank_check_every)},
-      po::options_description());
+       std::to_string(settings.rank_check_every)});
 }
 
 // Errors of exactly 0 (round-off luck) are drawn at this floor on the log axes.

@@ -10,7 +10,6 @@
 #include <limits>
 
 #include "continuation/bench_report.hpp"
-#include "continuation/scene_options.hpp"
 #include "core/errors.hpp"
 #include "core/finite_difference.hpp"
 #include "core/plot.hpp"
@@ -31,8 +30,6 @@ namespace backbone::contact_bar {
 void register_plugin(continuation::PluginRegistry& registry);  // plugin.cpp
 
 namespace {
-
-namespace po = boost::program_options;
 
 constexpr int repetitions = 3;  // medians of 3, as the stored peer runs
 
@@ -84,14 +81,10 @@ Mode1Trace trace_paper_mode1(int shooting_elements) {
   continuation::PluginRegistry registry;
   register_plugin(registry);
   const continuation::ProblemPlugin& plugin = *registry.find("contact_bar");
-  po::options_description keys = plugin.scene_keys();
-  keys.add(continuation::continuation_keys(keys));
-  const core::Scene scene =
-      core::read_scene(keys, (contact_bar_folder() / "scenes" / "paper.ini").string(),
-                       {"--start_offset", "0.25", "--energy_max", "5e-3", "--shooting_elements",
-                        std::to_string(shooting_elements), "--threads",
-                        std::to_string(core::default_jacobian_threads())},  // bench --threads K
-                       po::options_description());
+  const core::Scene scene = bench::read_paper_scene(
+      plugin, {"--start_offset", "0.25", "--energy_max", "5e-3", "--shooting_elements",
+               std::to_string(shooting_elements), "--threads",
+               std::to_string(core::default_jacobian_threads())});  // bench --threads K
   const bench::InProcessTrace run = bench::trace_in_process(plugin, scene, "mode1");
   Mode1Trace t;
   // As Stopwatch: CPU time on one thread, wall time with `bench --threads K > 1`.

@@ -12,10 +12,21 @@
 #include "core/errors.hpp"
 #include "core/newton.hpp"
 #include "core/periodic_orbit.hpp"
+#include "problems/contact_bar/bench_peers.hpp"
 #include "problems/contact_bar/family.hpp"
 #include "problems/contact_bar/scene.hpp"
 
 namespace backbone::contact_bar::bench {
+
+core::Scene read_paper_scene(const continuation::ProblemPlugin& plugin,
+                             const std::vector<std::string>& args) {
+  namespace po = boost::program_options;
+  po::options_description keys = plugin.scene_keys();
+  keys.add(continuation::continuation_keys(keys));
+  const std::filesystem::path paper =
+      contact_bar_peers_folder().parent_path() / "scenes" / "paper.ini";
+  return core::read_scene(keys, paper.string(), args, po::options_description());
+}
 
 PaperMode1 paper_mode1() {
   PaperMode1 m;

@@ -31,6 +31,12 @@ struct PaperMode1 {
 };
 PaperMode1 paper_mode1();
 
+// The paper scene (problems/contact_bar/scenes/paper.ini, found wherever the binary runs) read
+// with the plugin's keys and the continuation keys, as `backbone trace` reads it, with `args`
+// ("--key", "value", ...) on top. Throws InputError for a bad key or value.
+core::Scene read_paper_scene(const continuation::ProblemPlugin& plugin,
+                             const std::vector<std::string>& args);
+
 // The median (NaN for none): the middle value, or the mean of the two middle ones.
 double median(std::vector<double> values);
 
