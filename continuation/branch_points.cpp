@@ -192,10 +192,11 @@ core::Vector factor_of(const ScaledProblem& problem) {
   return problem.scale().cwiseQuotient(problem.unit_scale());
 }
 
-// J of the problem (its current units) in the unit scale.
-core::Matrix jacobian_in_unit_scale(const ScaledProblem& problem, const core::Matrix& J) {
-  core::Matrix out = J * factor_of(problem).cwiseInverse().asDiagonal();
-  const core::Vector& rf = problem.residual_factor();
+// J in units of factor (relative to the unit scale) and residual factor rf, in the unit scale:
+// diag(rf) J diag(1 ./ factor).
+core::Matrix jacobian_in_unit_scale(const core::Matrix& J, const core::Vector& factor,
+                                    const core::Vector& rf) {
+  core::Matrix out = J * factor.cwiseInverse().asDiagonal();
   if (rf.size() > 0) out = rf.asDiagonal() * out;
   return out;
 }
@@ -229,7 +230,7 @@ class BranchPointDetector::Locator {
  private:
   core::Vector factor() const { return factor_of(problem_); }
   core::Matrix in_unit_scale(const core::Matrix& J) const {
-    return jacobian_in_unit_scale(problem_, J);
+    return jacobian_in_unit_scale(J, factor(), problem_.residual_factor());
   }
   // Singular values at most this count as zero (the rank report's threshold, verify()).
   double null_cutoff() const;
@@ -605,8 +606,7 @@ void BranchPointDetector::sample(Point p) {
   sample.z = p.z.cwiseProduct(f);
   sample.tangent = p.tangent.cwiseProduct(f).normalized();
   sample.s = p.arclength;
-  last_jacobian_ = p.jacobian * f.cwiseInverse().asDiagonal();
-  if (p.residual_factor.size() > 0) last_jacobian_ = p.residual_factor.asDiagonal() * last_jacobian_;
+  last_jacobian_ = jacobian_in_unit_scale(p.jacobian, f, p.residual_factor);
   // One scale for the whole branch (J may vanish at a branch point: a per-point norm would hide
   // it): the Frobenius norm of the first point's Jacobian.
   if (!(jacobian_scale_ > 0))

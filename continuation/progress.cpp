@@ -33,27 +33,31 @@ std::string duration(double seconds) {
   return fmt::format("{:.1f} h", seconds / 3600);
 }
 
+// " period 3.6 frequency 1.74 ...": each observable to ten digits.
+std::string observables_text(const core::Observables& observables) {
+  std::string text;
+  for (const auto& [key, value] : observables) text += fmt::format(" {} {:.10g}", key, value);
+  return text;
+}
+
 }  // namespace
 
 std::string point_line(const BranchPoint& p) {
-  std::string observables;
-  for (const auto& [key, value] : p.observables)
-    observables += fmt::format(" {} {:.10g}", key, value);
+  const std::string observables = observables_text(p.observables);
   return fmt::format("point {:4d}{}  dim {}  |F| {:.1e}  newton {}  ds {:.3g}  {:.3f} s", p.index,
                      observables, p.dimension, p.residual, p.newton_iterations, p.step_size,
                      p.seconds);
 }
 
 std::string branch_point_line(const BranchPointReport& r) {
-  std::string observables;
-  for (const auto& [key, value] : r.observables)
-    observables += fmt::format(" {} {:.10g}", key, value);
+  const std::string observables = observables_text(r.observables);
   std::string verdict =
       r.verified() ? fmt::format("verified, attached dimension {} (nullity {})",
                                  r.attached_dimension, r.nullity)
                    : fmt::format("not verified (nullity {})", r.nullity);
-  for (const auto& [key, value] : r.attached_description)
-    if (r.verified()) verdict += fmt::format(" {} {:.6g}", key, value);
+  if (r.verified())
+    for (const auto& [key, value] : r.attached_description)
+      verdict += fmt::format(" {} {:.6g}", key, value);
   return fmt::format("branch point after point {}:{}  {}  {} Jacobians  {:.3f} s", r.after_point,
                      observables, verdict, r.jacobian_evaluations, r.seconds);
 }
