@@ -187,11 +187,6 @@ struct BranchPointDetector::Evaluation {
 
 namespace {
 
-// The loop's units relative to the unit scale (ScaledProblem::scale() ./ unit_scale()).
-core::Vector factor_of(const ScaledProblem& problem) {
-  return problem.scale().cwiseQuotient(problem.unit_scale());
-}
-
 // J in units of factor (relative to the unit scale) and residual factor rf, in the unit scale:
 // diag(rf) J diag(1 ./ factor).
 core::Matrix jacobian_in_unit_scale(const core::Matrix& J, const core::Vector& factor,
@@ -228,7 +223,8 @@ class BranchPointDetector::Locator {
   void run(Job job, std::vector<BranchPointReport>& found);
 
  private:
-  core::Vector factor() const { return factor_of(problem_); }
+  // The view's units relative to the unit scale (ScaledProblem::scale() ./ unit_scale()).
+  core::Vector factor() const { return problem_.scale().cwiseQuotient(problem_.unit_scale()); }
   core::Matrix in_unit_scale(const core::Matrix& J) const {
     return jacobian_in_unit_scale(J, factor(), problem_.residual_factor());
   }
