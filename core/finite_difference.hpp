@@ -10,7 +10,7 @@
 // the same operations whatever the thread count, so J is bit-identical to one thread's.
 // The default Jacobian of every Problem (Problem::compute_jacobian) uses
 // default_jacobian_threads(), a process-wide execution setting like Eigen::setNbThreads (the
-// `threads` key of a trace sets it for the run, continuation/scene_options.hpp).
+// `threads` key of a trace sets it for the run, continuation/cli/scene_options.hpp).
 //
 //   FiniteDifferenceOptions fd; fd.scheme = FiniteDifferenceOptions::Scheme::central;
 //   Matrix J;

@@ -1,8 +1,8 @@
 // `backbone bench [--problem NAME] [--case NAME] [--out DIR] [--threads K]`: the benchmarks of
-// every problem plugin (ProblemPlugin::bench_cases, continuation/plugin.hpp), not tests. Each
+// every problem plugin (ProblemPlugin::bench_cases, continuation/cli/plugin.hpp), not tests. Each
 // case writes its CSV tables, PNG figures and its markdown section into DIR (default
 // results/bench) and prints its table; DIR/BENCHMARKS.md is then rebuilt from the sections of
-// every case (continuation/bench_report.hpp). --threads K sets the finite-difference Jacobian
+// every case (continuation/cli/bench_report.hpp). --threads K sets the finite-difference Jacobian
 // threads of the cases that run continuation (core::set_default_jacobian_threads).
 //
 //   backbone bench                                  # every case of every problem
@@ -14,7 +14,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "continuation/bench_report.hpp"
+#include "continuation/cli/bench_report.hpp"
 #include "core/errors.hpp"
 #include "core/finite_difference.hpp"
 #include "core/scene.hpp"
@@ -58,7 +58,7 @@ int run_bench(const std::vector<std::string>& args) {
   if (!problem.empty() && !plugins().find(problem))
     throw core::InputError("problem",
                            fmt::format("must be one of {} (got '{}')", plugins().names(), problem));
-  std::vector<const continuation::ProblemJob*> jobs;
+  std::vector<const cli::ProblemJob*> jobs;
   for (const auto& plugin : plugins().all())
     for (const auto& c : plugin.bench_cases)
       if ((problem.empty() || plugin.name == problem) && (selected.empty() || c.name == selected))
@@ -71,7 +71,7 @@ int run_bench(const std::vector<std::string>& args) {
       std::clamp<long>(vm["threads"].as<long>(), 0, core::max_jacobian_threads + 1)));
   const std::filesystem::path out = vm["out"].as<std::string>();
   int status = core::exit_ok;
-  for (const continuation::ProblemJob* job : jobs) {
+  for (const cli::ProblemJob* job : jobs) {
     const auto start = std::chrono::steady_clock::now();
     status = std::max(status, job->run(out));
     fmt::print("bench {}: {:.1f} s\n\n", job->name,
@@ -80,14 +80,19 @@ int run_bench(const std::vector<std::string>& args) {
   std::vector<std::pair<std::string, std::string>> all_cases;
   for (const auto& plugin : plugins().all())
     for (const auto& c : plugin.bench_cases) all_cases.emplace_back(c.name, c.summary);
-  fmt::print("wrote {}\n", continuation::write_bench_report(out, all_cases).string());
+  fmt::print("wrote {}\n", cli::write_bench_report(out, all_cases).string());
   return status;
 }
 
 }  // namespace
 }  // namespace backbone::drivers
 
-static const bool registered = backbone::drivers::register_command(
-    {"bench", "[--problem NAME] [--case NAME] [--out DIR] [--threads K]",
+namespace backbone::drivers {
+
+Command bench_command() {
+  return {"bench", "[--problem NAME] [--case NAME] [--out DIR] [--threads K]",
      "benchmarks with known answers (CSV, PNG and BENCHMARKS.md in results/bench)",
-     backbone::drivers::run_bench});
+     run_bench};
+}
+
+}  // namespace backbone::drivers

@@ -1,15 +1,13 @@
-// Subcommands of the backbone CLI register themselves here.
+// The subcommands of a backbone CLI, each a function from its arguments (the words after the
+// subcommand name) to an exit code, one file each (trace.cpp, simulate.cpp, ...).
 //
-// A subcommand is a function from its arguments (the words after the subcommand name) to an
-// exit code. main() looks the name up, runs it, and maps exceptions: core::InputError -> one
-// line on stderr and exit 2; any other exception -> exit 1. A command returns 1 for a numerical
-// failure it reports itself (branch ended early, Newton failed).
+// drivers::main (main.hpp) looks the name up in commands(), runs it, and maps exceptions:
+// core::InputError -> one line on stderr and exit 2; any other exception -> exit 1. A command
+// returns 1 for a numerical failure it reports itself (branch ended early, Newton failed).
 //
-//   // drivers/simulate.cpp
-//   namespace { int run_simulate(const std::vector<std::string>& args) { ...; return 0; } }
-//   static const bool registered = backbone::drivers::register_command(
-//       {"simulate", "SCENE [--method tdbem|fem|exact] [--out DIR]", "time simulation",
-//       run_simulate});
+//   // drivers/version.cpp
+//   Command version_command() { return {"version", "", "print the version", run_version}; }
+//   // commands.cpp lists it: the table is explicit, so a static library keeps every command.
 #pragma once
 
 #include <functional>
@@ -26,7 +24,15 @@ struct Command {
   std::function<int(const std::vector<std::string>&)> run;
 };
 
-bool register_command(Command command);
+Command bench_command();
+Command figures_command();
+Command inspect_command();
+Command reproduce_command();
+Command simulate_command();
+Command trace_command();
+Command version_command();
+
+// Every subcommand above, by name.
 const std::map<std::string, Command>& commands();
 
 }  // namespace backbone::drivers

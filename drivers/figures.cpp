@@ -1,5 +1,5 @@
 // `backbone figures [--out DIR]`: the figures of every problem plugin
-// (ProblemPlugin::figures, continuation/plugin.hpp), drawn from the branches traced into DIR
+// (ProblemPlugin::figures, continuation/cli/plugin.hpp), drawn from the branches traced into DIR
 // (the contact bar: the paper's Figs. 4-7 from DIR/mode1 and DIR/mode2, and
 // closed_form_summary.csv).
 #include <fmt/format.h>
@@ -43,6 +43,11 @@ int run_figures(const std::vector<std::string>& args) {
 }  // namespace
 }  // namespace backbone::drivers
 
-static const bool registered = backbone::drivers::register_command(
-    {"figures", "[--out DIR]", "draw every problem's figures from the branches traced into DIR",
-     backbone::drivers::run_figures});
+namespace backbone::drivers {
+
+Command figures_command() {
+  return {"figures", "[--out DIR]", "draw every problem's figures from the branches traced into DIR",
+     run_figures};
+}
+
+}  // namespace backbone::drivers

@@ -1,4 +1,6 @@
-// backbone: nonlinear modes by shooting and continuation. Dispatches to a subcommand.
+// drivers::main (main.hpp): dispatches to a subcommand, maps exceptions to exit codes.
+#include "drivers/main.hpp"
+
 #include <fmt/format.h>
 
 #include <exception>
@@ -9,14 +11,11 @@
 
 #include "core/errors.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/plugins.hpp"
 
 namespace backbone::drivers {
 
 namespace {
-std::map<std::string, Command>& registry() {
-  static std::map<std::string, Command> table;
-  return table;
-}
 
 // glibc serves every block above 128 KiB by its own mmap and returns it on free, so each dense
 // Jacobian, QR or bordered system of a fine grid (6.5 MB at N = 640) is faulted in page by
@@ -37,27 +36,27 @@ void print_usage() {
 }
 }  // namespace
 
-bool register_command(Command command) {
-  std::string name = command.name;
-  return registry().emplace(name, std::move(command)).second;
-}
-
 const std::map<std::string, Command>& commands() {
-  return registry();
+  static const std::map<std::string, Command> table = [] {
+    std::map<std::string, Command> t;
+    for (Command c : {bench_command(), figures_command(), inspect_command(), reproduce_command(),
+                      simulate_command(), trace_command(), version_command()})
+      t.emplace(c.name, std::move(c));
+    return t;
+  }();
+  return table;
 }
 
-}  // namespace backbone::drivers
-
-int main(int argc, char** argv) {
-  using namespace backbone;
-  drivers::keep_large_blocks();
+int main(int argc, char** argv, RegisterPlugins register_plugins) {
+  set_plugin_registration(register_plugins);
+  keep_large_blocks();
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
-    drivers::print_usage();
+    print_usage();
     return argc < 2 ? core::exit_bad_input : core::exit_ok;
   }
   const std::string name = argv[1];
-  auto it = drivers::commands().find(name);
-  if (it == drivers::commands().end()) {
+  auto it = commands().find(name);
+  if (it == commands().end()) {
     fmt::print(stderr, "backbone: unknown command '{}' (try 'backbone --help')\n", name);
     return core::exit_bad_input;
   }
@@ -75,3 +74,5 @@ int main(int argc, char** argv) {
     return core::exit_numerical_failure;
   }
 }
+
+}  // namespace backbone::drivers

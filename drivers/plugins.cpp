@@ -1,4 +1,4 @@
-// The registry of problem plugins, filled once by the generated register_all().
+// The registry of problem plugins, filled once by the executable's registration function.
 #include "drivers/plugins.hpp"
 
 #include <fmt/format.h>
@@ -8,19 +8,27 @@
 
 namespace backbone::drivers {
 
-const continuation::PluginRegistry& plugins() {
-  static const continuation::PluginRegistry registry = [] {
-    continuation::PluginRegistry r;
-    register_all(r);
+namespace {
+void (*registration)(cli::PluginRegistry&) = nullptr;
+}  // namespace
+
+void set_plugin_registration(void (*register_plugins)(cli::PluginRegistry&)) {
+  registration = register_plugins;
+}
+
+const cli::PluginRegistry& plugins() {
+  static const cli::PluginRegistry registry = [] {
+    cli::PluginRegistry r;
+    if (registration) registration(r);
     return r;
   }();
   return registry;
 }
 
-const continuation::ProblemPlugin& plugin_for_scene(const std::string& scene_path,
+const cli::ProblemPlugin& plugin_for_scene(const std::string& scene_path,
                                                     const std::string& what) {
   const std::string name = core::scene_problem_name(scene_path);
-  const auto can = [&](const continuation::ProblemPlugin& p) {
+  const auto can = [&](const cli::ProblemPlugin& p) {
     return what == "simulate" ? p.can_simulate() : p.can_trace();
   };
   const std::string known = plugins().names(can);
@@ -28,7 +36,7 @@ const continuation::ProblemPlugin& plugin_for_scene(const std::string& scene_pat
     throw core::InputError("problem", fmt::format("the scene {} names no problem: add "
                                                   "'problem = NAME' (known: {})",
                                                   scene_path, known));
-  const continuation::ProblemPlugin* plugin = plugins().find(name);
+  const cli::ProblemPlugin* plugin = plugins().find(name);
   if (!plugin || !can(*plugin))
     throw core::InputError("problem",
                            fmt::format("'{}' cannot {} (known: {})", name,

@@ -1,5 +1,5 @@
 // `backbone reproduce`: the main job. Runs every study whose figures and tables belong in
-// results/ (each plugin's ProblemPlugin::reproduce steps, continuation/plugin.hpp), by calling
+// results/ (each plugin's ProblemPlugin::reproduce steps, continuation/cli/plugin.hpp), by calling
 // the other subcommands exactly as a user would, and writes a summary
 // of what ran, how long it took and whether it succeeded (results/reproduce.csv).
 #include <fmt/format.h>
@@ -20,7 +20,7 @@ namespace {
 namespace po = boost::program_options;
 using backbone::drivers::commands;
 
-using backbone::continuation::ReproduceStep;
+using backbone::cli::ReproduceStep;
 
 // Every plugin's steps, "{out}" replaced; figures and benchmarks after the rest.
 std::vector<ReproduceStep> plan(const std::string& out, bool quick) {
@@ -110,6 +110,11 @@ int run_reproduce(const std::vector<std::string>& args) {
 
 }  // namespace
 
-static const bool registered = backbone::drivers::register_command(
-    {"reproduce", "[--out DIR] [--quick] [--only STEP]",
-     "reproduce every figure and table into results/", run_reproduce});
+namespace backbone::drivers {
+
+Command reproduce_command() {
+  return {"reproduce", "[--out DIR] [--quick] [--only STEP]",
+     "reproduce every figure and table into results/", run_reproduce};
+}
+
+}  // namespace backbone::drivers

@@ -1,5 +1,5 @@
 // `backbone simulate SCENE [--out DIR] [--key value ...]`: a time simulation of a scene, by the
-// problem its `problem` key names (continuation/plugin.hpp: ProblemPlugin::simulate). The
+// problem its `problem` key names (continuation/cli/plugin.hpp: ProblemPlugin::simulate). The
 // contact bar's keys (--method tdbem|fem|exact|all, --periods P, --compare) are described by
 // `backbone simulate SCENE --help`. The problem validates everything and runs before it
 // creates DIR: bad input writes nothing (exit 2), a numerical failure writes nothing (exit 1).
@@ -43,7 +43,7 @@ int run_simulate(const std::vector<std::string>& args) {
     throw core::InputError("scene", "the first argument must be the scene file (SCENE)");
   }
   const std::string scene_path = args[0];
-  const continuation::ProblemPlugin& plugin = plugin_for_scene(scene_path, "simulate");
+  const cli::ProblemPlugin& plugin = plugin_for_scene(scene_path, "simulate");
   if (help) {
     std::ostringstream keys;
     keys << driver_keys() << "\n" << plugin.simulate_keys();
@@ -62,8 +62,9 @@ int run_simulate(const std::vector<std::string>& args) {
 
 }  // namespace
 
-static const bool registered =
-    register_command({"simulate", usage,
-                      "time simulation of a scene (contact bar: tdbem, fem, exact)", run_simulate});
+Command simulate_command() {
+  return {"simulate", usage, "time simulation of a scene (contact bar: tdbem, fem, exact)",
+          run_simulate};
+}
 
 }  // namespace backbone::drivers

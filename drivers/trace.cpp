@@ -2,7 +2,7 @@
 // solutions (a nonlinear mode) by continuation and writes DIR/branch.csv, DIR/orbits.csv,
 // DIR/unknowns.csv, DIR/state.txt (the restart format), DIR/branch.png and DIR/summary.txt.
 //
-// The scene's `problem` key picks a plugin (continuation/plugin.hpp); its setup builds the
+// The scene's `problem` key picks a plugin (continuation/cli/plugin.hpp); its setup builds the
 // problem and the guess. Continuation settings are scene keys too (continuation/
 // scene_options.hpp; defaults < scene file < command line). Bad input throws core::InputError
 // before anything is written (exit 2). A branch that ends early keeps and writes its points
@@ -16,10 +16,10 @@
 #include <sstream>
 
 #include "continuation/outputs.hpp"
-#include "continuation/progress.hpp"
+#include "continuation/cli/progress.hpp"
 #include "continuation/restart.hpp"
-#include "continuation/scene_options.hpp"
-#include "continuation/stop_signals.hpp"
+#include "continuation/cli/scene_options.hpp"
+#include "continuation/cli/stop_signals.hpp"
 #include "core/errors.hpp"
 #include "core/output_folder.hpp"
 #include "core/periodic_orbit.hpp"
@@ -49,7 +49,7 @@ po::options_description driver_keys() {
   return keys;
 }
 
-void print_help(const cont::ProblemPlugin* problem) {
+void print_help(const cli::ProblemPlugin* problem) {
   fmt::print(
       "usage: backbone trace SCENE [--branch NAME] [--out DIR] [--start DIR:K] [--key value ...]\n"
       "       backbone trace --resume DIR [--key value ...]   (continue an interrupted run)\n\n");
@@ -61,9 +61,9 @@ void print_help(const cont::ProblemPlugin* problem) {
   text << "\n" << driver_keys() << "\n";
   if (problem) {
     const po::options_description keys = problem->scene_keys();
-    text << keys << "\n" << cont::continuation_keys(keys);
+    text << keys << "\n" << cli::continuation_keys(keys);
   } else {
-    text << cont::continuation_keys(po::options_description())
+    text << cli::continuation_keys(po::options_description())
          << "\n(defaults of a problem's own keys: backbone trace SCENE --help)\n";
   }
   fmt::print("{}\n", text.str());
@@ -90,7 +90,7 @@ int run_trace(const std::vector<std::string>& args_in) {
                 {(resume / "scene.ini").string(), "--branch", branch, "--out", resume.string()});
   }
   const std::string scene_path = args[0];
-  const cont::ProblemPlugin& entry = plugin_for_scene(scene_path, "trace");
+  const cli::ProblemPlugin& entry = plugin_for_scene(scene_path, "trace");
   const std::vector<std::string> rest(args.begin() + 1, args.end());
   if (std::find_if(rest.begin(), rest.end(),
                    [](const std::string& a) { return a == "--help" || a == "-h"; }) != rest.end()) {
@@ -99,7 +99,7 @@ int run_trace(const std::vector<std::string>& args_in) {
   }
 
   po::options_description keys = entry.scene_keys();
-  keys.add(cont::continuation_keys(keys));
+  keys.add(cli::continuation_keys(keys));
   const core::Scene scene = core::read_scene(keys, scene_path, rest, driver_keys());
   const std::string branch_name = scene.has("branch") ? scene.text("branch") : entry.branches.at(0);
   if (std::find(entry.branches.begin(), entry.branches.end(), branch_name) == entry.branches.end())
@@ -109,13 +109,13 @@ int run_trace(const std::vector<std::string>& args_in) {
   const std::filesystem::path out =
       scene.has("out") ? scene.text("out") : fmt::format("out/{}_{}", entry.name, branch_name);
   core::check_output_folder("out", out);
-  cont::RunSettings run = cont::read_run_settings(scene);
+  cli::RunSettings run = cli::read_run_settings(scene);
   cont::ContinuationOptions& options = run.options;
   const long start_direction = scene.integer("direction", -1);
   if (start_direction != 1 && start_direction != -1)
     throw core::InputError("direction", fmt::format("must be 1 or -1 (got {})", start_direction));
 
-  cont::TraceSetup setup = entry.setup(scene, branch_name);
+  cli::TraceSetup setup = entry.setup(scene, branch_name);
   if (!setup.problem) throw core::InputError("problem", "setup returned no problem");
   const core::Problem& problem = *setup.problem;
   setup.apply_branch_options(options, run.newton_options);
@@ -189,9 +189,9 @@ int run_trace(const std::vector<std::string>& args_in) {
   core::write_text_atomically(out / "summary.txt", summary("running", nullptr, 0, -1));
 
   // SIGINT / SIGTERM: stop before the next step (the point is finished and written, then the
-  // summary); a second one stops at once (continuation/stop_signals.hpp).
-  std::optional<cont::StopSignals> stop(std::in_place);
-  cont::ProgressLine progress(options);
+  // summary); a second one stops at once (continuation/cli/stop_signals.hpp).
+  std::optional<cli::StopSignals> stop(std::in_place);
+  cli::ProgressLine progress(options);
   cont::ContinuationHooks hooks;
   hooks.cancel_requested = [&] { return stop->requested(); };
   hooks.on_point = [&](const cont::BranchPoint& p_in) {
@@ -202,7 +202,7 @@ int run_trace(const std::vector<std::string>& args_in) {
       fmt::print(stderr, "backbone trace: point {}: {}\n", p.index, cont::dimension_warning(p));
     dimension_flags[static_cast<int>(p.dimension_flag)] += 1;
     progress.finish();  // the point's line replaces the progress line, which follows it
-    fmt::print("  {}{}\n", cont::point_line(p),
+    fmt::print("  {}{}\n", cli::point_line(p),
                setup.describe_point ? "  " + setup.describe_point(p) : "");
     std::fflush(stdout);
     progress.update(p);
@@ -214,7 +214,7 @@ int run_trace(const std::vector<std::string>& args_in) {
   // that holds them; continuation/README.md, 'Branch points'), between the point lines.
   hooks.on_branch_point = [&](const cont::BranchPointReport& r) {
     progress.finish();
-    fmt::print("  {}\n", cont::branch_point_line(r));
+    fmt::print("  {}\n", cli::branch_point_line(r));
     std::fflush(stdout);
   };
   hooks.on_attempt = [&](const cont::StepAttempt& a) {
@@ -223,7 +223,7 @@ int run_trace(const std::vector<std::string>& args_in) {
     fmt::print("  point {:4d}  rejected at ds {:.3g}: {}\n", a.point, a.ds, a.rejection);
   };
 
-  cont::SwitchingBranch result = cont::run_continuation(
+  cont::SwitchingBranch result = cli::run_continuation(
       problem, setup.guess, direction, run, *corrector, hooks, restart ? &*restart : nullptr);
   const int stop_signal = stop->signal();
   stop.reset();  // the default actions again
@@ -276,7 +276,12 @@ int run_trace(const std::vector<std::string>& args_in) {
 }  // namespace
 }  // namespace backbone::drivers
 
-static const bool registered = backbone::drivers::register_command(
-    {"trace", "SCENE [--branch NAME] [--out DIR] [--key value ...]",
+namespace backbone::drivers {
+
+Command trace_command() {
+  return {"trace", "SCENE [--branch NAME] [--out DIR] [--key value ...]",
      "follow a nonlinear mode (branch of periodic orbits) by continuation",
-     backbone::drivers::run_trace});
+     run_trace};
+}
+
+}  // namespace backbone::drivers

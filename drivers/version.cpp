@@ -16,5 +16,10 @@ int run_version(const std::vector<std::string>&) {
 }
 }  // namespace
 
-static const bool registered = backbone::drivers::register_command(
-    {"version", "", "print the version and library versions", run_version});
+namespace backbone::drivers {
+
+Command version_command() {
+  return {"version", "", "print the version and library versions", run_version};
+}
+
+}  // namespace backbone::drivers

@@ -19,7 +19,7 @@
 #include "core/errors.hpp"
 #include "core/scene.hpp"
 #include "core/table.hpp"
-#include "problems/contact_bar/scene.hpp"
+#include "problems/contact_bar/solver/scene.hpp"
 
 namespace {
 

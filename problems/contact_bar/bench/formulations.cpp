@@ -1,0 +1,357 @@
+// Benchmark formulations (bench.hpp): the paper's shooting residual f = u0 - u(T) against the
+// regular half-period velocity residual (problems/contact_bar/README.md), on the same exact
+// orbits of the contact family.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "continuation/natural.hpp"
+#include "core/finite_difference.hpp"
+#include "core/newton.hpp"
+#include "core/periodic_orbit.hpp"
+#include "core/plot.hpp"
+#include "core/rank_report.hpp"
+#include "core/table.hpp"
+#include "problems/contact_bar/bench/cases.hpp"
+#include "problems/contact_bar/bench/metrics.hpp"
+#include "problems/contact_bar/bench/support.hpp"
+#include "problems/contact_bar/orbits/family.hpp"
+#include "problems/contact_bar/orbits/periodic_bar.hpp"
+#include "problems/contact_bar/solver/tdbem.hpp"
+#include "problems/exact_bar/exact_bar_solver.hpp"
+
+namespace backbone::contact_bar {
+
+namespace {
+
+const double nan = std::numeric_limits<double>::quiet_NaN();
+
+// End amplitudes (ratio * g0) along each branch, from grazing to E ~ 1e-2 J, the top of the
+// traced range: mode 1 E = (ratio g0)^2 / 2 (5e-3 J at 100), mode 2 E = ((2 ratio + 1) g0)^2 / 2
+// (9.9e-3 J at 70).
+struct FormulationBranch {
+  int mode;
+  std::vector<double> ratios;
+};
+const std::vector<FormulationBranch> formulation_branches{{1, {1.05, 2, 10, 100}},
+                                                          {2, {1.05, 2, 10, 70}}};
+const std::vector<std::pair<std::string, core::ShootingFormulation>> formulation_names{
+    {"regular", core::ShootingFormulation::half_period_velocity},
+    {"paper", core::ShootingFormulation::displacement_periodicity}};
+// The start of both formulations: x* plus start_u0_perturbation g0 sin(3 i) on u0 entry i
+// (a fixed pattern, alternating from node to node) and start_period_perturbation relative on T;
+// the knot stays. 1e-3 g0, not 1e-2: the pattern's strain, 2 * 1e-2 g0 / dx = 0.4 g0 / L, is
+// 40% of the grazing strain g0 / L, and from there both formulations leave the family at
+// A = 1.05 g0 (measured: u0 2% to 7% off x*, the paper's onto a T = 4L/c orbit without contact).
+const double start_u0_perturbation = 1e-3, start_period_perturbation = 1e-3;
+const double formulation_tolerance_metres = 1e-13;  // Newton: ||F||_inf in metres
+const int formulation_max_iterations = 30;
+// The trace's contact-bar settings (problems/contact_bar/README.md, shooting keys): residual
+// sampled on 2x as many test functions as unknowns, rank threshold 1e-5 relative.
+constexpr int formulation_oversampling = 2;
+constexpr double formulation_rank_threshold = 1e-5;
+
+// Newton on [F; E - E*] (energy fixed: both formulations aim at x* itself), one iteration per
+// solve() so that every iterate is measured. The eigen corrector keeps no state between calls
+// and applies the same tests after each iteration, so the iterates are those of one solve().
+struct NewtonTrace {
+  core::NewtonStatus status = core::NewtonStatus::max_iterations;
+  int iterations = 0;
+  std::vector<double> shooting_residual;  // ||F||_inf [m] at the start and after each iteration
+  std::vector<double> energy_error;       // |E - E*| [J]
+  std::vector<double> u0_error;           // relative_u0_distance to x*
+  double seconds = 0;
+};
+
+NewtonTrace trace_newton(const ContactBarOrbitProblem& problem, const core::Vector& exact,
+                         double unit, core::Vector& x) {
+  const double energy = problem.energy(exact);
+  const continuation::ParameterConstraintSystem system(
+      problem, continuation::NaturalParameter::of_observable("energy"), energy);
+  core::NewtonOptions options;
+  options.residual_tolerance = formulation_tolerance_metres / unit;  // problem's units
+  options.max_iterations = 1;
+  const auto newton = core::make_corrector("eigen", options);
+  NewtonTrace trace;
+  auto record = [&] {
+    core::Vector r;
+    trace.shooting_residual.push_back(
+        problem.residual(x, r) == core::EvalStatus::ok ? unit * r.lpNorm<Eigen::Infinity>() : nan);
+    trace.energy_error.push_back(std::abs(problem.energy(x) - energy));
+    trace.u0_error.push_back(relative_u0_distance(problem, x, exact));
+  };
+  record();
+  trace.seconds = bench::seconds_of([&] {
+    while (trace.iterations < formulation_max_iterations) {
+      const core::NewtonSummary s = newton->solve(system, x);
+      if (s.iterations == 0) {  // already converged at the start
+        trace.status = s.status;
+        return;
+      }
+      ++trace.iterations;
+      record();
+      if (s.status != core::NewtonStatus::max_iterations) {
+        trace.status = s.status;
+        return;
+      }
+    }
+  });
+  return trace;
+}
+
+// Rank report of the shooting Jacobian (2N equations, N + 1 unknowns) as the continuation makes
+// it (continuation/point_recorder.cpp: the problem's forward-difference Jacobian, relative
+// threshold 1e-8, candidate null directions verified by re-correction), and the same with an
+// absolute floor at the measured uncertainty of that Jacobian, ||J_forward - J_central||_2
+// (Weyl: singular values below it cannot be told from zero), and the central-difference
+// Jacobian at the relative threshold (problems/contact_bar/README.md). At the
+// paper's double root the period column is that uncertain: v(., T) jumps at T, so one-sided
+// differences give -v(T+), central ones its mean, zero (rank_report.hpp on absolute_threshold).
+struct RankColumns {
+  core::RankReport relative, absolute, central;  // central: relative threshold, J_central
+  double period_column_forward = nan, period_column_central = nan, uncertainty = nan;
+  double sigma_min(int k) const {  // k-th smallest singular value, 1-based
+    const Eigen::Index m = relative.singular_values.size();
+    return m >= k ? relative.singular_values[m - k] : nan;
+  }
+  double central_sigma_min_relative() const {
+    const Eigen::Index m = central.singular_values.size();
+    return m > 0 ? central.singular_values[m - 1] / central.singular_values[0] : nan;
+  }
+};
+
+RankColumns rank_columns(const core::PeriodicOrbitProblem& problem, const core::Vector& x) {
+  RankColumns c;
+  core::Matrix forward, central;
+  core::FiniteDifferenceOptions central_differences;
+  central_differences.scheme = core::FiniteDifferenceOptions::Scheme::central;
+  if (problem.jacobian(x, forward) != core::EvalStatus::ok ||
+      core::finite_difference_jacobian(problem, x, central, central_differences) !=
+          core::EvalStatus::ok)
+    return c;
+  const int period = problem.period_index();
+  c.period_column_forward = forward.col(period).lpNorm<Eigen::Infinity>();
+  c.period_column_central = central.col(period).lpNorm<Eigen::Infinity>();
+  c.uncertainty = Eigen::JacobiSVD<core::Matrix>(forward - central).singularValues()[0];
+  // The continuation's verifier (continuation/point_recorder.cpp): default VerifyOptions.
+  const core::VerifyOptions verify;
+  const auto verifier = core::make_verifier(verify);
+  core::RankOptions absolute;
+  absolute.absolute_threshold = c.uncertainty;
+  core::RankOptions relative;
+  relative.relative_threshold = formulation_rank_threshold;
+  absolute.relative_threshold = formulation_rank_threshold;
+  c.relative = core::rank_report(forward, relative);
+  c.absolute = core::rank_report(forward, absolute);
+  c.central = core::rank_report(central, relative);
+  for (core::RankReport* report : {&c.relative, &c.absolute, &c.central})
+    core::verify_null_directions(problem, x, *verifier, verify, *report);
+  return c;
+}
+
+}  // namespace
+
+int bench_formulations(const std::filesystem::path& out) {
+  const double gap = 1e-3;
+  bar::BarSetup setup;  // paper scene: E = rho = L = A = 1 (c = 1)
+  setup.left = {bar::EndType::fixed, 0};
+  setup.right = {bar::EndType::contact, gap};
+  const TdbemSolver tdbem(ContactMethod::event);
+  const exact_bar::ExactBarSolver oracle;
+  fmt::print(
+      "bench formulations: regular (half-period velocity) vs paper (u0 - u(T)) shooting from "
+      "the same perturbed exact orbits\n  TD-BEM event contact, 20 elements, 40 steps per "
+      "period, residual on {}x as many test functions as unknowns (trace's default); Newton "
+      "(eigen) on [F; E - E*], ||F||_inf <= {:g} m, {} iterations\n",
+      formulation_oversampling, formulation_tolerance_metres, formulation_max_iterations);
+
+  // Columns by group: the orbit and the start; the Newton run; where it ended; rank reports.
+  std::vector<std::string> columns;
+  for (const std::vector<std::string>& group :
+       {std::vector<std::string>{"formulation", "status", "mode", "amplitude_ratio", "energy",
+                                 "exact_residual", "exact_sigma_min_relative", "exact_nullity",
+                                 "start_residual", "start_u0_error"},
+        {"iterations", "final_residual", "energy_error", "residual_order", "residual_ratio"},
+        {"u0_error", "error_order", "error_ratio", "period_error", "knot_error", "return_error_u",
+         "return_error_v"},
+        {"period_column_forward", "period_column_central", "jacobian_uncertainty"},
+        {"sigma_min_1", "sigma_min_2", "sigma_min_3", "sigma_max", "threshold", "nullity",
+         "verified"},
+        {"threshold_absolute", "nullity_absolute", "verified_absolute"},
+        {"central_sigma_min_relative", "nullity_central", "verified_central"},
+        {"residual_unit", "seconds"}})
+    columns.insert(columns.end(), group.begin(), group.end());
+  core::Table table(columns);
+  core::Table history({"mode", "amplitude_ratio", "formulation", "iteration", "residual",
+                       "energy_error", "u0_error"});
+  core::Table screen({"mode", "A/g0", "form", "status", "it", "|F| [m]", "order_F", "order_err",
+                      "u0_err", "T_err", "return_err", "smin/smax", "null/ver", "abs", "central",
+                      "x*: smin/smax"});
+  const auto counts = [](const core::RankReport& r) {
+    return fmt::format("{}/{}", r.nullity, r.verified_dimension);
+  };
+
+  for (const FormulationBranch& branch : formulation_branches) {
+    OrbitOptions options;
+    options.elements = 20;
+    options.steps_per_period = 40;
+    options.free_knots = branch.mode == 2 ? 1 : 0;  // mode 2: its crest is a free knot
+    options.test_elements = formulation_oversampling * (options.elements + options.free_knots);
+    ContactBarOrbitProblem problem(setup, tdbem, options);
+    const int period = problem.period_index();
+    const ContactFamily family(setup.material, gap, branch.mode);
+    for (double ratio : branch.ratios) {
+      const core::Vector exact = problem.contact_family_guess(branch.mode, ratio);
+      const double energy = problem.energy(exact);
+      const double unit = residual_unit(problem, exact);
+      core::Vector start = exact;
+      for (int i = 0; i < options.elements; ++i)
+        start[i] += start_u0_perturbation * gap * std::sin(3.0 * (i + 1));
+      start[period] *= 1 + start_period_perturbation;
+      double u_max = 0;
+      for (int i = 0; i < options.elements; ++i) u_max = std::max(u_max, std::abs(exact[i]));
+      // Round-off of a residual or error of size u_max after O(steps) operations.
+      const double eps = std::numeric_limits<double>::epsilon();
+      const double residual_floor = 100 * eps * u_max, error_floor = 100 * eps;
+
+      for (const auto& [label, formulation] : formulation_names) {
+        problem.set_formulation(formulation);
+        core::Vector r;
+        const double exact_residual = problem.residual(exact, r) == core::EvalStatus::ok
+                                          ? unit * r.lpNorm<Eigen::Infinity>()
+                                          : nan;
+        // The Jacobian at x* itself (no verification): is the orbit sought a regular root?
+        core::Matrix exact_jacobian;
+        core::RankReport at_exact;
+        if (problem.jacobian(exact, exact_jacobian) == core::EvalStatus::ok)
+          at_exact = core::rank_report(
+              exact_jacobian, core::RankOptions{.relative_threshold = formulation_rank_threshold});
+        const Eigen::Index m = at_exact.singular_values.size();
+        const double exact_sigma_min =
+            m > 0 ? at_exact.singular_values[m - 1] / at_exact.singular_values[0] : nan;
+
+        core::Vector x = start;
+        const NewtonTrace trace = trace_newton(problem, exact, unit, x);
+        const ObservedRate residual_rate = observed_rate(trace.shooting_residual, residual_floor);
+        const ObservedRate error_rate = observed_rate(trace.u0_error, error_floor);
+        const double final_energy = problem.energy(x);
+        const double closed_form_frequency = family.frequency(final_energy);
+        const double period_error =
+            std::abs(x[period] * closed_form_frequency / (2 * std::numbers::pi) - 1);
+        const double knot_error =
+            options.free_knots == 1 ? std::abs(x[options.elements] - exact[options.elements]) : nan;
+        const ReturnError returned = return_error(problem, x, oracle);
+        const RankColumns rank = rank_columns(problem, x);
+        const double sigma_max =
+            rank.relative.singular_values.size() ? rank.relative.singular_values[0] : nan;
+        const std::string status = core::to_string(trace.status);
+        table.add_cells({label,
+                         status,
+                         double(branch.mode),
+                         ratio,
+                         energy,
+                         exact_residual,
+                         exact_sigma_min,
+                         double(at_exact.nullity),
+                         trace.shooting_residual.front(),
+                         trace.u0_error.front(),
+                         double(trace.iterations),
+                         trace.shooting_residual.back(),
+                         trace.energy_error.back(),
+                         residual_rate.order,
+                         residual_rate.ratio,
+                         trace.u0_error.back(),
+                         error_rate.order,
+                         error_rate.ratio,
+                         period_error,
+                         knot_error,
+                         returned.displacement,
+                         returned.velocity,
+                         rank.period_column_forward,
+                         rank.period_column_central,
+                         rank.uncertainty,
+                         rank.sigma_min(1),
+                         rank.sigma_min(2),
+                         rank.sigma_min(3),
+                         sigma_max,
+                         rank.relative.threshold,
+                         double(rank.relative.nullity),
+                         double(rank.relative.verified_dimension),
+                         rank.absolute.threshold,
+                         double(rank.absolute.nullity),
+                         double(rank.absolute.verified_dimension),
+                         rank.central_sigma_min_relative(),
+                         double(rank.central.nullity),
+                         double(rank.central.verified_dimension),
+                         unit,
+                         trace.seconds});
+        for (std::size_t k = 0; k < trace.shooting_residual.size(); ++k)
+          history.add_cells({double(branch.mode), ratio, label, double(k),
+                             trace.shooting_residual[k], trace.energy_error[k], trace.u0_error[k]});
+        screen.add_cells({double(branch.mode), ratio, label, status, double(trace.iterations),
+                          trace.shooting_residual.back(), residual_rate.order, error_rate.order,
+                          trace.u0_error.back(), period_error, returned.worst(),
+                          rank.sigma_min(1) / sigma_max, counts(rank.relative),
+                          counts(rank.absolute), counts(rank.central), exact_sigma_min});
+      }
+    }
+  }
+  const std::filesystem::path csv = out / "formulations.csv";
+  const std::filesystem::path hcsv = out / "formulations_history.csv";
+  table.write_csv(csv);
+  history.write_csv(hcsv);
+  fmt::print("{}", screen.aligned());
+  fmt::print(
+      "  |F|: final ||F||_inf; order_F, order_err: median observed order of the residual and of "
+      "u0_err = max|u0 - u0*| / max|u0*| (2 quadratic, 1 linear);\n  T_err: |T / T_closed(E) - "
+      "1|; return_err: exact-oracle return error (relative); smin/smax: smallest singular value "
+      "of the forward-difference\n  shooting Jacobian at the final point; null/ver: nullity at "
+      "relative 1e-5 / verified dimension; abs: absolute floor ||J_fwd - J_cen||_2; central: "
+      "J_cen;\n  x*: smin/smax at the exact orbit\n");
+
+  // Residual and u0 error vs iteration: one column per mode, colour per amplitude, dash per
+  // formulation. The error is the comparable measure: the two residuals differ by definition.
+  const std::string q = core::gnuplot_quote(hcsv);
+  std::string panels;
+  for (const auto& [column, label] : {std::pair{5, "shooting residual ||F||_{/Symbol \\245}  [m]"},
+                                      std::pair{7, "u_0 error max|u_0 - u_0^*| / max|u_0^*|"}})
+    for (const FormulationBranch& branch : formulation_branches) {
+      panels += fmt::format("set title 'mode {}'\nset ylabel '{}'\nplot ", branch.mode, label);
+      for (std::size_t k = 0; k < branch.ratios.size(); ++k)
+        for (std::size_t f = 0; f < formulation_names.size(); ++f)
+          panels += fmt::format(
+              "{}{} using (($1 == {} && abs($2 - {:.17g}) < 1e-9 && strcol(3) eq '{}') ? $4 "
+              ": NaN):(${} > 0 ? ${} : NaN) with linespoints lc {} dt {} pt {} title '{}, A = "
+              "{:g} g_0'",
+              k + f ? ", " : "", q, branch.mode, branch.ratios[k], formulation_names[f].first,
+              column, column, k + 1, f + 1, f ? 6 : 7, formulation_names[f].first,
+              branch.ratios[k]);
+      if (column == 5)
+        panels += fmt::format(", {:g} title 'tolerance' dt 2 lw 2 lc rgb 'black'",
+                              formulation_tolerance_metres);
+      panels += "\n";
+    }
+  const std::filesystem::path png = out / "formulations.png";
+  bench::report_plot(
+      core::render_png(png,
+                       fmt::format("set multiplot layout 2,2 title 'Newton from the same "
+                                   "perturbed exact orbit at fixed energy: regular "
+                                   "(solid) vs paper (dashed), g_0 = {:g} m'\nset "
+                                   "logscale y\nset grid\nset format y '10^{{%L}}'\n"
+                                   "set xlabel 'Newton iteration'\nset key outside right top "
+                                   "font ',8'\n",
+                                   gap) +
+                           panels + "unset multiplot\n",
+                       {1600, 1300}),
+      png);
+  return 0;
+}
+
+}  // namespace backbone::contact_bar

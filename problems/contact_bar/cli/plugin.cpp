@@ -1,0 +1,66 @@
+// The contact bar in the `backbone` CLI (continuation/cli/plugin.hpp): its trace branches and
+// simulation (trace.hpp), its benchmarks (bench/), its figures (figures/) and its steps of the
+// main job, `backbone reproduce`.
+#include "continuation/cli/plugin.hpp"
+
+#include <string>
+
+#include "problems/contact_bar/bench/cases.hpp"
+#include "problems/contact_bar/bench/peers.hpp"
+#include "problems/contact_bar/cli/trace.hpp"
+#include "problems/contact_bar/figures/modes.hpp"
+#include "problems/contact_bar/figures/resonance.hpp"
+
+namespace backbone::contact_bar {
+
+void register_plugin(cli::PluginRegistry& registry) {
+  cli::ProblemPlugin p = trace_plugin();
+  p.bench_cases = bench_cases();
+  for (cli::ProblemJob& job : peer_bench_cases()) p.bench_cases.push_back(std::move(job));
+  p.figures = figure_jobs();
+  for (cli::ProblemJob& job : resonance_figure_jobs()) p.figures.push_back(std::move(job));
+  const std::string scenes = "problems/contact_bar/scenes/";
+  p.reproduce = {
+      {"bouncing_bar",
+       "simulate",
+       {scenes + "bouncing_bar.ini", "--compare", "--periods", "2", "--out", "{out}/bouncing_bar"}},
+      {"mode1_orbit",
+       "simulate",
+       {scenes + "paper.ini", "--compare", "--periods", "1", "--out", "{out}/mode1_orbit"}},
+      {"mode1", "trace", {scenes + "paper.ini", "--branch", "mode1", "--out", "{out}/mode1"}},
+      {"mode2", "trace", {scenes + "paper.ini", "--branch", "mode2", "--out", "{out}/mode2"}},
+      {"mode1_resonances",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40", "--energy_max",
+        "3e-5", "--follow", "all", "--follow_max_points", "100", "--out",
+        "{out}/mode1_resonances"}},
+      {"subharmonic",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic", "--out", "{out}/subharmonic"}},
+      // The continuum at two energies, from the grazing limit shape 1 to shape_end (about one
+      // second each; README.md, section 'Subharmonic continuum').
+      {"subharmonic_continuum",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1.25e-5", "--out",
+        "{out}/subharmonic_continuum"}},
+      {"subharmonic_continuum_1e-3",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1e-3", "--out",
+        "{out}/subharmonic_continuum_1e-3"}},
+      // Other scenes, nothing but the bar changed: the closed forms must hold there too.
+      {"mode1_short_bar",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode1", "--length", "0.3", "--youngs_modulus", "7e4",
+        "--density", "2.7", "--gap", "1e-5", "--out", "{out}/mode1_short_bar"}},
+      {"mode2_steel_bar",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode2", "--length", "2.5", "--youngs_modulus", "2.1e11",
+        "--density", "7850", "--area", "3e-4", "--gap", "1e-4", "--energy_max", "1e3", "--out",
+        "{out}/mode2_steel_bar"}},
+      {"figures", "figures", {"--out", "{out}"}},
+      {"bench", "bench", {"--problem", "contact_bar", "--out", "{out}/bench"}},
+  };
+  registry.add(std::move(p));
+}
+
+}  // namespace backbone::contact_bar

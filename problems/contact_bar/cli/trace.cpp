@@ -1,0 +1,451 @@
+// The contact bar's trace branches (trace.hpp): mode1 and mode2
+// (the nonlinear modes born from the linear modes omega_k = (2k-1) pi c / (2L) at grazing),
+// subharmonic and subharmonic_continuum (mode 2 over two periods: a 2D manifold of orbits,
+// README.md section 'Subharmonic continuum'),
+// and `simulate` (simulate.hpp).
+//
+// The scene gives the bar (scene.hpp: length, youngs_modulus, density, area, gap, contact,
+// elements = the u0 grid); trace_keys add the shooting setup. The start is the grazing-side
+// orbit of the contact family (end amplitude (1 + start_offset) g0), not the sine of the
+// linear mode: at grazing every initial condition is 4L/c-periodic and a nodal Newton from the
+// sine lands on such a non-contact orbit (measured: T = 4L/c exactly). Mode 2 moves one knot
+// with the physics (free_knots = 1, the crest of the tent) because its kink travels with T and
+// a uniform grid holds it only to O(dx) (README.md, section "Shooting on the bar").
+//
+//   backbone trace problems/contact_bar/scenes/paper.ini --branch mode1 --out out/m1
+//   backbone trace problems/contact_bar/scenes/paper.ini --branch mode2 --free_knots 0
+#include "problems/contact_bar/cli/trace.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <functional>
+#include <memory>
+
+#include "core/errors.hpp"
+#include "core/table.hpp"
+#include "problems/contact_bar/orbits/attached_content.hpp"
+#include "problems/contact_bar/orbits/family.hpp"
+#include "problems/contact_bar/figures/modes.hpp"
+#include "problems/contact_bar/orbits/grazing_limits.hpp"
+#include "problems/contact_bar/orbits/manifold.hpp"
+#include "problems/contact_bar/orbits/periodic_bar.hpp"
+#include "problems/contact_bar/solver/scene.hpp"
+#include "problems/contact_bar/cli/simulate.hpp"
+#include "problems/contact_bar/orbits/subharmonic.hpp"
+#include "problems/contact_bar/solver/tdbem.hpp"
+#include "problems/exact_bar/exact_bar_solver.hpp"
+
+namespace backbone::contact_bar {
+
+namespace {
+
+namespace po = boost::program_options;
+
+po::options_description subharmonic_keys() {
+  po::options_description keys("subharmonic branches (subharmonic, subharmonic_continuum)");
+  keys.add_options()  //
+      ("energy", po::value<double>()->default_value(0),
+       "subharmonic_continuum: the energy of the members [J] (0: that of strain 5 g0 / L, "
+       "EA L (5 g0 / L)^2 / 2)")  //
+      ("shape", po::value<double>()->default_value(-1),
+       "subharmonic shape in [0, 1] (first contact phase / total contact time; 0 and 1 are "
+       "the grazing limits, 0.5 mode 2). subharmonic: the shape kept along the backbone "
+       "(-1: 0.3); subharmonic_continuum: the first member (-1: 1, a grazing limit)")  //
+      ("path_rows", po::value<bool>()->default_value(true),
+       "subharmonic branches: append the row that picks the path (shape or energy); false "
+       "leaves the periodicity residual F alone, whose solutions form a 2D manifold (for "
+       "`backbone inspect`: trace needs the row)")  //
+      ("dimension_check", po::value<bool>()->default_value(true),
+       "subharmonic branches: replace branch.csv's dimension (that of F plus the path rows) by "
+       "the verified dimension of the periodicity residual F alone at each point");
+  return keys;
+}
+
+po::options_description trace_keys() {
+  po::options_description keys = contact_bar::scene_keys();
+  po::options_description shooting("contact bar shooting");
+  shooting.add_options()  //
+      ("shooting_elements", po::value<long>()->default_value(20),
+       "intervals of the u0 grid (0: the scene's elements). 20 holds modes 1 and 2 exactly "
+       "(mode 2 with its free knot); at 100 mode 1 meets a continuum of other periodic orbits "
+       "at end amplitude 2 g0 and steps over it (max_turn_degrees; detect_branch_points "
+       "locates it), at ~100x the cost per point")  //
+      ("test_elements", po::value<long>()->default_value(-1),
+       "elements of the grid the residual is sampled on (its equations): 0 = as many as "
+       "unknowns (square), -1 = auto (2x the unknowns: overdetermined, consistent, no "
+       "spurious roots; least-squares Newton, eigen only)")  //
+      ("steps_per_period", po::value<long>()->default_value(40),
+       "time steps per period, dt = T / steps_per_period (even; event contact is exact for "
+       "piecewise-linear orbits at any dt <= L/c)")  //
+      ("shooting_solver", po::value<std::string>()->default_value("tdbem"),
+       "bar solver of the residual: tdbem or exact")  //
+      ("start_offset", po::value<double>()->default_value(0.05),
+       "first orbit: end amplitude (1 + start_offset) * gap, just inside contact")  //
+      ("start_guess", po::value<std::string>()->default_value("contact_family"),
+       "contact_family (exact piecewise-linear orbit) or linear_mode (sine, linear period)")  //
+      ("free_knots", po::value<long>()->default_value(-1),
+       "movable knots of the u0 grid, kept ordered: K >= 0, or -1 = auto (one per kink of the "
+       "branch's exact u0: 0 for mode1, 1 for mode2, 2 for the subharmonic branches)")        //
+      ("energy_max", po::value<double>()->default_value(1e-2), "stop above this energy [J]")  //
+      ("max_points", po::value<long>()->default_value(1000),
+       "points on the branch, first included")  //
+      ("rank_check_every", po::value<long>()->default_value(1),
+       "verified rank report every k points (0: never)")  //
+      ("rank_threshold", po::value<double>()->default_value(1e-5),
+       "rank report: singular values below this times the largest are candidate null "
+       "directions. Measured along the paper scene's branches (branch.csv sigma_zero, "
+       "sigma_kept): the forward-difference Jacobian's null value reaches 2.8e-6 (kinks of "
+       "the contact map), the smallest kept one is 5.6e-5; verify decides")  //
+      ("ds", po::value<double>()->default_value(0.45),
+       "first step, dimensionless: the L2 norm of the change of u0 / gap over the bar "
+       "(independent of the grid), knot / L and T c / L; mode1 and mode2 in amplitude units "
+       "default to 0.1 (10 % of the amplitude)")  //
+      ("ds_max", po::value<double>()->default_value(0.45),
+       "largest step (dimensionless; mode1, mode2 in amplitude units: 0.1)")  //
+      ("newton_tolerance", po::value<double>()->default_value(3e-9),
+       "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
+       "residual's round-off grows with the amplitude: measured at shooting_elements 100 on "
+       "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there). mode1 "
+       "and mode2 in amplitude units (F relative to the amplitude above the gap) default to "
+       "1e-10")  //
+      ("amplitude_units", po::value<bool>()->default_value(true),
+       "mode1, mode2: above the gap, steps and rank reports in units of the orbit's amplitude "
+       "(the L2 norm of u0) instead of the gap, so that ds is relative and a branch covers "
+       "decades of energy (README.md, section 'Cost'); false: the gap throughout")  //
+      ("max_residual_work", po::value<double>()->default_value(1e7),
+       "refuse a trace whose residual costs more than this many element-steps "
+       "(shooting_elements x steps_per_period; a point evaluates the residual about 2 x "
+       "shooting_elements times): raise it to run larger traces")  //
+      ("return_tolerance", po::value<double>()->default_value(1e-6),
+       "reject a converged point whose orbit, re-simulated over T by the exact oracle, misses "
+       "u0 or v0 = 0 by more than this, relative to max|u0| (0: no check). Catches spurious "
+       "roots of the projected residual");
+  keys.add(shooting);
+  keys.add(subharmonic_keys());
+  keys.add(manifold_keys());
+  return keys;
+}
+
+cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch);
+
+// The run's size against max_residual_work, before anything runs (simulate's max_steps habit):
+// one residual marches about elements x steps_per_period element-steps (measured: 0.1-0.15 us
+// per step at 20 intervals, problems/contact_bar/README.md, section 'Cost').
+void check_residual_work(const core::Scene& scene, const OrbitOptions& options) {
+  const double limit = scene.positive("max_residual_work");
+  const double work = static_cast<double>(options.elements) * options.steps_per_period;
+  if (work <= limit) return;
+  const bool steps = options.steps_per_period >= options.elements;
+  throw core::InputError(
+      steps ? "steps_per_period" : "shooting_elements",
+      fmt::format("shooting_elements x steps_per_period = {} x {} = {:.4g} element-steps per "
+                  "residual > max_residual_work {:.4g}; lower {} or raise max_residual_work",
+                  options.elements, options.steps_per_period, work, limit,
+                  steps ? "steps_per_period" : "shooting_elements"));
+}
+
+cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
+  if (branch.rfind("subharmonic", 0) == 0) return setup_subharmonic(scene, branch);
+  const int mode = branch == "mode2" ? 2 : 1;
+  bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
+  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
+    throw core::InputError("right_end",
+                           "the contact-bar modes need right_end = contact and gap > 0");
+  const ContactFamily family(setup.material, setup.right.gap, mode);
+
+  std::shared_ptr<const bar::BarSolver> solver;
+  if (scene.choice("shooting_solver", {"tdbem", "exact"}) == "exact")
+    solver = std::make_shared<exact_bar::ExactBarSolver>();
+  else
+    solver = std::make_shared<TdbemSolver>(contact_method_from_scene(scene));
+
+  OrbitOptions options;
+  const long shooting_elements = scene.integer("shooting_elements", 0);
+  options.elements =
+      static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
+  options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
+  check_residual_work(scene, options);
+  const long knots = scene.integer("free_knots", -1);
+  options.free_knots = knots < 0 ? (mode == 2 ? 1 : 0) : static_cast<int>(knots);
+  const long test_elements = scene.integer("test_elements", -1);
+  options.test_elements = static_cast<int>(
+      test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);
+  // A followed family's probes and paths are measured in units of the gap: with follow the gap
+  // stays the unit. (Branch-point detection works in either: its samples are kept in the unit
+  // scale, continuation/README.md, section 'Branch points'.)
+  options.amplitude_units = scene.flag("amplitude_units") && scene.text("follow") == "none";
+
+  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, solver, options);
+  const double ratio = 1 + scene.positive("start_offset");
+  const std::string guess = scene.choice("start_guess", {"contact_family", "linear_mode"});
+
+  cli::TraceSetup s;
+  if (options.amplitude_units) {
+    // In units of the amplitude a step ds is a relative change of the orbit and F's round-off
+    // is relative too (README.md, section 'Cost'): 10 % steps (mode 1 to 1e-2 J in 54 points,
+    // to 1e4 J in 126; 0.45 gave 18 and 37, too few for the figures) and a tolerance of 1e-10
+    // of the amplitude (closed-form error 4e-13 at 20 intervals and 1e-13 at 100, against 7e-12
+    // with the gap units' 3e-9, at the same Jacobians per point).
+    const bool ds_given = !scene.values()["ds"].defaulted();
+    const bool ds_max_given = !scene.values()["ds_max"].defaulted();
+    const bool tolerance_given = !scene.values()["newton_tolerance"].defaulted();
+    s.branch_options = [=](continuation::ContinuationOptions& o, core::NewtonOptions& newton) {
+      if (!ds_max_given) o.ds_max = 0.1;
+      if (!ds_given) o.ds = std::min(0.1, o.ds_max);
+      if (!tolerance_given) newton.residual_tolerance = 1e-10;
+    };
+  }
+  s.guess = guess == "linear_mode" ? problem->linear_mode_guess(mode, ratio)
+                                   : problem->contact_family_guess(mode, ratio);
+  // Energy grows along the family: the direction of the contact family's own tangent.
+  s.direction = problem->contact_family_guess(mode, ratio * 1.01) -
+                problem->contact_family_guess(mode, ratio);
+
+  const ContactBarOrbitProblem* p = problem.get();
+  const double return_tolerance = scene.non_negative("return_tolerance");
+  if (return_tolerance > 0) {
+    // Exact oracle sampled on 4x as many intervals as unknowns (finer than the default test
+    // grid): a spurious root of the projected equations is not a root of these.
+    const int check_elements = 4 * p->state_size();
+    s.reject_point = [p, return_tolerance, check_elements](const core::Vector& x) {
+      const exact_bar::ExactBarSolver oracle;
+      const ReturnError e = return_error(*p, x, oracle, check_elements);
+      if (e.worst() <= return_tolerance) return std::string();
+      return fmt::format(
+          "exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
+          "return_tolerance {:g}",
+          e.displacement, e.velocity, return_tolerance);
+    };
+  }
+  // Branch points: the frequency ratio of the attached orbit's extra end content, measured
+  // from exact re-simulations of both orbits (attached_content.hpp).
+  s.describe_branch_point = [p](const core::Vector& on_branch, const core::Vector& attached) {
+    const AttachedContent c =
+        attached_content(*p, on_branch, attached, exact_bar::ExactBarSolver());
+    return core::Observables{{"frequency_ratio", c.frequency_ratio},
+                             {"oscillations_per_period", c.oscillations_per_period}};
+  };
+  s.describe_point = [family](const continuation::BranchPoint& point) {
+    const double exact = family.frequency(point.observable("energy"));
+    return fmt::format("closed-form rel err {:.2e}",
+                       std::abs(point.observable("frequency") / exact - 1));
+  };
+  s.write_extra_outputs = [p, family](const std::filesystem::path& out,
+                                      const continuation::Branch& b) {
+    // Per point: the closed form at the point's own energy, the exact-oracle return error and
+    // the node (where u0 changes sign; NaN for mode 1, which has none).
+    const exact_bar::ExactBarSolver oracle;
+    core::Table check({"point", "energy", "frequency", "closed_form_frequency", "relative_error",
+                       "return_error_u", "return_error_v", "node"});
+    for (const auto& point : b.points) {
+      const double energy = point.observable("energy");
+      const double w = point.observable("frequency");
+      const double exact = family.frequency(energy);
+      const ReturnError re = return_error(*p, point.x, oracle);
+      check.add_row({static_cast<double>(point.index), energy, w, exact, std::abs(w / exact - 1),
+                     re.displacement, re.velocity, node_of(p->initial_displacement(point.x))});
+    }
+    check.write_csv(out / "closed_form_check.csv");
+  };
+  s.problem = std::move(problem);
+  return s;
+}
+
+std::shared_ptr<const bar::BarSolver> shooting_solver(const core::Scene& scene) {
+  if (scene.choice("shooting_solver", {"tdbem", "exact"}) == "exact")
+    return std::make_shared<exact_bar::ExactBarSolver>();
+  return std::make_shared<TdbemSolver>(contact_method_from_scene(scene));
+}
+
+// The continuum's own continuation settings (README.md, section 'Subharmonic continuum'):
+//  - the first step along the closed-form direction (start_along_direction);
+//  - ds = ds_max = 1/40 of the closed-form path length in the scaled step norm, so every
+//    energy has about 40 members (the path grows like sqrt(E) / g0 in that norm), unless the
+//    scene gives ds or ds_max;
+//  - a window on the shape from shape_end = 1e-6 L / ((1 - 3b) L) to 1 (to 1 - shape_end when
+//    the branch goes up from a first member below 1/2): the shape-0 limit has
+//    its second kink at x = L, where the two-knot chart degenerates (the forward-difference
+//    step of the last knot, 1.5e-8 L, crosses L once L - k2 is smaller), so the branch lands
+//    on the member with L - k2 = 1e-6 L, whose contact phase at t = 0 lasts 2e-6 L / c, and
+//    ends there with bound_reached (a complete branch; the limit itself: grazing_limits.hpp).
+std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)> continuum_options(
+    const core::Scene& scene, const ContactBarOrbitProblem& problem, double energy, double shape,
+    double toward) {
+  const bar::Material& material = problem.setup_template().material;
+  const double g0 = problem.displacement_scale();
+  const double s = std::sqrt(2 * energy / (material.axial_stiffness() * material.length));
+  const double b = 0.25 * (1 + g0 / (s * material.length));
+  const double shape_end = 1e-6 / (1 - 3 * b);
+  // The closed-form path length from `shape` to the end, in the loop's scaled unknowns: 40
+  // steps to twice shape_end, so that no planned member falls on the bound itself (a member on
+  // it leaves no landing ahead of it).
+  const core::Vector scale =
+      problem.typical_scale().cwiseAbs().cwiseQuotient(problem.step_weights());
+  const double last = toward < 0 ? 2 * shape_end : 1 - 2 * shape_end;
+  double length = 0;
+  core::Vector previous = problem.subharmonic_guess(energy, shape).cwiseQuotient(scale);
+  const int samples = 200;
+  for (int i = 1; i <= samples; ++i) {
+    const core::Vector z = problem.subharmonic_guess(energy, shape + (last - shape) * i / samples)
+                               .cwiseQuotient(scale);
+    length += (z - previous).norm();
+    previous = z;
+  }
+  const bool ds_given = !scene.values()["ds"].defaulted();
+  const bool ds_max_given = !scene.values()["ds_max"].defaulted();
+  return [=](continuation::ContinuationOptions& options, core::NewtonOptions&) {
+    options.start_along_direction = true;
+    const double step = length / 40;
+    if (!ds_given) options.ds = ds_max_given ? std::min(step, options.ds_max) : step;
+    if (!ds_max_given) options.ds_max = std::max(step, options.ds);
+    // Upwards (a first member below 1/2) the curve ends at the limit shape 1 itself, which no
+    // step crosses: the window closes just before it, and limits.csv has the limit.
+    options.bounds.push_back({"shape", shape_end, toward < 0 ? 1.0 : 1 - shape_end});
+  };
+}
+
+// The subharmonic branches (README.md, section 'Subharmonic continuum'): mode 2 taken over two
+// periods, T = 2 T2, started at rest at the centre of a contact phase (start_on_wall), two free
+// knots at its two kinks. The periodic orbits form a 2D manifold (energy x shape); a path on it
+// is picked by one path row: the shape (subharmonic: the backbone at constant shape) or the
+// energy (subharmonic_continuum: the members at one energy, from a grazing limit on).
+cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch) {
+  bar::BarSetup setup = bar_from_scene(scene);
+  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
+    throw core::InputError("right_end",
+                           "the subharmonic branches need right_end = contact and gap > 0");
+  // The manifold's seed is a member of the continuum at sqrt(energy_min energy_max) (manifold.hpp).
+  const bool manifold = branch == "subharmonic_manifold";
+  const bool continuum = branch == "subharmonic_continuum" || manifold;
+  const bar::Material& material = setup.material;
+  const double g0 = setup.right.gap;
+  const ContactFamily mode2(material, g0, 2);
+  double energy = scene.non_negative("energy");
+  if (energy == 0) energy = 0.5 * material.axial_stiffness() * 25 * g0 * g0 / material.length;
+  if (manifold) energy = manifold_seed_energy(scene);
+  const double shape_key = scene.number("shape");
+  const double shape = shape_key >= 0 ? shape_key : (continuum && !manifold ? 1.0 : 0.3);
+  if (!(shape > 0 && shape <= 1))
+    throw core::InputError("shape", fmt::format("must be in (0, 1] (got {})", shape));
+  // The backbone starts near the mode-2 grazing energy (end amplitude (1 + start_offset) g0).
+  const double ratio = 1 + scene.positive("start_offset");
+  const double start_energy = continuum ? energy
+                                        : 0.5 * material.axial_stiffness() *
+                                              std::pow((2 * ratio + 1) * g0, 2) / material.length;
+  const SubharmonicMember first = subharmonic_member(material, g0, start_energy, shape);
+
+  OrbitOptions options;
+  const long shooting_elements = scene.integer("shooting_elements", 0);
+  options.elements =
+      static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
+  options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
+  check_residual_work(scene, options);
+  options.start_on_wall = true;
+  const long knots = scene.integer("free_knots", -1);
+  options.free_knots = knots < 0 ? 2 : static_cast<int>(knots);
+  if (options.free_knots < 2)
+    throw core::InputError("free_knots", "the subharmonic members have two kinks: >= 2 or -1");
+  // Knot 1 on the node nearest the first kink; the last knot on node N - 1: beyond the second
+  // kink u0 is linear up to L for every member, and that segment shrinks to nothing at the
+  // shape-0 limit, where interior nodes would be free of the residual (spurious roots,
+  // measured: return errors 1e-5 from shape 0.09 on at N = 20). Further knots (free_knots > 2)
+  // spread between the two.
+  std::vector<double> at{first.kinks[0]};
+  for (int j = 1; j + 1 < options.free_knots; ++j)
+    at.push_back(first.kinks[0] + (first.kinks[1] - first.kinks[0]) * j / (options.free_knots - 1));
+  options.knot_nodes = nearest_knot_nodes(options.elements, material.length, at);
+  options.knot_nodes.push_back(options.elements - 1);
+  if (options.knot_nodes.size() >= 2 &&
+      options.knot_nodes[options.knot_nodes.size() - 2] >= options.elements - 1)
+    throw core::InputError("shooting_elements", "too few elements for the free knots");
+  const long test_elements = scene.integer("test_elements", -1);
+  options.test_elements =
+      static_cast<int>(test_elements < 0 ? 2 * options.state_size() : test_elements);
+  if (continuum)
+    options.fixed_energy = energy;
+  else
+    options.fixed_shape = shape;
+
+  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, shooting_solver(scene), options);
+  cli::TraceSetup s;
+  s.guess = problem->subharmonic_guess(start_energy, shape);
+  if (continuum) {
+    // Towards the other grazing limit: the shape decreases from 1 (increases from below 1/2).
+    // The closed-form direction of the family: the first step follows it, since the start at
+    // a grazing limit is a nonsmooth boundary point where the finite-difference tangent mixes
+    // the free and the contact side (measured: 8 to 83 degrees off the family).
+    const double toward = shape > 0.5 ? -1.0 : 1.0;
+    s.direction = problem->subharmonic_guess(energy, shape + toward * 1e-4) - s.guess;
+    s.branch_options = continuum_options(scene, *problem, energy, shape, toward);
+  } else {
+    s.direction = problem->subharmonic_guess(start_energy * 1.01, shape) - s.guess;
+  }
+  const ContactBarOrbitProblem* p = problem.get();
+  const double return_tolerance = scene.non_negative("return_tolerance");
+  if (return_tolerance > 0) {
+    // 1000 intervals: finer than any knot segment the branch keeps (a coarser check grid let
+    // spurious roots through near the shape-0 limit).
+    s.reject_point = [p, return_tolerance](const core::Vector& x) {
+      const exact_bar::ExactBarSolver oracle;
+      const ReturnError e = return_error(*p, x, oracle, 1000);
+      if (e.worst() <= return_tolerance) return std::string();
+      return fmt::format(
+          "exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
+          "return_tolerance {:g}",
+          e.displacement, e.velocity, return_tolerance);
+    };
+  }
+  s.describe_point = [mode2](const continuation::BranchPoint& point) {
+    const double exact = 2 * mode2.period(point.observable("energy"));
+    return fmt::format("T / (2 T2) - 1 = {:.2e}, shape {:.4f}",
+                       point.observable("period") / exact - 1, point.observable("shape"));
+  };
+  const bool dimension_check = scene.flag("dimension_check");
+  const double rank_threshold = scene.positive("rank_threshold");
+  s.write_extra_outputs = [p, mode2, dimension_check, rank_threshold, continuum, energy](
+                              const std::filesystem::path& out, const continuation::Branch& b) {
+    write_subharmonic_outputs(*p, mode2, b, out, dimension_check ? rank_threshold : std::nan(""));
+    if (!continuum) return;
+    // limits.csv: both grazing limits at this energy, located by NLopt (grazing_limits.hpp)
+    // on the continuum's grid and time step.
+    GrazingLimitOptions o;
+    o.elements = p->options().elements;
+    o.steps_per_period = p->options().steps_per_period;
+    const GrazingLimits g = grazing_limits(p->setup_template(), p->solver(), energy, o);
+    grazing_limit_table(g).write_csv(out / "limits.csv");
+    for (const GrazingLimit& l : g.limits)
+      fmt::print(
+          "grazing limit {} (NLopt): {} contact phase(s), {} grazing instant(s), vanishing phase "
+          "{:.2e} s, residual {:.1e}, exact return {:.1e}, {} ({:.2f} s)\n",
+          l.name, l.structure.contact_phases, l.structure.grazing_instants, l.phase_duration,
+          l.residual, l.return_error, l.message, l.seconds);
+    fmt::print("grazing limits: shape_1 simulated by T2 = {:.9g} s vs shape_0: {:.2e} relative\n",
+               g.half_period, g.shift_distance);
+  };
+  problem->set_path_rows(scene.flag("path_rows"));
+  if (manifold) add_manifold_outputs(scene, s, *problem);
+  s.problem = std::move(problem);
+  return s;
+}
+
+}  // namespace
+
+cli::ProblemPlugin trace_plugin() {
+  cli::ProblemPlugin p;
+  p.name = "contact_bar";
+  p.summary = "elastic bar fixed at x = 0, rigid wall at gap g0 beyond x = L (Signorini contact)";
+  p.scene_keys = &trace_keys;
+  p.branches = {"mode1", "mode2", "subharmonic", "subharmonic_continuum", "subharmonic_manifold"};
+  p.setup = &setup_trace;
+  p.simulate_keys = &simulate_keys;
+  p.simulate = &simulate_scene;
+  p.units = {{"period", "s"},
+             {"frequency", "rad/s"},
+             {"energy", "J"},
+             {"end_amplitude", "m"},
+             {"knot", "m"}};
+  return p;
+}
+
+}  // namespace backbone::contact_bar

@@ -1,0 +1,201 @@
+#include "problems/contact_bar/figures/resonance.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <string>
+
+#include "core/plot.hpp"
+#include "core/scene.hpp"
+#include "core/table.hpp"
+#include "problems/contact_bar/figures/modes.hpp"
+#include "problems/contact_bar/solver/scene.hpp"
+#include "problems/exact_bar/exact_bar_solver.hpp"
+
+namespace backbone::contact_bar {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The main job's mode-1 trace with --follow (plugin.cpp, reproduce step mode1_resonances): at
+// 40 intervals, where the family attached at T = 3.2 L/c is resolved.
+constexpr const char* resonances_folder = "mode1_resonances";
+
+std::vector<fs::path> followed_branches(const fs::path& mode1) {
+  std::vector<fs::path> attached;
+  if (!fs::exists(mode1)) return attached;
+  for (const auto& entry : fs::directory_iterator(mode1))
+    if (entry.path().filename().string().rfind("branch_point_", 0) == 0 &&
+        fs::exists(entry.path() / "branch.csv"))
+      attached.push_back(entry.path());
+  std::sort(attached.begin(), attached.end());
+  return attached;
+}
+
+}  // namespace
+
+int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
+  const std::vector<fs::path> attached = followed_branches(out / resonances_folder);
+  if (attached.empty()) {
+    fmt::print("[figures] resonant_end skipped: no followed branch in {} (trace --follow)\n",
+               (out / resonances_folder).string());
+    return 0;
+  }
+  const core::Scene scene = core::read_scene(scene_keys(), scene_path.string(), {},
+                                             boost::program_options::options_description());
+  bar::BarSetup s = setup_from_scene(scene);
+  const double L = s.material.length, c = s.material.wave_speed(), g0 = s.right.gap;
+  std::string plot =
+      "set grid\nset xlabel 't / T'\nset ylabel 'u(L,t) [m]'\nset key outside right\n";
+  std::string curves;
+  for (const fs::path& dir : attached) {
+    // The highest-energy orbit of the followed branch, and mode 1 at its period: the closed form
+    // u0 = eps x with T = (3 L + g0 / |eps|) / c (README.md, 'Mode 1').
+    const auto orbit = load_traced_orbit(dir, 1e300, L);
+    if (!orbit) continue;
+    const double eps = -g0 / (c * orbit->period - 3 * L);
+    bar::SimulationOptions o;
+    o.t_end = orbit->period;
+    o.dt = orbit->period / 4000;
+    o.history_samples = 4001;
+    o.energy = false;
+    const std::string k = dir.filename().string().substr(13);  // "branch_point_K" -> K
+    for (const bool resonant : {true, false}) {
+      s.u0 = resonant ? orbit->u0 : bar::PiecewiseLinear({0.0, L}, {0.0, eps * L});
+      s.v0 = bar::PiecewiseLinear::zero(L);
+      const fs::path csv =
+          out / fmt::format("resonant_end_{}_{}.csv", k, resonant ? "attached" : "mode1");
+      exact_bar::ExactBarSolver().simulate(s, o).to_table().write_csv(csv);
+      curves += fmt::format(
+          "{}{} using (column('t')/{}):'u_contact' with lines lw {} title '{}'",
+          curves.empty() ? "plot " : ", ", core::gnuplot_quote(csv), orbit->period,
+          resonant ? 1.5 : 3,
+          resonant ? fmt::format("attached at branch point {} (E = {:.3g} J)", k, orbit->energy)
+                   : fmt::format("mode 1 at T = {:.6g} s", orbit->period));
+    }
+  }
+  if (curves.empty()) return 0;
+  plot += "set title 'Contacting-end displacement over one period, exact oracle (Fig. 11)'\n" +
+          curves + "\n";
+  const fs::path png = out / "resonant_end.png";
+  const core::PlotResult r = core::render_png(png, plot, {1200, 700});
+  if (r.ok)
+    fmt::print("[figures] wrote {}\n", png.string());
+  else
+    fmt::print(stderr, "[figures] {}\n", r.message);
+  return 0;
+}
+
+int draw_resonant_spacetime(const fs::path& out, const fs::path& scene_path) {
+  const std::vector<fs::path> attached = followed_branches(out / resonances_folder);
+  if (attached.empty()) {
+    fmt::print("[figures] resonant_spacetime skipped: no followed branch in {} (trace --follow)\n",
+               (out / resonances_folder).string());
+    return 0;
+  }
+  const core::Scene scene = core::read_scene(scene_keys(), scene_path.string(), {},
+                                             boost::program_options::options_description());
+  bar::BarSetup s = setup_from_scene(scene);
+  // The highest-energy orbit of the first followed branch: u(x, t) at 121 instants of one
+  // period on 200 intervals, exact oracle.
+  const auto orbit = load_traced_orbit(attached.front(), 1e300, s.material.length);
+  if (!orbit) return 0;
+  s.u0 = orbit->u0;
+  s.v0 = bar::PiecewiseLinear::zero(s.material.length);
+  bar::SnapshotRequest request;
+  request.elements = 200;
+  std::string text = "t,x,u\n";
+  const exact_bar::ExactBarSolver oracle;
+  for (int k = 0; k <= 120; ++k) {
+    const double t = orbit->period * k / 120;
+    const bar::FieldSnapshot f = oracle.snapshot(s, t, request);
+    if (!f.ok) {
+      fmt::print(stderr, "[figures] resonant_spacetime: exact oracle failed at t = {}: {}\n", t,
+                 f.message);
+      return 1;
+    }
+    for (std::size_t i = 0; i < f.x.size(); ++i)
+      text += fmt::format("{:.9g},{:.9g},{:.9g}\n", t, f.x[i], f.u[i]);
+    text += "\n";  // gnuplot grid block separator
+  }
+  const fs::path csv = out / "resonant_spacetime.csv";
+  core::write_text_atomically(csv, text);
+  const std::string plot = fmt::format(
+      "set title 'Internally resonant orbit (branch point {}) over one period (exact oracle): E = "
+      "{:.3g} J, "
+      "T = {:.6g} s'\n"
+      "set xlabel 'x [m]'\nset ylabel 't [s]'\nset zlabel 'u [m]' rotate parallel\n"
+      "set pm3d depthorder\nset palette rgbformulae 33,13,10\nset view 55,35\n"
+      "set key top left\nset ticslevel 0\n"
+      "splot {} using 'x':'t':'u' with pm3d title 'u(x,t)'\n",
+      attached.front().filename().string().substr(13), orbit->energy, orbit->period,
+      core::gnuplot_quote(csv));
+  const fs::path png = out / "resonant_spacetime.png";
+  const core::PlotResult r = core::render_png(png, plot, {1100, 800});
+  if (r.ok)
+    fmt::print("[figures] wrote {}\n", png.string());
+  else
+    fmt::print(stderr, "[figures] {}\n", r.message);
+  return 0;
+}
+
+int draw_attached_branches(const fs::path& out) {
+  const fs::path mode1 = out / resonances_folder;
+  if (!fs::exists(mode1 / "branch.csv")) {
+    fmt::print("[figures] attached_branches skipped: no {}\n", (mode1 / "branch.csv").string());
+    return 0;
+  }
+  const std::vector<fs::path> attached = followed_branches(mode1);
+  if (attached.empty()) {
+    fmt::print("[figures] attached_branches skipped: no followed branch in {} (trace --follow)\n",
+               mode1.string());
+    return 0;
+  }
+  std::string plot =
+      "set title 'Mode 1 and the branches attached at its branch points (internal resonances)'\n"
+      "set xlabel 'frequency {/Symbol w} [rad/s]'\nset ylabel 'energy E [J]'\n"
+      "set logscale y\nset format y '10^{%L}'\nset grid\nset key outside right\n";
+  plot += fmt::format(
+      "plot {} using 'frequency':'energy' with linespoints pt 7 ps 0.5 lw 2 lc rgb 'blue' "
+      "title 'mode 1'",
+      core::gnuplot_quote(mode1 / "branch.csv"));
+  if (fs::exists(mode1 / "branch_points.csv"))
+    plot += fmt::format(
+        ", {} using 'frequency':(column('verified') == 1 ? "
+        "column('energy') : NaN) with points pt 6 ps 2 lc rgb 'black' title 'verified branch "
+        "points'",
+        core::gnuplot_quote(mode1 / "branch_points.csv"));
+  for (const fs::path& dir : attached)
+    plot += fmt::format(
+        ", {} using 'frequency':'energy' with linespoints pt 5 ps 0.5 title "
+        "'attached at branch point {}'",
+        core::gnuplot_quote(dir / "branch.csv"),
+        dir.filename().string().substr(13));  // "branch_point_K" -> K
+  const fs::path png = out / "attached_branches.png";
+  const core::PlotResult r = core::render_png(png, plot + "\n", {1200, 700});
+  if (r.ok)
+    fmt::print("[figures] wrote {}\n", png.string());
+  else
+    fmt::print(stderr, "[figures] {}\n", r.message);
+  return 0;
+}
+
+std::vector<cli::ProblemJob> resonance_figure_jobs() {
+  return {{"attached_branches",
+           "attached_branches.png: mode 1 with its followed attached branches (Fig. 4 d)",
+           draw_attached_branches},
+          {"resonant_spacetime",
+           "resonant_spacetime.png: u(x, t) over one period of an attached orbit (Fig. 10)",
+           [](const fs::path& out) {
+             return draw_resonant_spacetime(out, "problems/contact_bar/scenes/paper.ini");
+           }},
+          {"resonant_end",
+           "resonant_end.png: contacting end of an attached orbit beside mode 1 at its period "
+           "(Fig. 11)",
+           [](const fs::path& out) {
+             return draw_resonant_end(out, "problems/contact_bar/scenes/paper.ini");
+           }}};
+}
+
+}  // namespace backbone::contact_bar

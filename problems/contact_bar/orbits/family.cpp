@@ -1,0 +1,112 @@
+#include "problems/contact_bar/orbits/family.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "core/errors.hpp"
+
+namespace backbone::contact_bar {
+
+ContactFamily::ContactFamily(const bar::Material& material, double gap, int mode)
+    : material_(material), gap_(gap), mode_(mode) {
+  if (mode != 1 && mode != 2)
+    throw core::InputError("mode", fmt::format("the contact family is known in closed form for "
+                                               "modes 1 and 2 (got {})",
+                                               mode));
+  if (!(gap > 0) || !std::isfinite(gap))
+    throw core::InputError("gap", fmt::format("the contact family needs a gap > 0 (got {})", gap));
+}
+
+double ContactFamily::slope(double energy) const {
+  return std::sqrt(2 * energy / (material_.axial_stiffness() * material_.length));
+}
+
+double ContactFamily::grazing_energy() const {
+  const double g = (2 * mode_ - 1) * gap_;  // mode 2 grazes when s L = 3 g0
+  return material_.axial_stiffness() * g * g / (2 * material_.length);
+}
+
+// Mode 1: README.md, section 'Mode 1'. Mode 2 closed form. With c = L = 1 and u = F(t + x) - F(t -
+// x), let H(t) = F'(t - 1) be the wave arriving at x = L. Free end: H(t + 2) = -H(t) and the end
+// moves at -2 H(t); closed contact: H(t + 2) = H(t) while H(t) <= 0. v0 = 0 makes H symmetric about
+// t = 1 on [0, 2], H(1 +- x) = u0'(x) / 2. Take H = +h on (1 - b, 1 + b), -h elsewhere (the tent u0
+// of slopes s = 2h, -2h with crest at b). The end approaches for 2b, sticks for 1 - 3b, recedes for
+// 2b: the pattern is periodic with T = 1 + b iff the approach from u0(1) = s (2b - 1) reaches g0 in
+// 2b, i.e. b = (1 + g0 / s) / 4, in [1/4, 1/3] (grazing at s = 3 g0). E = s^2 / 2 (EA = 1).
+double ContactFamily::period(double energy) const {
+  const double length = material_.length, s = slope(energy);
+  if (!(s * length >= (2 * mode_ - 1) * gap_)) return std::nan("");
+  if (mode_ == 1) return (3 * length + gap_ / s) / material_.wave_speed();
+  return (5 * length + gap_ / s) / (4 * material_.wave_speed());
+}
+
+double ContactFamily::frequency(double energy) const {
+  return 2 * std::numbers::pi / period(energy);
+}
+
+double ContactFamily::linear_frequency() const {
+  return (2 * mode_ - 1) * std::numbers::pi * material_.wave_speed() / (2 * material_.length);
+}
+
+double ContactFamily::asymptotic_frequency() const {
+  const double c = material_.wave_speed(), length = material_.length;
+  return mode_ == 1 ? 2 * std::numbers::pi * c / (3 * length)
+                    : 8 * std::numbers::pi * c / (5 * length);
+}
+
+double ContactFamily::node(double energy) const {
+  const double s = slope(energy), length = material_.length;
+  if (mode_ == 1 || !(s * length >= 3 * gap_)) return std::nan("");
+  const double b = 0.25 * (1 + gap_ / (s * length));
+  return 2 * b * length;
+}
+
+double node_of(const bar::PiecewiseLinear& u0) {
+  const auto& xs = u0.knots();
+  const auto& ys = u0.values();
+  for (std::size_t i = 2; i < xs.size(); ++i)
+    if ((ys[i - 1] > 0 && ys[i] <= 0) || (ys[i - 1] < 0 && ys[i] >= 0))
+      return xs[i - 1] + (xs[i] - xs[i - 1]) * ys[i - 1] / (ys[i - 1] - ys[i]);
+  return std::nan("");
+}
+
+// Derivation (c = L = 1, u = F(t + x) - F(t - x), H(t) = F'(t - 1) the wave arriving at x = 1,
+// README.md sections 'Mode 2' and 'Subharmonic continuum'): v0 = 0 makes H symmetric about 1 on
+// [0, 2] and u0'(x) = 2 H(1 + x). Take H = +h on a pulse of width 2b centred at c in [0, 1]
+// (mirrored about 1), -h elsewhere: u0(1) = s (4b - 1) = g0 whatever c, so the end starts on the
+// wall. Marching the free / closed reflections over T = 2 (1 + b) returns the state for every c
+// in [b, 1 - 2b]: contact phases of 2 (c - b) around t = 0 and 2 (1 - 2b - c) around T / 2.
+SubharmonicMember subharmonic_member(const bar::Material& material, double gap, double energy,
+                                     double shape) {
+  const double length = material.length;
+  const double s = std::sqrt(2 * energy / (material.axial_stiffness() * length));
+  if (!(s * length >= 3 * gap) || !std::isfinite(s))
+    throw core::InputError("energy",
+                           fmt::format("the subharmonic continuum needs E >= the mode-2 "
+                                       "grazing energy {} (got {})",
+                                       ContactFamily(material, gap, 2).grazing_energy(), energy));
+  if (!(shape >= 0 && shape <= 1))
+    throw core::InputError("shape", fmt::format("must be in [0, 1] (got {})", shape));
+  const double b = 0.25 * (1 + gap / (s * length));
+  const double c = b + shape * (1 - 3 * b);
+  const double x1 = (1 - c - b) * length, x2 = (1 - c + b) * length;
+  std::vector<double> knots{0.0, x1}, values{0.0, -s * x1};
+  if (x2 < length) {
+    knots.push_back(x2);
+    values.push_back(values.back() + s * (x2 - x1));
+  }
+  values.push_back(gap);  // s (4b - 1) L = g0 exactly (the sum of the slopes rounds)
+  knots.push_back(length);
+  const double tau = length / material.wave_speed();
+  SubharmonicMember m{bar::PiecewiseLinear(std::move(knots), std::move(values)),
+                      2 * (1 + b) * tau,
+                      2 * (c - b) * tau,
+                      2 * (1 - 2 * b - c) * tau,
+                      {x1, x2}};
+  return m;
+}
+
+}  // namespace backbone::contact_bar

@@ -1,0 +1,87 @@
+// Known-solution tests of contact_bar::ContactFamily against the exact characteristics solver:
+// the closed-form period at an orbit's own energy is the time after which the exact oracle
+// brings the orbit back to its initial state; the mode-2 node is where its u0 changes sign.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/errors.hpp"
+#include "problems/contact_bar/orbits/family.hpp"
+#include "problems/contact_bar/orbits/periodic_bar.hpp"
+#include "problems/exact_bar/exact_bar_solver.hpp"
+
+namespace {
+
+using namespace backbone;
+using contact_bar::ContactFamily;
+
+bar::BarSetup steel_bar(double gap) {
+  bar::BarSetup s;
+  s.material.length = 2.5;
+  s.material.youngs_modulus = 2.1e11;
+  s.material.density = 7850;
+  s.material.area = 3e-4;
+  s.left = {bar::EndType::fixed, 0};
+  s.right = {bar::EndType::contact, gap};
+  return s;
+}
+
+TEST(ContactFamily, ClosedFormPeriodIsTheExactOraclesReturnTime) {
+  const double gap = 1e-4;
+  const bar::BarSetup setup = steel_bar(gap);
+  const exact_bar::ExactBarSolver exact;
+  for (int mode : {1, 2}) {
+    contact_bar::OrbitOptions o;
+    o.elements = 20;
+    o.free_knots = mode == 2 ? 1 : 0;
+    contact_bar::ContactBarOrbitProblem orbit(setup, exact, o);
+    const ContactFamily family(setup.material, gap, mode);
+    for (double ratio : {1.3, 7.0, 60.0}) {
+      core::Vector x = orbit.contact_family_guess(mode, ratio);
+      const double energy = orbit.energy(x);
+      // The family's period from the energy alone, put into the orbit: the exact oracle must
+      // return it to u0 to round-off (piecewise-linear data, exact solver: 1e-11 relative
+      // leaves room for the ~1e3 characteristic crossings of one period).
+      x[orbit.period_index()] = family.period(energy);
+      const contact_bar::ReturnError e = contact_bar::return_error(orbit, x, exact, 200);
+      EXPECT_LT(e.worst(), 1e-11) << "mode " << mode << " ratio " << ratio;
+      EXPECT_NEAR(family.frequency(energy) * family.period(energy), 2 * std::numbers::pi, 1e-14);
+      EXPECT_GT(energy, family.grazing_energy());
+      if (mode == 2) {
+        // The tent's sign change, read off the sampled u0 (its knot sits at the crest), is
+        // the closed-form node 2bL to round-off.
+        const double node = contact_bar::node_of(orbit.initial_displacement(x));
+        EXPECT_NEAR(node, family.node(energy), 1e-12 * setup.material.length);
+      } else {
+        EXPECT_TRUE(std::isnan(family.node(energy)));
+      }
+    }
+  }
+}
+
+TEST(ContactFamily, GrazingAndLimits) {
+  const double gap = 1e-3;
+  bar::Material paper;  // E = rho = L = A = 1
+  const ContactFamily mode1(paper, gap, 1), mode2(paper, gap, 2);
+  // At grazing the period is the linear one, 4L/c (mode 1) and 4L/(3c) (mode 2).
+  EXPECT_NEAR(mode1.period(mode1.grazing_energy() * (1 + 1e-14)), 4.0, 1e-12);
+  EXPECT_NEAR(mode2.period(mode2.grazing_energy() * (1 + 1e-14)), 4.0 / 3.0, 1e-12);
+  EXPECT_NEAR(mode1.frequency(mode1.grazing_energy() * (1 + 1e-14)), mode1.linear_frequency(),
+              1e-12);
+  EXPECT_NEAR(mode2.frequency(mode2.grazing_energy() * (1 + 1e-14)), mode2.linear_frequency(),
+              1e-12);
+  // Far above grazing the frequencies approach 2 pi c/(3L) and 8 pi c/(5L): exactly
+  // omega_inf / omega = 1 + (g0/s)/(3L) (mode 1) and 1 + (g0/s)/(5L) (mode 2).
+  for (double e : {1e2, 1e6}) {
+    EXPECT_NEAR(mode1.asymptotic_frequency() / mode1.frequency(e), 1 + gap / mode1.slope(e) / 3,
+                1e-14);
+    EXPECT_NEAR(mode2.asymptotic_frequency() / mode2.frequency(e), 1 + gap / mode2.slope(e) / 5,
+                1e-14);
+  }
+  EXPECT_TRUE(std::isnan(mode1.frequency(0.5 * mode1.grazing_energy())));
+  EXPECT_THROW(ContactFamily(paper, gap, 3), core::InputError);
+  EXPECT_THROW(ContactFamily(paper, 0.0, 1), core::InputError);
+}
+
+}  // namespace
