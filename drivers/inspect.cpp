@@ -5,8 +5,8 @@
 #include "continuation/cli/inspect.hpp"
 
 #include "core/errors.hpp"
-#include "drivers/commands.hpp"
-#include "drivers/plugins.hpp"
+#include "drivers/internal/commands.hpp"
+#include "drivers/internal/plugins.hpp"
 
 namespace backbone::drivers {
 namespace {

@@ -10,8 +10,8 @@
 #endif
 
 #include "core/errors.hpp"
-#include "drivers/commands.hpp"
-#include "drivers/plugins.hpp"
+#include "drivers/internal/commands.hpp"
+#include "drivers/internal/plugins.hpp"
 
 namespace backbone::drivers {
 

@@ -1,5 +1,5 @@
 // The registry of problem plugins, filled once by the executable's registration function.
-#include "drivers/plugins.hpp"
+#include "drivers/internal/plugins.hpp"
 
 #include <fmt/format.h>
 

@@ -12,8 +12,8 @@
 #include "core/errors.hpp"
 #include "core/output_folder.hpp"
 #include "core/scene.hpp"
-#include "drivers/commands.hpp"
-#include "drivers/plugins.hpp"
+#include "drivers/internal/commands.hpp"
+#include "drivers/internal/plugins.hpp"
 
 namespace backbone::drivers {
 namespace {

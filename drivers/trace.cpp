@@ -26,8 +26,8 @@
 #include "core/scene.hpp"
 #include "core/scene_ini.hpp"
 #include "core/table.hpp"
-#include "drivers/commands.hpp"
-#include "drivers/plugins.hpp"
+#include "drivers/internal/commands.hpp"
+#include "drivers/internal/plugins.hpp"
 
 namespace backbone::drivers {
 namespace {

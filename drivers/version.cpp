@@ -5,7 +5,7 @@
 #include <Eigen/Core>
 #include <boost/version.hpp>
 
-#include "drivers/commands.hpp"
+#include "drivers/internal/commands.hpp"
 
 namespace {
 int run_version(const std::vector<std::string>&) {

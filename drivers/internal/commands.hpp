@@ -1,4 +1,4 @@
-// The subcommands of a backbone CLI, each a function from its arguments (the words after the
+// Internal to backbone::drivers: the subcommands of a backbone CLI, each a function from its arguments (the words after the
 // subcommand name) to an exit code, one file each (trace.cpp, simulate.cpp, ...).
 //
 // drivers::main (main.hpp) looks the name up in commands(), runs it, and maps exceptions:
