@@ -1,0 +1,183 @@
+#include "continuation/cli/trace_run.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cstdio>
+
+#include "continuation/cli/progress.hpp"
+#include "continuation/follow.hpp"
+#include "core/errors.hpp"
+#include "core/output_folder.hpp"
+#include "core/scene_ini.hpp"
+#include "core/table.hpp"
+
+namespace backbone::cli {
+
+TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
+                       std::filesystem::path resume) {
+  TraceRun t;
+  t.entry = &entry;
+  t.resume = std::move(resume);
+  t.scene = std::move(scene_in);
+  const core::Scene& scene = t.scene;
+  t.branch_name = scene.has("branch") ? scene.text("branch") : entry.branches.at(0);
+  if (std::find(entry.branches.begin(), entry.branches.end(), t.branch_name) ==
+      entry.branches.end())
+    throw core::InputError(
+        "branch", fmt::format("'{}' is not a branch of {} (known: {})", t.branch_name, entry.name,
+                              fmt::join(entry.branches, ", ")));
+  t.out =
+      scene.has("out") ? scene.text("out") : fmt::format("out/{}_{}", entry.name, t.branch_name);
+  core::check_output_folder("out", t.out);
+  t.run = read_run_settings(scene);
+  continuation::ContinuationOptions& options = t.run.options;
+  const long start_direction = scene.integer("direction", -1);
+  if (start_direction != 1 && start_direction != -1)
+    throw core::InputError("direction", fmt::format("must be 1 or -1 (got {})", start_direction));
+
+  t.setup = entry.setup(scene, t.branch_name);
+  if (!t.setup.problem) throw core::InputError("problem", "setup returned no problem");
+  const core::Problem& problem = *t.setup.problem;
+  t.setup.apply_branch_options(options, t.run.newton_options);
+  t.corrector = core::make_corrector(t.run.newton, t.run.newton_options);
+  t.follow_corrector = core::make_corrector(
+      t.run.newton, continuation::follow_newton_options(t.run.newton_options, options));
+  t.periodic = dynamic_cast<core::PeriodicOrbitProblem*>(t.setup.problem.get());
+  if (t.periodic) t.periodic->set_formulation(t.run.formulation);
+  t.direction = t.setup.direction;
+  if (t.direction.size() == 0)
+    t.direction =
+        core::Vector::Unit(problem.num_unknowns(),
+                           t.periodic ? t.periodic->period_index() : problem.num_unknowns() - 1);
+
+  const std::string restart_key = t.resume.empty() ? "start" : "resume";
+  if (!t.resume.empty()) {
+    continuation::repair_branch_files(t.resume, "resume");
+    t.restart = continuation::restart_point(t.resume, -1, options, "resume");
+    t.restart->record_saved_point = false;  // it is in the files
+  } else if (scene.has("start")) {
+    const auto [dir, point] = continuation::parse_saved_point(scene.text("start"), "start");
+    t.restart = continuation::restart_point(dir, point, options, "start");
+  }
+  if (t.restart)
+    continuation::take_up(*t.restart, restart_key, static_cast<int>(start_direction), problem,
+                          options, t.setup.guess, t.direction);
+
+  const int n = problem.num_unknowns(), m = problem.num_equations();
+  if (m != n - 1 && t.corrector->name() == "kinsol")
+    throw core::InputError("newton", fmt::format("kinsol solves square systems only; this {} "
+                                                 "residual has {} equations for {} unknowns "
+                                                 "(use newton = eigen, least squares)",
+                                                 entry.name, m, n));
+  // A consistent overdetermined system (m > n - 1) still has curves of solutions.
+  t.expected_dimension = n - std::min(m, n - 1);
+  return t;
+}
+
+void print_trace_header(TraceRun& t) {
+  const continuation::ContinuationOptions& options = t.options();
+  const core::Problem& problem = t.problem();
+  fmt::print("{} / {}: {} equations in {} unknowns, expected manifold dimension {}\n",
+             t.entry->name, t.branch_name, problem.num_equations(), problem.num_unknowns(),
+             t.expected_dimension);
+  const auto& restart = t.restart;
+  fmt::print("  {} continuation, {} predictor, newton {}, {}{}{}\n",
+             continuation::to_string(options.method), continuation::to_string(options.predictor),
+             t.corrector->name(),
+             t.periodic ? fmt::format("formulation {}, ", core::scene_name(t.run.formulation)) : "",
+             fmt::format("ds {:g} in [{:g}, {:g}], at most {} points", options.ds, options.ds_min,
+                         options.ds_max, options.max_points),
+             restart ? fmt::format(", restarting from point {} ({})", restart->index,
+                                   restart->state ? "its saved loop state"
+                                                  : "corrected again: " + (restart->note.empty()
+                                                                               ? "no saved state"
+                                                                               : restart->note))
+                     : "");
+}
+
+TraceReport::TraceReport(TraceRun& t)
+    : t_(t),
+      writer_(t.out, t.periodic, t.restart.has_value() && !t.resume.empty()),
+      progress_(t.options()) {}
+
+continuation::ContinuationHooks TraceReport::hooks(const std::optional<StopSignals>& stop) {
+  continuation::ContinuationHooks hooks;
+  hooks.cancel_requested = [&stop] { return stop.has_value() && stop->requested(); };
+  hooks.on_point = [this](const continuation::BranchPoint& p) { on_point(p); };
+  hooks.reject_point = t_.setup.reject_point;
+  hooks.describe_branch_point = t_.setup.describe_branch_point;
+  // Located candidates as they come (from the detector's thread, a few points after the bracket
+  // that holds them; continuation/README.md, 'Branch points'), between the point lines.
+  hooks.on_branch_point = [this](const continuation::BranchPointReport& r) {
+    progress_.finish();
+    fmt::print("  {}\n", branch_point_line(r));
+    std::fflush(stdout);
+  };
+  hooks.on_attempt = [this](const continuation::StepAttempt& a) {
+    if (a.rejection.empty()) return;
+    ++rejected;
+    fmt::print("  point {:4d}  rejected at ds {:.3g}: {}\n", a.point, a.ds, a.rejection);
+  };
+  return hooks;
+}
+
+std::string TraceReport::summary(const std::string& status, const continuation::Branch* branch,
+                                 int switch_index) const {
+  const core::Problem& problem = t_.problem();
+  return fmt::format(
+      "problem {}\nbranch {}\nstatus {}\nequations {}\nunknowns {}\nexpected_dimension {}\n"
+      "method {}\nnewton {}\nformulation {}\npoints {}\nrejected_corrections {}\n"
+      "switch_index {}\nstop_reason {}\nmessage {}\ndimension_rechecked {}\n"
+      "dimension_unconfirmed {}\n",
+      t_.entry->name, t_.branch_name, status, problem.num_equations(), problem.num_unknowns(),
+      t_.expected_dimension, continuation::to_string(t_.run.options.method), t_.corrector->name(),
+      t_.periodic ? core::scene_name(t_.run.formulation) : "-", points_in_files, rejected,
+      switch_index, branch ? continuation::to_string(branch->reason) : "-",
+      branch ? branch->message : "-", dimension_flags_[1], dimension_flags_[2]);
+}
+
+void TraceReport::on_point(const continuation::BranchPoint& p) {
+  if (t_.restart && !t_.resume.empty() && p.index == t_.restart->index) return;  // in the files
+  writer_.append(p);
+  if (p.dimension_flag != continuation::DimensionFlag::as_verified)
+    fmt::print(stderr, "backbone trace: point {}: {}\n", p.index,
+               continuation::dimension_warning(p));
+  dimension_flags_[static_cast<int>(p.dimension_flag)] += 1;
+  progress_.finish();  // the point's line replaces the progress line, which follows it
+  fmt::print("  {}{}\n", point_line(p),
+             t_.setup.describe_point ? "  " + t_.setup.describe_point(p) : "");
+  std::fflush(stdout);
+  progress_.update(p);
+}
+
+bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
+                              const continuation::ContinuationHooks& hooks) {
+  bool followed_complete = true;
+  const continuation::ContinuationOptions& options = t.options();
+  if (options.branch_points.detect) {
+    const auto verified =
+        std::count_if(branch.branch_points.begin(), branch.branch_points.end(),
+                      [](const continuation::BranchPointReport& r) { return r.verified(); });
+    fmt::print("branch points located by this run: {} ({} verified; branch_points.csv)\n",
+               branch.branch_points.size(), verified);
+  }
+  if (branch.points.empty()) return followed_complete;
+  const core::Table table = core::Table::read_csv(t.out / "branch.csv");
+  report.points_in_files = table.rows();
+  continuation::plot_branch(
+      t.out, table, fmt::format("{} / {} ({} points)", t.entry->name, t.branch_name, table.rows()),
+      t.entry->units);
+  continuation::write_after_run(t.out, t.problem(), branch, !t.resume.empty(),
+                                options.branch_points.detect, t.setup.write_extra_outputs);
+  for (const auto& f : continuation::follow_branch_points(
+           t.problem(), branch, t.run.follow, *t.follow_corrector, options, hooks, t.out,
+           t.setup.write_extra_outputs, t.entry->units)) {
+    fmt::print("  followed {}\n", continuation::follow_line(f));
+    followed_complete = followed_complete && !f.branch.points.empty() && !f.branch.ended_early();
+  }
+  return followed_complete;
+}
+
+}  // namespace backbone::cli

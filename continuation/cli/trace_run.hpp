@@ -1,0 +1,98 @@
+// A trace as `backbone trace` runs it, in named steps: prepare_trace reads and checks every
+// setting and builds the problem (and takes up a restart) before anything is written; a
+// TraceReport writes each accepted point into the branch files and a line on the screen, counts
+// rejected steps and writes summary.txt; write_outputs_and_follow draws the branch, writes the
+// problem's extra outputs and follows the attached branches.
+//
+//   TraceRun t = prepare_trace(plugin, scene, /*resume=*/{});   // InputError on bad input
+//   print_trace_header(t);
+//   TraceReport report(t);                                      // creates t.out's files
+//   std::optional<StopSignals> stop(std::in_place);
+//   const auto hooks = report.hooks(stop);
+//   auto result = run_continuation(t.problem(), t.setup.guess, t.direction, t.run,
+//                                  *t.corrector, hooks, t.restart ? &*t.restart : nullptr);
+//   write_outputs_and_follow(t, report, result.branch, hooks);
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "continuation/cli/plugin.hpp"
+#include "continuation/cli/progress.hpp"
+#include "continuation/cli/scene_options.hpp"
+#include "continuation/cli/stop_signals.hpp"
+#include "continuation/outputs.hpp"
+#include "continuation/restart.hpp"
+#include "core/newton.hpp"
+#include "core/periodic_orbit.hpp"
+#include "core/scene.hpp"
+
+namespace backbone::cli {
+
+// Everything a trace needs, read and checked before anything is written.
+struct TraceRun {
+  const ProblemPlugin* entry = nullptr;
+  std::filesystem::path resume;  // the folder of `trace --resume DIR`, else empty
+  core::Scene scene;             // the problem's keys, the continuation keys and trace's own
+  std::string branch_name;
+  std::filesystem::path out;
+  RunSettings run;
+  TraceSetup setup;
+  std::unique_ptr<core::Corrector> corrector, follow_corrector;
+  core::PeriodicOrbitProblem* periodic = nullptr;  // setup.problem when it is one
+  core::Vector direction;                          // the first tangent's hint
+  std::optional<continuation::RestartPoint> restart;
+  int expected_dimension = 0;
+
+  const core::Problem& problem() const { return *setup.problem; }
+  continuation::ContinuationOptions& options() { return run.options; }
+};
+
+// The branch (scene key `branch`, default the plugin's first), the output folder (`out`,
+// default out/PROBLEM_BRANCH), the settings and the problem; with `resume` or the key `start` a
+// restart takes up its saved point (its loop state, or its unknowns, the way the branch went,
+// the next step; `direction` +1 or -1) and numbers on from it. Throws core::InputError naming
+// the key for bad input.
+TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene, std::filesystem::path resume);
+
+// The run's first lines: equations, unknowns, expected dimension, method and step settings.
+void print_trace_header(TraceRun& t);
+
+// What the run reports as it goes: every point into the branch files (BranchWriter; after a
+// resume, appended) and a line on the screen, the located branch points, the rejected steps,
+// and summary.txt (summary()).
+class TraceReport {
+ public:
+  explicit TraceReport(TraceRun& t);
+
+  std::size_t points_in_files = 0;  // the whole branch, a resumed run's saved points included
+  long rejected = 0;
+  continuation::BranchWriter& writer() { return writer_; }
+  ProgressLine& progress() { return progress_; }
+
+  // stop: the signal handlers while they are installed (the followed branches run after they
+  // are reset, and then cannot be cancelled).
+  continuation::ContinuationHooks hooks(const std::optional<StopSignals>& stop);
+  // summary.txt: `key value` lines (problem, branch, status, counts, stop reason, ...).
+  std::string summary(const std::string& status, const continuation::Branch* branch,
+                      int switch_index) const;
+
+ private:
+  void on_point(const continuation::BranchPoint& p);
+
+  TraceRun& t_;
+  continuation::BranchWriter writer_;
+  ProgressLine progress_;
+  long dimension_flags_[3] = {0, 0, 0};  // points per DimensionFlag (branch.hpp)
+};
+
+// After the run: the number of located branch points, the figure and the extra outputs of the
+// whole branch (saved points included), then the followed branches. Returns whether every
+// followed branch reached its bound or budget.
+bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
+                              const continuation::ContinuationHooks& hooks);
+
+}  // namespace backbone::cli
