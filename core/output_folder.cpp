@@ -1,10 +1,14 @@
 #include "core/output_folder.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <system_error>
 
 #include "core/errors.hpp"
@@ -53,6 +57,28 @@ void check_output_folder(const std::string& key, const fs::path& folder) {
   if (const std::error_code e = probe_folder_creation(ancestor))
     throw InputError(key, fmt::format("cannot create '{}': no folder can be created in '{}' ({})",
                                       folder.string(), ancestor.string(), e.message()));
+}
+
+FolderLock::FolderLock(const std::string& key, const fs::path& folder) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  fd_ = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd_ < 0)
+    throw InputError(key, fmt::format("cannot open the folder '{}' ({})", folder.string(),
+                                      std::strerror(errno)));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    fd_ = -1;
+    throw InputError(key, error == EWOULDBLOCK
+                              ? fmt::format("another run is writing into '{}'", folder.string())
+                              : fmt::format("cannot lock the folder '{}' ({})", folder.string(),
+                                            std::strerror(error)));
+  }
+}
+
+FolderLock::~FolderLock() {
+  if (fd_ >= 0) ::close(fd_);  // closing the descriptor releases the lock
 }
 
 }  // namespace backbone::core

@@ -13,6 +13,14 @@
 //   core::check_output_folder("out", "/proc/x");        // InputError "out: cannot create
 //                                                       //   '/proc/x': no folder can be
 //                                                       //   created in '/proc' (...)"
+//
+// FolderLock makes one process at a time the writer of a folder: it creates the folder and holds
+// an exclusive advisory lock (flock) on it while it lives; a second writer's lock is refused at
+// once with an InputError naming `key`. The lock goes with the process, so a killed run leaves
+// no stale lock behind.
+//
+//   core::FolderLock lock("out", "results/run1");   // InputError "out: another run is writing
+//                                                   //   into 'results/run1'" while one does
 #pragma once
 
 #include <filesystem>
@@ -21,5 +29,16 @@
 namespace backbone::core {
 
 void check_output_folder(const std::string& key, const std::filesystem::path& folder);
+
+class FolderLock {
+ public:
+  FolderLock(const std::string& key, const std::filesystem::path& folder);
+  ~FolderLock();
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
 
 }  // namespace backbone::core

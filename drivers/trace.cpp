@@ -70,6 +70,20 @@ void print_help(const cli::ProblemPlugin* problem) {
   fmt::print("{}\n", text.str());
 }
 
+// The scene file names the problem; `--problem` on the command line may only repeat it.
+void check_problem_not_overridden(const cli::ProblemPlugin& entry,
+                                  const std::vector<std::string>& rest) {
+  for (std::size_t i = 0; i < rest.size(); ++i) {
+    std::string given;
+    if (rest[i] == "--problem" && i + 1 < rest.size()) given = rest[i + 1];
+    if (rest[i].rfind("--problem=", 0) == 0) given = rest[i].substr(10);
+    if (!given.empty() && given != entry.name)
+      throw core::InputError("problem", fmt::format("is the scene file's ({}); it cannot be "
+                                                    "changed on the command line (got '{}')",
+                                                    entry.name, given));
+  }
+}
+
 // --resume DIR: the run's own resolved scene, its branch and folder in front of the other
 // arguments. Returns DIR (empty without --resume).
 std::filesystem::path take_resume(std::vector<std::string>& args) {
@@ -101,6 +115,7 @@ int run_trace(const std::vector<std::string>& args_in) {
     print_help(&entry);
     return core::exit_ok;
   }
+  check_problem_not_overridden(entry, rest);
   po::options_description keys = entry.scene_keys();
   keys.add(cli::continuation_keys(keys));
   cli::TraceRun t = cli::prepare_trace(entry, core::read_scene(keys, args[0], rest, driver_keys()),

@@ -15,6 +15,24 @@
 
 namespace backbone::cli {
 
+namespace {
+
+// Every bound names an observable of the problem (its observables at the guess).
+void check_bounds(const core::Problem& problem, const core::Vector& guess,
+                  const continuation::ContinuationOptions& options) {
+  if (options.bounds.empty()) return;
+  std::vector<std::string> names;
+  for (const auto& [name, value] : problem.observables(guess)) names.push_back(name);
+  for (const continuation::Bound& b : options.bounds)
+    if (std::find(names.begin(), names.end(), b.observable) == names.end())
+      throw core::InputError("bound",
+                             fmt::format("'{}' is not an observable of {} (its "
+                                         "observables: {})",
+                                         b.observable, problem.name(), fmt::join(names, ", ")));
+}
+
+}  // namespace
+
 TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
                        std::filesystem::path resume) {
   TraceRun t;
@@ -36,6 +54,10 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
   const long start_direction = scene.integer("direction", -1);
   if (start_direction != 1 && start_direction != -1)
     throw core::InputError("direction", fmt::format("must be 1 or -1 (got {})", start_direction));
+  if (!scene.values()["direction"].defaulted() && !scene.has("start") && t.resume.empty())
+    throw core::InputError("direction",
+                           "applies with --start DIR:K or --resume DIR only (the way "
+                           "the saved branch goes on)");
 
   t.setup = entry.setup(scene, t.branch_name);
   if (!t.setup.problem) throw core::InputError("problem", "setup returned no problem");
@@ -54,11 +76,18 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
 
   const std::string restart_key = t.resume.empty() ? "start" : "resume";
   if (!t.resume.empty()) {
+    t.lock = std::make_unique<core::FolderLock>("resume", t.resume);
     continuation::repair_branch_files(t.resume, "resume");
     t.restart = continuation::restart_point(t.resume, -1, options, "resume");
     t.restart->record_saved_point = false;  // it is in the files
   } else if (scene.has("start")) {
     const auto [dir, point] = continuation::parse_saved_point(scene.text("start"), "start");
+    std::error_code same_error;
+    if (std::filesystem::equivalent(dir, t.out, same_error))
+      throw core::InputError("out", fmt::format("'{}' is the folder --start reads from: its "
+                                                "points would be overwritten (write elsewhere, "
+                                                "or --resume {} to go on in it)",
+                                                t.out.string(), dir.string()));
     t.restart = continuation::restart_point(dir, point, options, "start");
   }
   if (t.restart)
@@ -71,12 +100,16 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
                                                  "residual has {} equations for {} unknowns "
                                                  "(use newton = eigen, least squares)",
                                                  entry.name, m, n));
+  check_bounds(problem, t.setup.guess, options);
   // A consistent overdetermined system (m > n - 1) still has curves of solutions.
   t.expected_dimension = n - std::min(m, n - 1);
   return t;
 }
 
 void print_trace_header(TraceRun& t) {
+  if (!t.scene.has("branch"))
+    fmt::print("branch {}: the first of {}'s branches ({}; choose with --branch NAME)\n",
+               t.branch_name, t.entry->name, fmt::join(t.entry->branches, ", "));
   const continuation::ContinuationOptions& options = t.options();
   const core::Problem& problem = t.problem();
   fmt::print("{} / {}: {} equations in {} unknowns, expected manifold dimension {}\n",
@@ -97,8 +130,15 @@ void print_trace_header(TraceRun& t) {
                      : "");
 }
 
+namespace {
+TraceRun& locked(TraceRun& t) {
+  if (!t.lock) t.lock = std::make_unique<core::FolderLock>("out", t.out);
+  return t;
+}
+}  // namespace
+
 TraceReport::TraceReport(TraceRun& t)
-    : t_(t),
+    : t_(locked(t)),
       writer_(t.out, t.periodic, t.restart.has_value() && !t.resume.empty()),
       progress_(t.options()) {}
 
@@ -162,6 +202,15 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
                       [](const continuation::BranchPointReport& r) { return r.verified(); });
     fmt::print("branch points located by this run: {} ({} verified; branch_points.csv)\n",
                branch.branch_points.size(), verified);
+  }
+  const continuation::FollowSelection& selection = t.run.follow.selection;
+  if (selection.kind == continuation::FollowSelection::Kind::one &&
+      selection.k > static_cast<int>(branch.branch_points.size())) {
+    fmt::print(stderr,
+               "backbone trace: --follow {}: this run located {} branch points "
+               "(branch_points.csv), nothing to follow\n",
+               selection.k, branch.branch_points.size());
+    followed_complete = false;
   }
   if (branch.points.empty()) return followed_complete;
   const core::Table table = core::Table::read_csv(t.out / "branch.csv");

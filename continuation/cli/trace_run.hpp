@@ -27,6 +27,7 @@
 #include "continuation/outputs.hpp"
 #include "continuation/restart.hpp"
 #include "core/newton.hpp"
+#include "core/output_folder.hpp"
 #include "core/periodic_orbit.hpp"
 #include "core/scene.hpp"
 
@@ -46,6 +47,9 @@ struct TraceRun {
   core::Vector direction;                          // the first tangent's hint
   std::optional<continuation::RestartPoint> restart;
   int expected_dimension = 0;
+  // One writer of `out` at a time: taken before a resume repairs the saved files, else by
+  // TraceReport once every check has passed.
+  std::unique_ptr<core::FolderLock> lock;
 
   const core::Problem& problem() const { return *setup.problem; }
   continuation::ContinuationOptions& options() { return run.options; }
@@ -63,7 +67,8 @@ void print_trace_header(TraceRun& t);
 
 // What the run reports as it goes: every point into the branch files (BranchWriter; after a
 // resume, appended) and a line on the screen, the located branch points, the rejected steps,
-// and summary.txt (summary()).
+// and summary.txt (summary()). It takes the lock of t.out (TraceRun::lock) when the run does
+// not hold it yet: a second run into the same folder is refused before it writes anything.
 class TraceReport {
  public:
   explicit TraceReport(TraceRun& t);
@@ -91,7 +96,8 @@ class TraceReport {
 
 // After the run: the number of located branch points, the figure and the extra outputs of the
 // whole branch (saved points included), then the followed branches. Returns whether every
-// followed branch reached its bound or budget.
+// followed branch reached its bound or budget (false too when `--follow K` names a row the
+// run did not locate).
 bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
                               const continuation::ContinuationHooks& hooks);
 

@@ -1,0 +1,103 @@
+// `backbone trace` and `backbone inspect` on input that names something the run cannot honour:
+// each is refused before any work (exit 2, one line naming the key, nothing written), or, when
+// it can only be known after the run, fails the run (exit 1) instead of passing in silence.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+
+#include "core/output_folder.hpp"
+#include "core/table.hpp"
+#include "tests/drivers/cli_run.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string scene =
+    std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
+// A short mode-1 branch: 20 intervals, a few points up to E = 2e-5 J (a tenth of a second).
+const std::string small = scene + " --branch mode1 --shooting_elements 20 --energy_max 2e-5";
+
+// Runs the binary and returns its standard output (exit code in `code`).
+std::string stdout_of(const std::string& arguments, int& code) {
+  const std::string command =
+      std::string(BACKBONE_BINARY_DIR) + "/bin/backbone " + arguments + " 2> /dev/null";
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
+  std::string text;
+  std::array<char, 4096> buffer{};
+  while (pipe && fgets(buffer.data(), buffer.size(), pipe.get())) text += buffer.data();
+  const int status = pclose(pipe.release());
+  code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return text;
+}
+
+TEST(TraceInput, BoundOnAnObservableTheProblemDoesNotHaveIsBadInput) {
+  cli::expect_bad_input("trace", small + " --bound nosuch:0:1", "bound", "trace_input");
+}
+
+TEST(TraceInput, DirectionWithoutAStartIsBadInput) {
+  cli::expect_bad_input("trace", small + " --direction -1", "direction", "trace_input");
+}
+
+TEST(TraceInput, ProblemCannotBeChangedOnTheCommandLine) {
+  cli::expect_bad_input("trace", small + " --problem duffing", "problem", "trace_input");
+}
+
+TEST(TraceInput, StartingFromTheOutputFolderIsRefusedAndKeepsItsPoints) {
+  const fs::path out = cli::scratch("trace_input", "branch");
+  ASSERT_EQ(cli::run("trace", small, out).code, 0);
+  const std::size_t rows = backbone::core::Table::read_csv(out / "branch.csv").rows();
+  ASSERT_GT(rows, 4u);
+  const cli::Run again = cli::run("trace", small + " --start " + (out / "orbits.csv:3").string(),
+                                  out, out.string() + ".again.stderr");
+  EXPECT_EQ(again.code, 2) << again.err;
+  EXPECT_NE(again.err.find("out"), std::string::npos) << again.err;
+  EXPECT_EQ(backbone::core::Table::read_csv(out / "branch.csv").rows(), rows);
+}
+
+TEST(TraceInput, SecondWriterIntoAFolderIsRefusedBeforeItWrites) {
+  const fs::path out = cli::scratch("trace_input", "locked");
+  const backbone::core::FolderLock first("out", out);  // the first writer, in this process
+  const cli::Run r = cli::run("trace", small, out);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("another run is writing"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(out));
+}
+
+TEST(TraceInput, FollowingARowTheRunDidNotLocateFailsTheRun) {
+  // 40 intervals up to 3e-5 J locate two candidates (results/mode1_resonances at the main job's
+  // settings): row 99 does not exist.
+  const fs::path out = cli::scratch("trace_input", "follow");
+  const cli::Run r = cli::run("trace",
+                              scene +
+                                  " --branch mode1 --shooting_elements 40 --energy_max 3e-5 "
+                                  "--detect_branch_points true --follow 99",
+                              out);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("--follow 99"), std::string::npos) << r.err;
+}
+
+TEST(TraceInput, TheDefaultBranchIsAnnounced) {
+  const fs::path out = cli::scratch("trace_input", "default");
+  int code = -1;
+  const std::string text = stdout_of(
+      "trace " + scene + " --shooting_elements 20 --energy_max 2e-5 --out " + out.string(), code);
+  EXPECT_EQ(code, 0);
+  EXPECT_NE(text.find("branch mode1: the first of contact_bar's branches"), std::string::npos)
+      << text;
+  const std::string chosen = stdout_of("trace " + small + " --out " + out.string() + "2", code);
+  EXPECT_EQ(chosen.find("the first of"), std::string::npos) << chosen;
+}
+
+TEST(InspectInput, HelpIsAnswered) {
+  int code = -1;
+  EXPECT_NE(stdout_of("inspect --help", code).find("usage: backbone inspect"), std::string::npos);
+  EXPECT_EQ(code, 0);
+  EXPECT_NE(stdout_of("inspect " + scene + " --help", code).find("usage"), std::string::npos);
+  EXPECT_EQ(code, 0);
+}
+
+}  // namespace
