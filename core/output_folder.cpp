@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <climits>
 #include <cstring>
 #include <system_error>
 
@@ -37,6 +38,18 @@ std::error_code probe_folder_creation(const fs::path& directory) {
 
 void check_output_folder(const std::string& key, const fs::path& folder) {
   if (folder.empty()) throw InputError(key, "must not be empty");
+  // The system's limits on a path and on each name in it (PATH_MAX, NAME_MAX).
+  std::error_code absolute_error;
+  const std::string whole = fs::absolute(folder, absolute_error).string();
+  if (whole.size() >= PATH_MAX)
+    throw InputError(key, fmt::format("the path is {} characters long, more than the system's "
+                                      "limit of {}",
+                                      whole.size(), PATH_MAX - 1));
+  for (const fs::path& name : folder)
+    if (name.string().size() > NAME_MAX)
+      throw InputError(key, fmt::format("a folder name of {} characters is longer than the "
+                                        "system's limit of {}",
+                                        name.string().size(), NAME_MAX));
   std::error_code error;
   const fs::file_status status = fs::status(folder, error);
   if (fs::exists(status)) {

@@ -17,6 +17,7 @@
 #include "continuation/cli/bench_report.hpp"
 #include "core/errors.hpp"
 #include "core/finite_difference.hpp"
+#include "core/output_folder.hpp"
 #include "core/scene.hpp"
 #include "drivers/internal/commands.hpp"
 #include "drivers/internal/plugins.hpp"
@@ -70,6 +71,7 @@ int run_bench(const std::vector<std::string>& args) {
   core::set_default_jacobian_threads(static_cast<int>(
       std::clamp<long>(vm["threads"].as<long>(), 0, core::max_jacobian_threads + 1)));
   const std::filesystem::path out = vm["out"].as<std::string>();
+  core::check_output_folder("out", out);
   int status = core::exit_ok;
   for (const cli::ProblemJob* job : jobs) {
     const auto start = std::chrono::steady_clock::now();
@@ -91,8 +93,7 @@ namespace backbone::drivers {
 
 Command bench_command() {
   return {"bench", "[--problem NAME] [--case NAME] [--out DIR] [--threads K]",
-     "benchmarks with known answers (CSV, PNG and BENCHMARKS.md in results/bench)",
-     run_bench};
+          "benchmarks with known answers (CSV, PNG and BENCHMARKS.md in results/bench)", run_bench};
 }
 
 }  // namespace backbone::drivers

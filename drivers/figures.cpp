@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/output_folder.hpp"
 #include "core/scene.hpp"
 #include "drivers/internal/commands.hpp"
 #include "drivers/internal/plugins.hpp"
@@ -34,6 +35,11 @@ int run_figures(const std::vector<std::string>& args) {
     return core::exit_ok;
   }
   const std::filesystem::path out = vm["out"].as<std::string>();
+  if (!std::filesystem::is_directory(out))
+    throw core::InputError("out", fmt::format("'{}' is not a folder of traced branches (backbone "
+                                              "reproduce --out DIR writes one)",
+                                              out.string()));
+  core::check_output_folder("out", out);
   int status = core::exit_ok;
   for (const auto& plugin : plugins().all())
     for (const auto& job : plugin.figures) status = std::max(status, job.run(out));
@@ -46,8 +52,8 @@ int run_figures(const std::vector<std::string>& args) {
 namespace backbone::drivers {
 
 Command figures_command() {
-  return {"figures", "[--out DIR]", "draw every problem's figures from the branches traced into DIR",
-     run_figures};
+  return {"figures", "[--out DIR]",
+          "draw every problem's figures from the branches traced into DIR", run_figures};
 }
 
 }  // namespace backbone::drivers

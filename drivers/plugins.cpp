@@ -25,8 +25,7 @@ const cli::PluginRegistry& plugins() {
   return registry;
 }
 
-const cli::ProblemPlugin& plugin_for_scene(const std::string& scene_path,
-                                                    const std::string& what) {
+const cli::ProblemPlugin& plugin_for_scene(const std::string& scene_path, const std::string& what) {
   const std::string name = core::scene_problem_name(scene_path);
   const auto can = [&](const cli::ProblemPlugin& p) {
     return what == "simulate" ? p.can_simulate() : p.can_trace();

@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "core/errors.hpp"
+#include "core/output_folder.hpp"
 #include "core/scene.hpp"
 #include "core/table.hpp"
 #include "drivers/internal/commands.hpp"
@@ -64,6 +65,7 @@ int run_reproduce(const std::vector<std::string>& args) {
     if (steps.empty())
       throw backbone::core::InputError("only", fmt::format("no step named '{}'", only));
   }
+  backbone::core::check_output_folder("out", out);
 
   backbone::core::Table summary({"step", "exit_code", "seconds"});
   std::vector<std::string> failed;
@@ -114,7 +116,7 @@ namespace backbone::drivers {
 
 Command reproduce_command() {
   return {"reproduce", "[--out DIR] [--quick] [--only STEP]",
-     "reproduce every figure and table into results/", run_reproduce};
+          "reproduce every figure and table into results/", run_reproduce};
 }
 
 }  // namespace backbone::drivers

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <climits>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -90,6 +91,39 @@ TEST(TraceInput, TheDefaultBranchIsAnnounced) {
       << text;
   const std::string chosen = stdout_of("trace " + small + " --out " + out.string() + "2", code);
   EXPECT_EQ(chosen.find("the first of"), std::string::npos) << chosen;
+}
+
+TEST(OutputFolderInput, AFolderThatCannotBeCreatedIsBadInputForEveryCommand) {
+  // /proc takes no new folders; bench and reproduce checked nothing before their first case.
+  const fs::path proc = "/proc/backbone_test";
+  for (const std::string command : {"bench --case tdbem_scaling", "reproduce --only mode1"}) {
+    const cli::Run r = cli::run(command, "", proc, cli::scratch("cli_input", "err"));
+    EXPECT_EQ(r.code, 2) << command << "\n" << r.err;
+    EXPECT_NE(r.err.find("out: cannot create"), std::string::npos) << r.err;
+  }
+}
+
+TEST(OutputFolderInput, NamesAndPathsBeyondTheSystemsLimitsAreBadInput) {
+  const fs::path parent = cli::scratch("cli_input", "long");
+  const std::string long_name(NAME_MAX + 1, 'a');  // one character over the limit of a name
+  const cli::Run name =
+      cli::run("trace", small, parent / long_name, parent.string() + ".name.stderr");
+  EXPECT_EQ(name.code, 2) << name.err;
+  EXPECT_NE(name.err.find("longer than the system's limit"), std::string::npos) << name.err;
+  fs::path deep = parent;  // PATH_MAX reached by names each within NAME_MAX
+  while (deep.string().size() < PATH_MAX) deep /= std::string(200, 'b');
+  const cli::Run path = cli::run("simulate", scene, deep, parent.string() + ".path.stderr");
+  EXPECT_EQ(path.code, 2) << path.err;
+  EXPECT_NE(path.err.find("characters long"), std::string::npos) << path.err;
+  EXPECT_FALSE(fs::exists(parent / std::string(200, 'b')));
+}
+
+TEST(FiguresInput, AFolderWithoutTracedBranchesIsBadInput) {
+  const fs::path missing = cli::scratch("cli_input", "no_such_folder");
+  const cli::Run r = cli::run("figures", "", missing);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("out:"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(missing));
 }
 
 TEST(InspectInput, HelpIsAnswered) {
