@@ -4,6 +4,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -53,13 +54,52 @@ std::string locate_scene(const std::string& ini_path) {
   return std::filesystem::is_regular_file(shipped, error) ? shipped.string() : ini_path;
 }
 
+// A scene file is a regular text file of at most this many bytes (the shipped ones are < 1 KiB).
+constexpr std::uintmax_t max_scene_bytes = 1 << 20;
+
+// Refuses what is not a scene's text: NUL bytes (a binary file), UTF-16 (a byte-order mark of
+// FF FE or FE FF; Boost would read it as raw bytes), and [section] headers (Boost would prefix
+// every key after one with the section's name, so `problem` would not be found).
+void check_scene_text(const std::string& path, const std::string& content) {
+  if (content.rfind("\xff\xfe", 0) == 0 || content.rfind("\xfe\xff", 0) == 0)
+    throw InputError("scene", fmt::format("'{}' is UTF-16 text: save it as UTF-8", path));
+  if (const auto nul = content.find('\0'); nul != std::string::npos)
+    throw InputError("scene",
+                     fmt::format("'{}' holds a NUL byte at offset {}: not a text file", path, nul));
+  std::istringstream lines(content);
+  std::string line;
+  for (int number = 1; std::getline(lines, line); ++number) {
+    const auto first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line[first] == '[')
+      throw InputError("scene", fmt::format("'{}' line {}: a scene has no [sections], only flat "
+                                            "`key = value` lines",
+                                            path, number));
+  }
+}
+
 // The file's text without a leading UTF-8 byte-order mark (Boost would read it as part of the
-// first key: "unrecognised option '\ufeffproblem'").
+// first key: "unrecognised option '\ufeffproblem'"). Only a regular file of at most
+// max_scene_bytes is read: a device (/dev/zero) or a FIFO is refused before it is opened.
 std::istringstream open_scene(const std::string& given_path) {
+  if (given_path.rfind("--", 0) == 0)
+    throw InputError("scene", fmt::format("the scene file comes first: backbone COMMAND SCENE "
+                                          "[--key value ...] (got '{}' in its place)",
+                                          given_path));
   const std::string ini_path = locate_scene(given_path);
   std::error_code error;
-  if (std::filesystem::is_directory(ini_path, error))
+  const std::filesystem::file_status status = std::filesystem::status(ini_path, error);
+  if (std::filesystem::is_directory(status))
     throw InputError("scene", fmt::format("'{}' is a directory, not a scene file", ini_path));
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw InputError("scene", fmt::format("'{}' is not a regular file (a device, FIFO or "
+                                          "socket), not a scene file",
+                                          ini_path));
+  if (std::filesystem::exists(status)) {
+    const std::uintmax_t bytes = std::filesystem::file_size(ini_path, error);
+    if (!error && bytes > max_scene_bytes)
+      throw InputError("scene", fmt::format("'{}' has {} bytes; a scene file has at most {}",
+                                            ini_path, bytes, max_scene_bytes));
+  }
   std::ifstream in(ini_path);
   if (!in)
     throw InputError("scene", fmt::format("cannot read scene file '{}' (nor in the source tree "
@@ -70,6 +110,7 @@ std::istringstream open_scene(const std::string& given_path) {
   std::string content = text.str();
   if (content.rfind(utf8_byte_order_mark, 0) == 0)
     content.erase(0, std::string_view(utf8_byte_order_mark).size());
+  check_scene_text(ini_path, content);
   return std::istringstream(content);
 }
 

@@ -2,6 +2,7 @@
 // each is refused before any work (exit 2, one line naming the key, nothing written), or, when
 // it can only be known after the run, fails the run (exit 1) instead of passing in silence.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <array>
 #include <climits>
@@ -124,6 +125,34 @@ TEST(FiguresInput, AFolderWithoutTracedBranchesIsBadInput) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("out:"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(missing));
+}
+
+// Writes `bytes` as a scene file in the test's scratch folder.
+fs::path scene_file(const std::string& name, const std::string& bytes) {
+  const fs::path path = cli::scratch("cli_input", name);
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
+TEST(SceneFileInput, WhatIsNotASceneIsRefusedBeforeItIsRead) {
+  const fs::path fifo = cli::scratch("cli_input", "fifo");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);  // reading it would block forever
+  const std::string paper_keys = "problem = contact_bar\n";
+  for (const std::string& path :
+       {std::string("/dev/zero"), fifo.string(),
+        scene_file("large.ini", paper_keys + std::string(2 << 20, '#')).string(),
+        scene_file("nul.ini", paper_keys + std::string("gap = 1e-3\0\n", 12)).string(),
+        scene_file("utf16.ini", std::string("\xff\xfep\0r\0o\0", 8)).string(),
+        scene_file("section.ini", "[bar]\n" + paper_keys).string()})
+    cli::expect_bad_input("trace", path + " --branch mode1", "scene", "cli_input_scene");
+}
+
+TEST(SceneFileInput, TheSceneFileComesFirst) {
+  const fs::path out = cli::scratch("cli_input", "order");
+  const cli::Run r = cli::run("trace", "--branch mode1 " + scene, out);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("the scene file comes first"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(InspectInput, HelpIsAnswered) {
