@@ -43,15 +43,12 @@ std::string message_of(const po::error& e) {
   throw InputError("", where.empty() ? message : where + ": " + message);
 }
 
-// A relative path that names no file here is looked up in the source tree the binary was built
-// from, so that the shipped scenes (`problems/contact_bar/scenes/paper.ini`, and the steps of
-// `backbone reproduce`) work from any directory (core/README.md, 'Scenes, tables, plots').
 std::string locate_scene(const std::string& ini_path) {
   std::error_code error;
   const std::filesystem::path path(ini_path);
   if (path.empty() || path.is_absolute() || std::filesystem::exists(path, error)) return ini_path;
-  const std::filesystem::path shipped = std::filesystem::path(BACKBONE_SOURCE_DIR) / path;
-  return std::filesystem::is_regular_file(shipped, error) ? shipped.string() : ini_path;
+  const std::filesystem::path shipped = shipped_path(path);
+  return shipped.empty() ? ini_path : shipped.string();
 }
 
 // A scene file is a regular text file of at most this many bytes (the shipped ones are < 1 KiB).
@@ -132,6 +129,17 @@ std::vector<std::string> glue_negative_values(const std::vector<std::string>& wo
 }
 
 }  // namespace
+
+std::filesystem::path shipped_path(const std::filesystem::path& relative) {
+  std::error_code error;
+  std::vector<std::filesystem::path> roots;
+  const std::filesystem::path executable = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) roots.push_back(executable.parent_path().parent_path() / "share" / "backbone");
+  roots.emplace_back(BACKBONE_SOURCE_DIR);
+  for (const std::filesystem::path& root : roots)
+    if (std::filesystem::exists(root / relative, error)) return root / relative;
+  return {};
+}
 
 double Scene::number(const std::string& key) const {
   if (!has(key)) throw InputError(key, "is required but was not given");

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <boost/program_options.hpp>
+#include <filesystem>
 #include <initializer_list>
 #include <limits>
 #include <string>
@@ -70,5 +71,12 @@ po::variables_map parse_options(const po::options_description& keys,
 // The value of the `problem` key of an INI file (empty when absent), read before the
 // problem's keys are known. Throws InputError when the file cannot be read.
 std::string scene_problem_name(const std::string& ini_path);
+
+// A file or folder shipped with backbone (scenes, stored peer data), by its path in the source
+// tree (`problems/contact_bar/scenes/paper.ini`): PREFIX/share/backbone/PATH of the install the
+// running executable belongs to, else the source tree the binary was built from; empty when
+// neither holds it. A relative scene path that names no file in the working directory is looked
+// up there, so the shipped scenes (and the steps of `backbone reproduce`) work from any folder.
+std::filesystem::path shipped_path(const std::filesystem::path& relative);
 
 }  // namespace backbone::core

@@ -4,7 +4,8 @@
 #         [-DCMAKE_CXX_COMPILER=...] [-DCMAKE_CXX_COMPILER_LAUNCHER=...]
 #         [-DCONSUMER_CXX_FLAGS=...]   (the backbone build's CMAKE_CXX_FLAGS, e.g. sanitizers)
 #         -P tests/examples/install_and_run.cmake
-# 1. installs the build into <build>/examples/prefix (cmake --install),
+# 1. installs the build into <build>/examples/prefix (cmake --install), checks that the shipped
+#    scenes are there and that the installed `backbone` traces one from another folder,
 # 2. configures each example in a fresh <build>/examples/<name> with CMAKE_PREFIX_PATH set to
 #    that prefix (searched first by find_package), so it sees the installed package only,
 # 3. builds it and runs its CLI: `--help`, `trace` on the example's scene (exit 0: the branch
@@ -33,6 +34,22 @@ function(run_step name)
 endfunction()
 
 run_step("install" ${CMAKE_COMMAND} --install ${BACKBONE_BINARY_DIR} --prefix ${prefix})
+# The shipped scenes are installed, and the installed CLI traces one from any folder.
+foreach(shipped problems/contact_bar/scenes/paper.ini problems/duffing/scenes/duffing.ini
+                problems/contact_bar/bench/peers/lu_legrand_runs.csv)
+  if(NOT EXISTS ${prefix}/share/backbone/${shipped})
+    message(FATAL_ERROR "install: ${shipped} is not installed under share/backbone")
+  endif()
+endforeach()
+file(MAKE_DIRECTORY ${work}/elsewhere)
+execute_process(COMMAND ${prefix}/bin/backbone trace problems/duffing/scenes/duffing.ini
+                        --bound amplitude:0.005:0.1 --out ${work}/out/installed_duffing
+                WORKING_DIRECTORY ${work}/elsewhere RESULT_VARIABLE status
+                OUTPUT_VARIABLE out ERROR_VARIABLE out)
+if(NOT status EQUAL 0)
+  message(FATAL_ERROR "installed backbone trace of a shipped scene failed (${status}):\n${out}")
+endif()
+message(STATUS "installed backbone traces a shipped scene: ok")
 
 function(build_example name)
   set(build ${work}/${name})
