@@ -2,13 +2,47 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
+#include <system_error>
 
 #include "core/table.hpp"
 
 namespace backbone::cli {
 
+namespace {
+
+// The section of a case that writes no markdown of its own: its summary, then its tables
+// (<case>*.csv) and figures (<case>*.png) found in `out`, or a line saying it has not run here.
+std::string files_section(const std::filesystem::path& out, const std::string& name,
+                          const std::string& summary) {
+  std::vector<std::string> tables, figures;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(out, error)) {
+    const std::string file = entry.path().filename().string();
+    if (file.rfind(name, 0) != 0) continue;
+    const std::string rest = file.substr(name.size());
+    if (!rest.empty() && rest[0] != '.' && rest[0] != '_') continue;  // another case's prefix
+    if (entry.path().extension() == ".csv") tables.push_back(file);
+    if (entry.path().extension() == ".png") figures.push_back(file);
+  }
+  std::sort(tables.begin(), tables.end());
+  std::sort(figures.begin(), figures.end());
+  if (tables.empty() && figures.empty())
+    return fmt::format("## {}\n\n{} (not run into this folder: `backbone bench --case {}`).\n",
+                       name, summary, name);
+  std::string text = fmt::format("## {}\n\n{}.\n", name, summary);
+  if (!tables.empty()) {
+    text += "\nTables:";
+    for (const std::string& t : tables) text += fmt::format(" [{0}]({0})", t);
+    text += "\n";
+  }
+  for (const std::string& figure : figures) text += fmt::format("\n![{0}]({0})\n", figure);
+  return text;
+}
+
+}  // namespace
 
 std::filesystem::path bench_section_path(const std::filesystem::path& out,
                                          const std::string& case_name) {
@@ -41,9 +75,7 @@ std::filesystem::path write_bench_report(
       text << in.rdbuf();
       report += text.str();
     } else {
-      report += fmt::format(
-          "## {}\n\n{} (no section in this folder: the case writes none, or has not run here).\n",
-          name, summary);
+      report += files_section(out, name, summary);
     }
   }
   const std::filesystem::path path = out / "BENCHMARKS.md";

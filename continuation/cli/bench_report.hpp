@@ -7,7 +7,8 @@
 // links to its PNGs (relative to <out>, where BENCHMARKS.md lives too). `backbone bench` then
 // calls write_bench_report with every case it knows: sections found in <out> are concatenated,
 // so running one case (`--case NAME`) refreshes its own section and keeps the others. A case
-// without a section file gets a heading and its summary line only.
+// without a section file gets a heading, its summary line, and links to its tables and figures
+// (<case>.csv, <case>_*.csv, <case>.png, <case>_*.png in <out>).
 //
 //   write_bench_section(out, "duffing_auto", "## Duffing vs AUTO-07p\n\n| ... |\n");
 //   write_bench_report(out, {{"duffing_auto", "Duffing backbone vs AUTO-07p"},

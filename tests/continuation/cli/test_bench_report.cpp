@@ -50,3 +50,25 @@ TEST(BenchReport, SectionsFollowTheCaseListAndMissingOnesGetTheirSummary) {
   EXPECT_NE(again.find("## Second"), std::string::npos);  // kept from the earlier run
   std::filesystem::remove_all(out);
 }
+
+TEST(BenchReport, ACaseWithoutASectionLinksItsOwnTablesAndFigures) {
+  const std::filesystem::path out =
+      std::filesystem::temp_directory_path() / "backbone_test_bench_report_files";
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out);
+  for (const char* file : {"scaling.csv", "scaling.png", "scaling_fit.csv", "scalingx.csv"})
+    std::ofstream(out / file) << "x\n";
+  const std::string text = read(cli::write_bench_report(
+      out, {{"scaling", "cost against N"}, {"never_ran", "a case not run here"}}));
+  EXPECT_NE(text.find("## scaling\n\ncost against N.\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("[scaling.csv](scaling.csv) [scaling_fit.csv](scaling_fit.csv)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("![scaling.png](scaling.png)"), std::string::npos) << text;
+  EXPECT_EQ(text.find("scalingx.csv"), std::string::npos) << text;  // another case's file
+  EXPECT_NE(text.find("## never_ran\n\na case not run here (not run into this folder"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("no section in this folder"), std::string::npos) << text;
+  std::filesystem::remove_all(out);
+}
