@@ -3,7 +3,7 @@
 #   cmake -DBACKBONE_BINARY_DIR=<build> -DEXAMPLES_DIR=<source>/problems/examples
 #         [-DCMAKE_CXX_COMPILER=...] [-DCMAKE_CXX_COMPILER_LAUNCHER=...]
 #         [-DCONSUMER_CXX_FLAGS=...]   (the backbone build's CMAKE_CXX_FLAGS, e.g. sanitizers)
-#         -P tests/examples/install_and_run.cmake
+#         -P tests/problems/examples/install_and_run.cmake
 # 1. installs the build into <build>/examples/prefix (cmake --install), checks that the shipped
 #    scenes are there and that the installed `backbone` traces one from another folder,
 # 2. configures each example in a fresh <build>/examples/<name> with CMAKE_PREFIX_PATH set to
