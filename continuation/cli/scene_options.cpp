@@ -88,8 +88,7 @@ po::options_description continuation_keys(const po::options_description& problem
   add("newton_jacobian_check", po::value<double>()->default_value(1e-2),
       "eigen corrector: accept a compressed Jacobian whose check error is below this fraction, "
       "in [0, 1), of each row (the answer is judged by F alone); rank reports keep the pattern's "
-      "own; 0: "
-      "the pattern's own everywhere");
+      "own; 0: the pattern's own everywhere");
   add("chord_corrections", po::value<bool>()->default_value(true),
       "arclength: start each correction (and each rank-verification probe) with chord steps on "
       "the previous point's Jacobian, a fresh Jacobian only when they contract too slowly");
