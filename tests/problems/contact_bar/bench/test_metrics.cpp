@@ -184,7 +184,8 @@ TEST(BenchMetrics, Mode1ContactEpisodeIsTheExactSolversContact) {
 
 TEST(BenchMetrics, ResidualUnitIsTheGapTheProblemScalesBy) {
   // The orbit problem documents its residual in units of g0 (displacement_scale): the
-  // measured metres per residual unit must be that, whatever the formulation, mode and bar.
+  // metres per residual unit the metric finds must be that, whatever the formulation, mode and
+  // bar.
   bar::BarSetup s;
   s.material = {2.0, 3.0, 1.5, 0.5};
   s.left = {bar::EndType::fixed, 0};
