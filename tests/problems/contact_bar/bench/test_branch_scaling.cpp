@@ -1,4 +1,4 @@
-// The mode-1 branch-cost benchmark's pieces (problems/contact_bar/bench_branch_scaling.hpp): the
+// The mode-1 branch-cost benchmark's pieces (problems/contact_bar/bench/branch_scaling.hpp): the
 // exponent fit against an exact power law, the grid list, and the table of two tiny in-process
 // traces checked against the closed form.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The benchmark metrics of problems/contact_bar/bench_metrics.hpp on exact oracles: power laws
+// The benchmark metrics of problems/contact_bar/bench/metrics.hpp on exact oracles: power laws
 // of known exponent, step means computed by hand, the closed-form bouncing bar and mode 1
 // (against the exact characteristics solver), and the residual scale the problem documents.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// The Duffing benchmark against AUTO-07p (problems/duffing/bench.hpp): backbone's headline run
-// against the exact period, the reader of AUTO's branch file on a file with known errors, and
+// The Duffing benchmark against AUTO-07p (problems/duffing/bench/bench.hpp): backbone's headline
+// run against the exact period, the reader of AUTO's branch file on a file with known errors, and
 // the stored peer runs against the exact period recomputed here.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
