@@ -56,10 +56,8 @@ boost::program_options::options_description scene_keys() {
   keys.add_options()  //
       ("amplitude", po::value<double>()->default_value(0.01),
        "starting amplitude x0 of the backbone (v0 = 0) [dimensionless] (> 0)")  //
-      (
-          "period_guess", po::value<double>(),
-          "starting guess of the period [dimensionless time] (> 0; default: the linear period 2 "
-          "pi)")  //
+      ("period_guess", po::value<double>(),
+       "starting guess of the period [dimensionless] (> 0; default: the linear period 2 pi)")  //
       ("rtol", po::value<double>()->default_value(1e-13),
        "CVODE relative tolerance [-] (in (0, 1e-3))");
   return keys;
