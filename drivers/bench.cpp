@@ -36,10 +36,13 @@ std::string case_names() {
 
 int run_bench(const std::vector<std::string>& args) {
   po::options_description keys("backbone bench");
-  keys.add_options()("problem", po::value<std::string>(), "only this problem's cases")(
-      "case", po::value<std::string>(), "only this case (default: all)")(
-      "out", po::value<std::string>()->default_value("results/bench"), "output directory")(
-      "threads", po::value<long>()->default_value(1), "finite-difference Jacobian threads")(
+  keys.add_options()("problem", po::value<std::string>(),
+                     "only this problem's cases (a registered problem name)")(
+      "case", po::value<std::string>(), "only this case, by name (default: all; listed below)")(
+      "out", po::value<std::string>()->default_value("results/bench"),
+      "output directory of the tables, figures and BENCHMARKS.md")(
+      "threads", po::value<long>()->default_value(1),
+      "finite-difference Jacobian threads of the cases that run continuation (1 to 256)")(
       "help", "describe the command");
   const po::variables_map vm = backbone::core::parse_options(keys, args);
   if (vm.count("help")) {

@@ -18,10 +18,9 @@ namespace backbone::drivers {
 namespace {
 
 // glibc serves every block above 128 KiB by its own mmap and returns it on free, so each dense
-// Jacobian, QR or bordered system of a fine grid (6.5 MB at N = 640) is faulted in page by
-// page again: on this project's (virtualised) machines that was 2.7 of the 7.7 s of mode 1 at
-// N = 640 without rank checks, and most of the run-to-run scatter. Served from the heap and
-// kept there, the same trace takes 2.7 s (drivers/README.md, 'Memory').
+// Jacobian, QR or bordered system of a fine grid (6.5 MB at N = 640) would be faulted in page by
+// page on every evaluation. Blocks up to 256 MiB come from the heap and up to 512 MiB of freed
+// heap is kept, so large blocks are reused in place (drivers/README.md, 'Memory').
 void keep_large_blocks() {
 #if defined(__GLIBC__)
   mallopt(M_MMAP_THRESHOLD, 256 << 20);

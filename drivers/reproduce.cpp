@@ -47,9 +47,10 @@ std::vector<ReproduceStep> plan(const std::string& out, bool quick) {
 int run_reproduce(const std::vector<std::string>& args) {
   po::options_description keys("backbone reproduce [--out DIR] [--quick] [--only NAME]");
   keys.add_options()("help", "describe the command")(
-      "out", po::value<std::string>()->default_value("results"), "output folder")(
-      "quick", po::bool_switch(), "skip the benchmarks (bench)")("only", po::value<std::string>(),
-                                                                 "run one step by name");
+      "out", po::value<std::string>()->default_value("results"),
+      "output folder of every step's figures and tables, and of reproduce.csv")(
+      "quick", po::bool_switch(), "skip the benchmarks (bench)")(
+      "only", po::value<std::string>(), "run one step by name (listed below)");
   const po::variables_map vm = backbone::core::parse_options(keys, args);
   if (vm.count("help")) {
     std::string names;

@@ -25,8 +25,10 @@ const char* const usage = "SCENE [--out DIR] [--key value ...]";
 
 po::options_description driver_keys() {
   po::options_description keys("simulate");
-  keys.add_options()("out", po::value<std::string>()->default_value("simulate_out"),
-                     "output directory DIR")("help", po::bool_switch(), "print the keys and exit");
+  keys.add_options()(
+      "out", po::value<std::string>()->default_value("simulate_out"),
+      "output directory DIR (existing or creatable; written after a successful run)")(
+      "help", po::bool_switch(), "print the keys and exit");
   return keys;
 }
 

@@ -39,21 +39,28 @@ po::options_description continuation_keys(const po::options_description& problem
   add("formulation", po::value<std::string>()->default_value("regular"),
       "shooting residual: regular (v(T/2) = 0) or paper (u0 - u(T) = 0)");
   add("ds", po::value<double>()->default_value(0.01),
-      "first step, in unknowns divided by their typical scale (dimensionless)");
-  add("ds_min", po::value<double>()->default_value(1e-8), "smallest step before giving up");
-  add("ds_max", po::value<double>()->default_value(0.5), "largest step (dimensionless)");
-  add("max_points", po::value<long>()->default_value(200), "points on the branch, first included");
-  add("energy_min", po::value<double>()->default_value(-inf), "stop below this energy");
-  add("energy_max", po::value<double>()->default_value(inf), "stop above this energy");
-  add("period_min", po::value<double>()->default_value(-inf), "stop below this period");
-  add("period_max", po::value<double>()->default_value(inf), "stop above this period");
+      "first step, in unknowns divided by their typical scale (dimensionless, in [ds_min, "
+      "ds_max])");
+  add("ds_min", po::value<double>()->default_value(1e-8),
+      "smallest step (dimensionless, in (0, ds]): the run stops when a step this small fails");
+  add("ds_max", po::value<double>()->default_value(0.5), "largest step (dimensionless, >= ds)");
+  add("max_points", po::value<long>()->default_value(200),
+      "points on the branch, first included (>= 1)");
+  add("energy_min", po::value<double>()->default_value(-inf),
+      "stop below this energy (the problem's energy unit; -inf: no bound)");
+  add("energy_max", po::value<double>()->default_value(inf),
+      "stop above this energy (the problem's energy unit; inf: no bound)");
+  add("period_min", po::value<double>()->default_value(-inf),
+      "stop below this period (the problem's time unit; -inf: no bound)");
+  add("period_max", po::value<double>()->default_value(inf),
+      "stop above this period (the problem's time unit; inf: no bound)");
   add("bound", po::value<std::vector<std::string>>()->composing(),
       "NAME:MIN:MAX, stop when observable NAME leaves [MIN, MAX] (empty = unbounded; repeatable)");
   add("rank_check_every", po::value<long>()->default_value(1),
-      "verified rank report every k points (0: never)");
+      "verified rank report every k points (k >= 0; 0: never)");
   add("rank_threshold", po::value<double>()->default_value(1e-8),
-      "rank report: singular values below this times the largest count as zero (candidates; "
-      "verify then keeps only the real directions)");
+      "rank report: singular values below this times the largest count as zero, in (0, 1) "
+      "(candidates; verify then keeps only the real directions)");
   add("verify", po::value<bool>()->default_value(true),
       "re-correct along candidate null directions (verified dimension)");
   add("detect_branch_points", po::value<bool>()->default_value(false),
@@ -67,19 +74,21 @@ po::options_description continuation_keys(const po::options_description& problem
       "1-based row of branch_points.csv) branch point and trace it towards growing energy into "
       "DIR/branch_point_K/ (implies detect_branch_points)");
   add("follow_max_points", po::value<long>()->default_value(30),
-      "points of each followed branch (with the energy bound)");
+      "points of each followed branch (>= 1; with the energy bound)");
   add("max_turn_degrees", po::value<double>()->default_value(20),
-      "arclength: refuse a correction whose step turns by more than this from the predictor "
-      "direction (it landed on another family); 0: off");
-  add("newton_tolerance", po::value<double>()->default_value(1e-10), "||F||_inf to converge");
-  add("newton_max_iterations", po::value<long>()->default_value(25), "Newton iterations per point");
+      "arclength: refuse a correction whose step turns by more than this many degrees (>= 0) "
+      "from the predictor direction (it landed on another family); 0: off");
+  add("newton_tolerance", po::value<double>()->default_value(1e-10),
+      "||F||_inf to converge, in the residual's units (> 0)");
+  add("newton_max_iterations", po::value<long>()->default_value(25),
+      "Newton iterations per point (>= 1)");
   add("newton_reuse_jacobian", po::value<bool>()->default_value(false),
       "eigen corrector: after a fresh Jacobian, take chord steps on its factorization while each "
       "cuts ||F|| tenfold (one residual each), else a fresh Jacobian");
   add("newton_jacobian_check", po::value<double>()->default_value(1e-2),
-      "eigen corrector: accept a compressed Jacobian whose check error is below this fraction "
-      "of each row (the answer is judged by F alone); rank reports keep the pattern's own; 0: "
-      "the pattern's own everywhere");
+      "eigen corrector: accept a compressed Jacobian whose check error is below this fraction, "
+      "in [0, 1), of each row (the answer is judged by F alone); rank reports keep the pattern's "
+      "own; 0: the pattern's own everywhere");
   add("chord_corrections", po::value<bool>()->default_value(true),
       "arclength: start each correction (and each rank-verification probe) with chord steps on "
       "the previous point's Jacobian, a fresh Jacobian only when they contract too slowly");
@@ -87,7 +96,7 @@ po::options_description continuation_keys(const po::options_description& problem
       "natural method: the period unknown or an observable name");
   add("natural_direction", po::value<long>()->default_value(1), "natural method: +1 or -1");
   add("threads", po::value<long>()->default_value(1),
-      "threads for the finite-difference Jacobian columns (same branch, bit for bit)");
+      "threads for the finite-difference Jacobian columns, 1 to 256 (same branch, bit for bit)");
   return keys;
 }
 
@@ -152,7 +161,7 @@ RunSettings read_run_settings(const core::Scene& scene) {
   run.follow.max_points = static_cast<int>(scene.integer("follow_max_points", 1));
   o.branch_points.detect = scene.flag("detect_branch_points") ||
                            run.follow.selection.kind != FollowSelection::Kind::none;
-  // The detector samples its test function at the points: it was measured with the tangent
+  // The detector samples its test function at the points and is sized for the tangent
   // predictor's steps, which the quadratic one lengthens (continuation/README.md, 'Predictors').
   o.predictor = predictor != "auto"      ? parse_predictor(predictor)
                 : o.branch_points.detect ? Predictor::tangent
@@ -164,10 +173,8 @@ RunSettings read_run_settings(const core::Scene& scene) {
   run.newton = scene.choice("newton", {"eigen", "kinsol"});
   run.newton_options.residual_tolerance = scene.positive("newton_tolerance");
   // A probe of the rank verification is a solution by the same standard as a point of the
-  // branch. With a stricter one, a probe that lands on the solution set is refused where the
-  // residual's round-off exceeds it (measured on the contact bar at 80 intervals, end amplitude
-  // 10 g0: probes stalled at 1.4e-9 > 1e-9 with drift 0.05, so the point had verified
-  // dimension 0 while the branch runs through it at newton_tolerance 3e-9).
+  // branch: a stricter one refuses probes on the solution set wherever the residual's round-off
+  // exceeds it, and a point the branch runs through would verify as dimension 0.
   o.verification.residual_tolerance =
       std::max(o.verification.residual_tolerance, run.newton_options.residual_tolerance);
   run.newton_options.max_iterations = static_cast<int>(scene.integer("newton_max_iterations", 1));

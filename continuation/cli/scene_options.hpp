@@ -3,7 +3,7 @@
 // `backbone trace` reads a problem's scene keys plus these (method, predictor, newton,
 // formulation, ds, ds_min, ds_max, max_points, bounds, rank checks, Newton tolerance, natural
 // parameter, threads); a problem that declares one of them itself owns its default (the contact
-// bar's ds is 2, dimensionless). read_run_settings validates them all before any work (InputError
+// bar declares ds and ds_max). read_run_settings validates them all before any work (InputError
 // naming the key); run_continuation dispatches to pseudo_arclength, natural or
 // natural_then_arclength.
 //

@@ -1,5 +1,6 @@
-// Internal to backbone::drivers: the subcommands of a backbone CLI, each a function from its arguments (the words after the
-// subcommand name) to an exit code, one file each (trace.cpp, simulate.cpp, ...).
+// Internal to backbone::drivers: the subcommands of a backbone CLI, each a function from its
+// arguments (the words after the subcommand name) to an exit code, one file each (trace.cpp,
+// simulate.cpp, ...).
 //
 // drivers::main (main.hpp) looks the name up in commands(), runs it, and maps exceptions:
 // core::InputError -> one line on stderr and exit 2; any other exception -> exit 1. A command
@@ -7,7 +8,8 @@
 //
 //   // drivers/version.cpp
 //   Command version_command() { return {"version", "", "print the version", run_version}; }
-//   // commands.cpp lists it: the table is explicit, so a static library keeps every command.
+//   // main.cpp's commands() lists it: the table is explicit, so a static library keeps every
+//   // command.
 #pragma once
 
 #include <functional>

@@ -55,10 +55,11 @@ boost::program_options::options_description scene_keys() {
   po::options_description keys("duffing (x'' + x + x^3 = 0)");
   keys.add_options()  //
       ("amplitude", po::value<double>()->default_value(0.01),
-       "starting amplitude x0 of the backbone (v0 = 0) [length]")  //
+       "starting amplitude x0 of the backbone (v0 = 0) [dimensionless] (> 0)")  //
       ("period_guess", po::value<double>(),
-       "starting guess of the period [time] (default: the linear period 2 pi)")  //
-      ("rtol", po::value<double>()->default_value(1e-13), "CVODE relative tolerance [-]");
+       "starting guess of the period [dimensionless] (> 0; default: the linear period 2 pi)")  //
+      ("rtol", po::value<double>()->default_value(1e-13),
+       "CVODE relative tolerance [-] (in (0, 1e-3))");
   return keys;
 }
 

@@ -12,7 +12,7 @@
 // exact d'Alembert update at the nodes for fixed and free ends (v0 = 0 start-up included),
 // but if both ends are free (or a contact end is open) the grid-scale mode u_i = (-1)^i then
 // has a double amplification factor -1 and grows linearly from round-off and contact kicks
-// (measured: `backbone bench --case bouncing_bar`); use Courant < 1 for long runs.
+// (`backbone bench --case bouncing_bar` shows it); use Courant < 1 for long runs.
 //
 //   fem_bar::FemBarSolver fem;                       // FemOptions{} defaults
 //   bar::SimulationOptions o; o.t_end = 3.1; o.elements = 100; o.dt = 1e-2;  // dt <= dx / c

@@ -2,10 +2,9 @@
 // has the documented columns and holds the branch point of mode 1 at T = 3.2 L/c, located at the
 // exact value; `--follow` switches onto the attached family there and writes its branch.
 //
-// At shooting_elements 40 and E <= 3e-5 the run takes about 4 s and finds two candidates: a dip
-// near T = 3.33 that its probes do not verify, and T = 3.2 with an attached family of
-// dimension 6 or 7 (measured; it depends on N and on round-off, problems/contact_bar/README.md,
-// section 'Dimension changes').
+// At shooting_elements 40 and E <= 3e-5 the run is short and finds two candidates: a dip near
+// T = 3.33 that its probes do not verify, and T = 3.2 with an attached family of dimension 6 or
+// 7 (it depends on N and on round-off, problems/contact_bar/README.md, 'Dimension changes').
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -52,7 +51,7 @@ TEST(BranchPointsCli, BadFollowExitsTwoAndWritesNothing) {
 // The exact branch point: mode 1 of the paper scene (E = rho = L = A = 1, g0 = 1e-3) has
 // u0 = eps x and T = 3 + g0 / |eps| (problems/contact_bar/README.md, 'Mode 1'); at T = 3.2,
 // |eps| = 5e-3, E = eps^2 / 2 = 1.25e-5 and end amplitude 5e-3. Location: 1e-6 relative, the
-// acceptance of the issue for a point found at two resolutions (measured 9e-10 in period).
+// acceptance for a point found at two resolutions.
 TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   const fs::path out = cli::scratch("branch_points_cli", "detect");
   const cli::Run r = cli::run("trace", detecting, out);
@@ -71,7 +70,7 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   EXPECT_NEAR(at("frequency") * 3.2 / (2 * M_PI), 1.0, 1e-6);
   // The located point is corrected on a hyperplane orthogonal to mode 1, which holds the attached
   // directions: it may sit slightly on the attached family, whose energy grows at constant T and
-  // amplitude (measured 1.2e-6 off in energy, 1.4e-8 in amplitude): 1e-5.
+  // amplitude, hence 1e-5 in energy and 1e-6 in amplitude.
   EXPECT_NEAR(at("energy") / 1.25e-5, 1.0, 1e-5);
   EXPECT_NEAR(at("end_amplitude") / 5e-3, 1.0, 1e-6);
   EXPECT_GE(at("dimension"), 1);
@@ -79,9 +78,8 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   EXPECT_GT(at("frequency_ratio"), 2);
   // The attached family leaves transversally to mode 1. The angle is the smallest over the
   // probes of a 7-8 dimensional null space that re-correct, and which do, and where, follows the
-  // round-off of the march: measured 89.996 degrees, 83.6 with an equivalent interpolation
-  // formula in the TD-BEM, 79.6 with its times on the step grid (problems/contact_bar/README.md,
-  // 'Hard cases'). Bound 60 (mode 1 itself would give 0).
+  // round-off of the march (problems/contact_bar/README.md, 'Hard cases'), so the angle moves by
+  // degrees under equivalent formulas. Bound 60 (mode 1 itself would give 0).
   EXPECT_GT(at("tangent_angle"), 60);
   fs::remove_all(out);
 }
@@ -104,11 +102,10 @@ TEST(BranchPointsCli, UnverifiedRowIsNotFollowed) {
 }
 
 // The family attached at T = 3.5 L/c at the paper's 100 intervals has 22-24 dimensions: the
-// bordered Jacobian there has 21-23 singular values at the finite-difference noise, and with
-// Newton's default rank cut-off (1e-12) the minimum-norm steps divided by them: every step
-// turned by 90 degrees and the followed branch ended (step_floor) after 6 points. With the
-// follow corrector's cut-off at the rank threshold (follow_newton_options) it takes its whole
-// budget at constant period (measured 30 of 30, period within 1.2e-12). About 15 s of CPU.
+// bordered Jacobian there has 21-23 singular values at the finite-difference noise, which
+// Newton's default rank cut-off (1e-12) would divide the minimum-norm steps by, turning every
+// step by 90 degrees. The follow corrector cuts at the rank threshold instead
+// (follow_newton_options), so the followed branch takes its whole budget at constant period.
 TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
   const fs::path out = cli::scratch("branch_points_cli", "follow_3.5");
   const cli::Run r = cli::run("trace",
@@ -121,14 +118,14 @@ TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
   const int row = verified_row_near(t, 3.5);
   ASSERT_EQ(row, 2) << "row 3 (followed): T = 3.5 after a dip near 3.67 and T = 3.6";
   // 1e-7: in this trace (gap units) T = 3.5 shows as a dip, located by the V-fit of |tau| to
-  // |tau| ~ 1e-8, where the test function's finite-difference noise stops it. Under changes of
-  // the Jacobian's rounding only (its pattern, its factorisation) the located period measured
-  // 3.5 - 6.8e-10, + 2.2e-9, - 2.7e-10 and + 7.0e-8 (|tau| 9.9e-9); a wrong point is 1e-3 away.
+  // |tau| ~ 1e-8, where the test function's finite-difference noise stops it. Changes of the
+  // Jacobian's rounding only (its pattern, its factorisation) move the located period by up to
+  // about 1e-7; a wrong point is 1e-3 away.
   EXPECT_NEAR(t.column("period")[static_cast<std::size_t>(row)], 3.5, 1e-7);
   // Its 24 probes step across a kink of F (the period's column of J changes by rank one). They
   // learn it from the first probe's Jacobian and difference it at the others' starts
-  // (continuation/branch_points.cpp, verify()): location and verification took 12 Jacobians;
-  // without the learning every probe took at least one of its own (measured 45).
+  // (continuation/branch_points.cpp, verify()), so location and verification need far fewer
+  // Jacobians than the probes, each of which would otherwise take at least one of its own.
   EXPECT_LE(t.column("jacobian_evaluations")[static_cast<std::size_t>(row)], 20);
   EXPECT_GE(t.column("dimension")[static_cast<std::size_t>(row)], 20);
   const fs::path dir = out / ("branch_point_" + std::to_string(row + 1));
@@ -140,14 +137,6 @@ TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
     for (double e : check.column(column)) EXPECT_LE(e, 1e-6) << column;
 }
 
-// A resumed detecting trace re-adds its saved point, which locates again what adding that point
-// had located: the earlier run's rows from there on are replaced, not repeated. At 100
-// intervals mode 1 meets six candidates (after points 5, 7, 8, 11, 17, 20). Cut at 9 points the
-// saved point 8 brackets T = 3.5 with point 7 (its row had been written twice); cut at 21 the
-// re-located row is the unverified 3.142, whose table lacks the description columns
-// (frequency_ratio, ...): the merge had then dropped the earlier rows. Periods agree with the
-// uninterrupted run's to the test function's noise (the resumed sample is recomputed in that
-// point's units, continuation/README.md 'Branch points'; measured <= 4e-8 relative).
 // The candidates are located and verified on a second thread (the worker has its own copy of
 // the problem, core::Problem::clone, and the loop's units of the moment each candidate was
 // bracketed): every row must be the same bits as the loop's own thread gives
@@ -156,7 +145,8 @@ TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
 // the located periods and the counts.
 TEST(BranchPointsCli, SecondThreadGivesTheRowsOfTheLoopsOwnBitForBit) {
   const std::string scene =
-      paper + " --branch mode1 --shooting_elements 100 --energy_max 1e-2 --detect_branch_points true";
+      paper +
+      " --branch mode1 --shooting_elements 100 --energy_max 1e-2 --detect_branch_points true";
   const fs::path worker = cli::scratch("branch_points_cli", "worker");
   const fs::path inline_ = cli::scratch("branch_points_cli", "inline");
   // The worker's run keeps its stdout: each candidate gets a line as it is located.
@@ -197,9 +187,18 @@ TEST(BranchPointsCli, SecondThreadGivesTheRowsOfTheLoopsOwnBitForBit) {
   fs::remove_all(inline_);
 }
 
+// A resumed detecting trace re-adds its saved point, which locates again what adding that point
+// had located: the interrupted run's rows from there on are replaced, not repeated. At 100
+// intervals mode 1 meets six candidates (after points 5, 7, 8, 11, 17, 20). Cut at 9 points the
+// saved point 8 brackets T = 3.5 with point 7, whose row must not be written twice; cut at 21 the
+// re-located row is the unverified 3.142, whose table lacks the description columns
+// (frequency_ratio, ...), and the merge must keep the interrupted run's rows. Periods agree with
+// the uninterrupted run's to the test function's noise (the resumed sample is recomputed in that
+// point's units, continuation/README.md 'Branch points'), well inside 1e-6 relative.
 TEST(BranchPointsCli, ResumedRunNeitherRepeatsNorDropsCandidates) {
   const std::string scene =
-      paper + " --branch mode1 --shooting_elements 100 --energy_max 1e-2 --detect_branch_points true";
+      paper +
+      " --branch mode1 --shooting_elements 100 --energy_max 1e-2 --detect_branch_points true";
   const fs::path full = cli::scratch("branch_points_cli", "full");
   ASSERT_EQ(cli::run("trace", scene, full).code, 0);
   const Table a = Table::read_csv(full / "branch_points.csv");
@@ -226,11 +225,10 @@ TEST(BranchPointsCli, ResumedRunNeitherRepeatsNorDropsCandidates) {
 }  // namespace
 
 // --follow all: the family attached at T = 3.2 is traced into branch_point_K/ (K: its row). It
-// leaves mode 1 at constant frequency, as the issue expects of an internal resonance: every
-// point keeps T = 3.2 within 1e-9 relative (measured 4.4e-13: the period is not pinned, it is
-// the family's), its energy grows from the branch point's, and every orbit returns under the
-// exact oracle within return_tolerance = 1e-6 (trace's per-point check; closed_form_check.csv
-// re-measures it on another grid: measured 4.9e-9 worst).
+// leaves mode 1 at constant frequency, as an internal resonance does: every point keeps T = 3.2
+// within 1e-9 relative (the period is not pinned, it is the family's), its energy grows from the
+// branch point's, and every orbit returns under the exact oracle within return_tolerance = 1e-6
+// (trace's per-point check; closed_form_check.csv checks it again on another grid).
 TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   const fs::path root = cli::scratch("branch_points_cli", "follow"),
                  out = root / "mode1_resonances";
@@ -249,9 +247,8 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   for (double p : period) EXPECT_NEAR(p / 3.2, 1.0, 1e-9);
   EXPECT_GT(energy.front(), 1.25e-5);
   // The path inside the 5-7 dimensional family follows the round-off of the march (see
-  // tangent_angle): measured 2.08e-5 after 30 points, 1.78e-5 with the TD-BEM times on the step
-  // grid, and the energy bound 3e-5 after 9 points with the follow corrector's rank cut-off.
-  // Either it grows by a quarter or it reaches the bound.
+  // tangent_angle), and so does how far its energy climbs: either it grows by a quarter or it
+  // reaches the bound 3e-5.
   EXPECT_GT(energy.back(), 1.25 * 1.25e-5);
   const Table check = Table::read_csv(dir / "closed_form_check.csv");
   for (const char* column : {"return_error_u", "return_error_v"})
@@ -263,13 +260,12 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
       EXPECT_FALSE(fs::exists(out / ("branch_point_" + std::to_string(i + 1))));
     }
 
-  // The figures of the followed branch (figures_resonance.hpp). Fig. 11's mode-1 orbit at the
-  // attached orbit's period is the closed form: u(L, 0) = eps L = -5e-3 (T = 3.2 to 1e-9, so
-  // 1e-8 relative) and contact at u(L) = g0 = 1e-3 (the exact oracle: round-off). The attached
-  // orbit is mode 1 plus low-magnitude content: differs by more than 1e-6 and less than g0
-  // (measured 1.0e-4 at E = 2.08e-5).
-  // From the source folder: the figure jobs read the paper scene by its repository path. The
-  // followed run is in mode1_resonances (the main job's folder); it also stands for mode1, so
+  // The figures of the followed branch (problems/contact_bar/figures/resonance.hpp). Fig. 11's
+  // mode-1 orbit at the attached orbit's period is the closed form: u(L, 0) = eps L = -5e-3 (T
+  // = 3.2 to 1e-9, so 1e-8 relative) and contact at u(L) = g0 = 1e-3 (the exact oracle: round-off).
+  // The attached orbit is mode 1 plus low-magnitude content: differs by more than 1e-6 and less
+  // than g0. From the source folder: the figure jobs read the paper scene by its repository path.
+  // The followed run is in mode1_resonances (the main job's folder); it also stands for mode1, so
   // that the backbone figure has its branch.
   fs::remove_all(root / "mode1");
   fs::create_directory_symlink("mode1_resonances", root / "mode1");

@@ -82,10 +82,9 @@ TEST(SimulateCli, CompareWritesOneHistoryPerMethod) {
   fs::remove_all(out);
 }
 
-// Issue 12, item 1: FEM time steps that do not divide t_end used to stop one partial step short
-// and exit 1 "fem failed (non-finite values)". Now the history ends at t_end; its last value is
-// mode 1's return to u(L) = -0.01 up to the FEM's error on 100 elements (tests/problems/fem_bar:
-// measured 1.7e-4 .. 2.5e-4 at these dt, the dispersion of the mode's kinks; bound 3e-4).
+// FEM time steps that do not divide t_end: the history ends at t_end, its last value mode 1's
+// return to u(L) = -0.01 up to the FEM's error on 100 elements, the dispersion of the mode's
+// kinks (tests/problems/fem_bar), which stays below 3e-4 at these dt.
 TEST(SimulateCli, FemTimeStepsThatDoNotDivideTEndReachTEnd) {
   for (const char* dt : {"0.007", "0.009", "0.008", "0.006"}) {
     const fs::path out = scratch(std::string("fem_") + dt);
@@ -111,8 +110,8 @@ TEST(SimulateCli, FemTimeStepsThatDoNotDivideTEndReachTEnd) {
   fs::remove_all(out);
 }
 
-// Item 3: the run's size is bounded by max_steps before anything runs (these used to grow to
-// gigabytes or run for minutes silently).
+// The run's size is bounded by max_steps before anything runs: each of these runs would take
+// gigabytes or minutes.
 TEST(SimulateCli, RunSizeIsBoundedByMaxSteps) {
   expect_bad_input(paper + " --dt 1e-300", "dt");
   expect_bad_input(paper + " --periods 1e9", "max_steps");    // 3.1e11 steps
@@ -130,14 +129,15 @@ TEST(SimulateCli, RunSizeIsBoundedByMaxSteps) {
   fs::remove_all(out);
 }
 
-// Item 4: inputs that used to be accepted as nonsense.
+// Inputs that are nonsense (a folder as scene, values beyond double or int) are refused,
+// naming the key.
 TEST(SimulateCli, NonsenseInputIsRefused) {
   expect_bad_input(std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes", "scene");
   expect_bad_input(paper + " x", "unexpected argument 'x'");
-  expect_bad_input(paper + " --length 1e100", "length");  // used to give "energy 0 -> 0 J"
+  expect_bad_input(paper + " --length 1e100", "length");  // its energy would underflow to 0 J
   expect_bad_input(paper + " --length 1e15", "u0");       // knots 1 m apart on a 1e15 m bar
   expect_bad_input(paper + " --youngs_modulus 1e-300", "youngs_modulus");
-  expect_bad_input(paper + " --periods 1e308", "periods");  // used to name t_end
+  expect_bad_input(paper + " --periods 1e308", "periods");  // the key given, not t_end
   expect_bad_input(paper + " --history_samples 4294967298", "history_samples");
   expect_bad_input(paper + " --elements 4294967297", "elements");
 }
@@ -159,8 +159,8 @@ cli::Run run_with_out(const std::string& command, const std::string& arguments,
   return cli::run(command, arguments, out, scratch(command + ".stderr"));
 }
 
-// Item 5 (and item 2 for trace): a bad --out, an integer beyond int, a NaN limit are refused
-// before any work, by trace as well as simulate.
+// A bad --out, an integer beyond int, a NaN limit are refused before any work, by trace as well
+// as simulate.
 TEST(SimulateCli, OutputFolderIsCheckedBeforeTheWork) {
   const fs::path file = scratch("existing.csv");
   std::ofstream(file) << "t\n0\n";

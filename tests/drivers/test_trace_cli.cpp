@@ -31,8 +31,8 @@ void expect_bad_input(const std::string& arguments, const std::string& key) {
 }
 
 // Traces mode 1 of the paper scene with extra arguments into a scratch folder named `name`;
-// every point must match the closed form at its own energy: acceptance 1e-5, asserted 1e-8
-// (measured 1e-13, the Newton tolerance 1e-10 g0 propagated). Returns closed_form_check.csv.
+// every point must match the closed form at its own energy: acceptance 1e-5, asserted 1e-8, far
+// above what the Newton tolerance 1e-10 g0 leaves. Returns closed_form_check.csv.
 backbone::core::Table trace_mode1_on_the_closed_form(const std::string& name,
                                                      const std::string& arguments, fs::path& out) {
   out = cli::scratch("trace_cli", name);
@@ -57,8 +57,8 @@ TEST(TraceCli, BadInputExitsTwoAndWritesNothing) {
   expect_bad_input(paper + " --right_end free", "right_end");
   expect_bad_input(paper + " --predictor cubic", "predictor");
   expect_bad_input(paper + " --newton_jacobian_check 1", "newton_jacobian_check");
-  // The size of a residual is bounded before any work (it used to run for ever): 1e7 steps per
-  // period at 20 intervals, a million intervals at 40 steps, both above max_residual_work 1e7.
+  // The size of a residual is bounded before any work: 1e7 steps per period at 20 intervals, a
+  // million intervals at 40 steps, both above max_residual_work 1e7.
   expect_bad_input(paper + " --steps_per_period 10000000", "steps_per_period");
   expect_bad_input(paper + " --shooting_elements 1000000", "shooting_elements");
   expect_bad_input(paper + " --branch subharmonic --steps_per_period 10000000", "steps_per_period");
@@ -83,9 +83,8 @@ TEST(TraceCli, OtherSceneModeOneMatchesTheClosedForm) {
   fs::remove_all(out);
 }
 
-// Natural continuation in the period, the paper's parameter, on the oversampled residual (the
-// bordered predictor once overran its right-hand side there and aborted): T falls from 3.95
-// towards 3 L/c, each point on the closed form (measured 2e-13).
+// Natural continuation in the period, the paper's parameter, on the oversampled (rectangular)
+// residual: T falls from 3.95 towards 3 L/c, each point on the closed form (1e-8, as above).
 TEST(TraceCli, NaturalInThePeriodFollowsModeOne) {
   fs::path out;
   trace_mode1_on_the_closed_form("natural",
@@ -140,8 +139,8 @@ std::string file_text(const fs::path& path) {
   return text.str();
 }
 
-// mode 1 on a coarse grid up to 2e-3 J: 88 points in a fraction of a second (steps of 5 % of
-// the amplitude above the gap: amplitude_units, problems/contact_bar/README.md 'Cost').
+// mode 1 on a coarse grid up to 2e-3 J: 88 cheap points (steps of 5 % of the amplitude above
+// the gap: amplitude_units, problems/contact_bar/README.md 'Cost').
 const std::string small_mode1 =
     paper + " --branch mode1 --shooting_elements 10 --energy_max 2e-3 --ds 0.05 --ds_max 0.05";
 
@@ -149,9 +148,9 @@ const std::string small_mode1 =
 // with its last complete point (state.txt, continuation/restart.hpp): a 30-point run whose last
 // unknowns.csv row is cut (what SIGKILL mid-write leaves) is repaired to 29 complete points and
 // resumed without a point budget to the energy bound. The whole branch, to its end, is the
-// uninterrupted run's bit for bit (the restart corrects and re-derives nothing; the restart this
-// replaced agreed to 1e-14 up to a retried step, then diverged), and so are unknowns.csv and
-// state.txt byte for byte, and the closed-form check and branch points cover the whole branch.
+// uninterrupted run's bit for bit (the restart corrects and re-derives nothing), and so are
+// unknowns.csv and state.txt byte for byte, and the closed-form check and branch points cover the
+// whole branch.
 TEST(TraceCli, ResumeContinuesAnInterruptedBranch) {
   const fs::path full = cli::scratch("trace_cli", "full"), part = cli::scratch("trace_cli", "part");
   // In fixed units: with amplitude_units the resumed point's detector sample is recomputed from a
@@ -192,14 +191,14 @@ TEST(TraceCli, ResumeContinuesAnInterruptedBranch) {
 }
 
 // A branch that ended on its bound gains no point when taken up again (the restart's last
-// point lies on the bound: landing again had added a copy of it), whatever other key is given:
+// point lies on the bound: landing again would add a copy of it), whatever other key is given:
 // branch.csv stays byte for byte, exit 0. A key that moves the bound extends it.
 TEST(TraceCli, ResumingABranchOnItsBoundAddsNothingUnlessTheBoundMoves) {
   const fs::path done = cli::scratch("trace_cli", "done");
   ASSERT_EQ(cli::run("trace", small_mode1, done).code, 0);
   const std::string before = file_text(done / "branch.csv");
-  const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
-                             done.string() + "'";
+  const std::string resume =
+      std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" + done.string() + "'";
   const std::string log = " > '" + done.string() + ".log' 2>&1";
   for (const std::string keys : {"", " --threads 2"}) {
     ASSERT_EQ(std::system((resume + keys + log).c_str()), 0) << file_text(done.string() + ".log");
@@ -214,17 +213,16 @@ TEST(TraceCli, ResumingABranchOnItsBoundAddsNothingUnlessTheBoundMoves) {
 }
 
 // A finished branch far above the gap is extended from its last point, which has no loop state
-// (it was landed on the bound) and is corrected again: in its own amplitude units, where its
-// points converged. In the unit scale (gap units) mode 1 at 200 intervals and E = 1e-2 stalled at
-// |F| = 4.0e-10 against the tolerance 1e-10 (residual round-off ~100 times the amplitude units')
-// and the resumed run ended at once with newton_failed. Every extended point keeps the closed
-// form (mode 1: the trace's own check, closed_form_check.csv; 1e-8 is the bound).
+// (it lies on the bound) and is corrected again: in its own amplitude units, where its points
+// converged; in gap units the residual's round-off of mode 1 at 200 intervals and E = 1e-2 is
+// above the tolerance 1e-10. Every extended point keeps the closed form (mode 1: the trace's own
+// check, closed_form_check.csv; 1e-8, as above).
 TEST(TraceCli, FinishedBranchFarAboveTheGapExtends) {
   const fs::path done = cli::scratch("trace_cli", "extend");
-  ASSERT_EQ(cli::run("trace", paper + " --branch mode1 --shooting_elements 200 --energy_max 1e-2",
-                     done)
-                .code,
-            0);
+  ASSERT_EQ(
+      cli::run("trace", paper + " --branch mode1 --shooting_elements 200 --energy_max 1e-2", done)
+          .code,
+      0);
   const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
                              done.string() + "' --energy_max 2e-2 > '" + done.string() +
                              ".log' 2>&1";
@@ -239,9 +237,8 @@ TEST(TraceCli, FinishedBranchFarAboveTheGapExtends) {
 
 // A resumed run reads the resolved scene.ini, where keys left at their defaults are comments: in
 // the amplitude units (mode 1's default) newton_tolerance is then still "not given" and the
-// branch keeps its own 1e-10 (problems/contact_bar/README.md, 'Cost'). When scene.ini listed
-// the default 3e-9 as given, the resumed branch took the gap units' tolerance and left the
-// uninterrupted one's points after the restart.
+// branch keeps its own 1e-10 (problems/contact_bar/README.md, 'Cost'), so the resumed branch
+// is the uninterrupted one's point for point.
 TEST(TraceCli, ResumeInTheAmplitudeUnitsKeepsTheBranchsOwnSettings) {
   const fs::path full = cli::scratch("trace_cli", "full_amp"),
                  part = cli::scratch("trace_cli", "part_amp");
@@ -279,7 +276,7 @@ TEST(TraceCli, StartFromASavedPointReproducesTheRestOfTheBranch) {
   EXPECT_EQ(b.column("point").front(), 40);
   // Point K itself is recorded from its saved state, kept in fixed units, while the first run
   // recorded it in the units of its amplitude (LocalScale): the conversions may differ in the
-  // last bit (measured 3e-16 relative). The points after it are the same bit for bit.
+  // last bits (hence 1e-14). The points after it are the same bit for bit.
   EXPECT_NEAR(b.column("energy").front() / a.column("energy")[40], 1.0, 1e-14);
   expect_same_rows(a, b, 41, 1);
   ASSERT_EQ(cli::run("trace", small_mode1 + start + " --direction -1 --max_points 45", back).code,
@@ -293,10 +290,10 @@ TEST(TraceCli, StartFromASavedPointReproducesTheRestOfTheBranch) {
 }
 
 // The paper's residual u0 - u(T) is degenerate on mode 1 (a double root: its period column
-// vanishes, problems/contact_bar/README.md). Its corrections once left the family for T = 4
-// orbits after point 0 (closed-form error up to 0.13) and the trace exited 0. The turn check
-// (max_turn_degrees) refuses those steps; the branch must end there honestly: exit 1 with the
-// reason on stderr, and every point it wrote on the closed form (1e-8, as above).
+// vanishes, problems/contact_bar/README.md): its corrections can leave the family for T = 4
+// orbits after point 0. The turn check (max_turn_degrees) refuses those steps; the branch must
+// end there honestly: exit 1 with the reason on stderr, and every point it wrote on the closed
+// form (1e-8, as above).
 TEST(TraceCli, PaperFormulationDoesNotLeaveTheFamily) {
   const fs::path out = cli::scratch("trace_cli", "paper_formulation");
   const cli::Run r = cli::run("trace", paper + " --branch mode1 --formulation paper", out);
@@ -312,11 +309,10 @@ TEST(TraceCli, PaperFormulationDoesNotLeaveTheFamily) {
 
 // A point of a traced curve has dimension >= 1. At end amplitudes that are whole multiples of
 // g0 (T = 3 + 1/k: the contact events fall on the time grid) the candidate null space is several
-// directions wide; at 80 intervals and 10 g0 the rank verification once gave 0 of 4 candidates,
-// its probes stalling at residual 1.4e-9 above its own tolerance 1e-9 while the branch runs
-// through the point at newton_tolerance 3e-9. Every point must now report dimension >= 1, and a
-// point whose verification still gave 0 is re-checked along the tangent and said on stderr
-// and in summary.txt (dimension_flag, continuation/README.md).
+// directions wide, and at 80 intervals and 10 g0 the verification's probes end near the
+// residual's round-off. Every point must report dimension >= 1, and a point whose verification
+// gives 0 is re-checked along the tangent and said on stderr and in summary.txt (dimension_flag,
+// continuation/README.md).
 TEST(TraceCli, DimensionOnTheCurveIsNeverZero) {
   const fs::path out = cli::scratch("trace_cli", "grid_coincidence");
   const cli::Run r = cli::run(

@@ -9,8 +9,8 @@
 #include "continuation/outputs.hpp"
 #include "core/errors.hpp"
 #include "core/plot.hpp"
-#include "problems/contact_bar/solver/bar_solvers.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
+#include "problems/contact_bar/solver/bar_solvers.hpp"
 #include "problems/contact_bar/solver/scene.hpp"
 
 namespace backbone::contact_bar {
@@ -32,7 +32,8 @@ po::options_description simulate_keys() {
       "simulated time in scene periods (t_end = periods * period) (> 0)")(
       "compare", po::bool_switch(), "run tdbem, fem and exact; one figure with the three")(
       "max_steps", po::value<long>()->default_value(default_max_steps),
-      "refuse a run larger than this many time steps: t_end / dt (tdbem, fem), max(rows, 100) "
+      "refuse a run larger than this many time steps (>= 1): t_end / dt (tdbem, fem), max(rows, "
+      "100) "
       "x min(L/c, t_end) / dt (the tdbem window, integrated per row), node-steps / 100 (fem), "
       "1000 x t_end / (L/c) (exact: stored wave transits)")(
       "orbit", po::value<std::string>(),
@@ -74,14 +75,12 @@ std::string history_defect(const bar::History& h, double t_end) {
   return "";
 }
 
-// The run's size against max_steps, before anything runs. Counted, with their measured costs on
-// one (shared) core: the march length t_end / dt (TD-BEM, FEM; a TD-BEM step ~1 us); the
-// TD-BEM's window of w = min(L / c, t_end) / dt steps (one knot per end, ~100 bytes per step),
-// integrated for the energy of each of the R rows (~0.6 us per step and row) and held in memory:
-// max(R, 100) w; the FEM's node-steps (t_end / dt) (elements + 1) / 100 (~2 ns per node-step);
-// the exact solution's stored wave transits (~0.5 kB, ~2 us each), 1000 t_end / (L / c). The
-// default 1e8 is thus at most about a minute and 150 MB (measured: TD-BEM dt = 1e-4 on the
-// paper scene, 2e7 window-rows, 13 s; dt = 2e-6 with 50 rows, 5e7, 21 s and 72 MB).
+// The run's size against max_steps, before anything runs. Counted: the march length t_end / dt
+// (TD-BEM, FEM); the TD-BEM's window of w = min(L / c, t_end) / dt steps (one knot per end),
+// held in memory and integrated for the energy of each of the R rows: max(R, 100) w; the FEM's
+// node-steps (t_end / dt) (elements + 1) / 100; the exact solution's stored wave transits
+// (~0.5 kB each), 1000 t_end / (L / c). The weights give each count about the cost of one
+// TD-BEM step, so the default 1e8 keeps any solver to about a minute and 150 MB.
 void check_run_size(const core::Scene& scene, const bar::BarSetup& setup,
                     const bar::SimulationOptions& o, const std::vector<std::string>& methods) {
   const long max_steps = scene.integer("max_steps", 1, std::numeric_limits<long>::max());

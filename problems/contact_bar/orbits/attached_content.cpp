@@ -51,8 +51,7 @@ AttachedContent attached_content(const ContactBarOrbitProblem& problem,
   c.amplitude = amplitude;
   // Spectrum over one period (both orbits are sampled on their own period, so the content is
   // periodic over the sampled window): harmonics 1..samples/2 by an FFT (Eigen's, kissfft),
-  // O(samples log samples). The direct DFT it replaces took 20-40 ms per described branch
-  // point at 4096 samples, 8 % of a mode-1 trace with detection at N = 100.
+  // O(samples log samples), so describing a branch point costs little beside locating it.
   Eigen::FFT<double> fft;
   std::vector<std::complex<double>> spectrum;
   fft.fwd(spectrum, d);

@@ -2,7 +2,7 @@
 // optimisation on the solution manifold with NLopt (README.md, section 'Subharmonic continuum').
 //
 // At energy E the members form a curve (shape in [0, 1]); at its ends one contact phase shrinks
-// to a grazing instant. Each limit is the minimiser of that phase's duration, measured by an
+// to a grazing instant. Each limit is the minimiser of that phase's duration, computed by an
 // exact simulation of the member over its period, subject to the periodicity residual F = 0
 // (the regular half-period residual of ContactBarOrbitProblem, every test row an equality) and
 // the energy row (E(x) - E) / E = 0, solved by NLopt's SLSQP with forward-difference gradients

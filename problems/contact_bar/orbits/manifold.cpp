@@ -65,8 +65,7 @@ ManifoldRun cover_subharmonic_manifold(const ContactBarOrbitProblem& problem,
   auto corrector = core::make_corrector("eigen", newton);  // F plus 2 rows: least squares
   const exact_bar::ExactBarSolver oracle;
   // The exact-oracle return on 1000 intervals, as the continuum's reject_point (plugin.cpp):
-  // near shape 1/2 (mode 2 itself) the projected residual has spurious roots (measured without
-  // it: 10 of 159 charts returned with errors 2e-4 .. 7, periods off by 1e-5).
+  // near shape 1/2 (mode 2 itself) the projected residual has spurious roots, which it refuses.
   auto accept = [&](const core::Vector& x) {
     return !(return_tolerance > 0) || return_error(f, x, oracle, 1000).worst() <= return_tolerance;
   };

@@ -60,7 +60,8 @@ struct OrbitOptions {
                                 // M > that: overdetermined but consistent (true orbits zero
                                 // every test function), solved by least squares; the N
                                 // projections of a square system have spurious roots that
-                                // M >= 2N removes (measured, see trace_contact_bar.cpp)
+                                // M >= 2N removes (test_periodic_bar.cpp,
+                                // OversampledResidualHasNoSpuriousRoots)
   int steps_per_period = 2000;  // dt = T / steps_per_period; must be even
   double fixed_dt = 0;          // > 0: this dt instead (T/2 and T then fall between steps)
   // Path rows: equations appended after the M residual rows that pick a path on a manifold of
@@ -208,6 +209,6 @@ struct ReturnError {
 ReturnError return_error(const ContactBarOrbitProblem& problem, const core::Vector& x,
                          const bar::BarSolver& oracle, int elements = 1000);
 
-// Closed forms of the contact family: problems/contact_bar/family.hpp (ContactFamily).
+// Closed forms of the contact family: problems/contact_bar/orbits/family.hpp (ContactFamily).
 
 }  // namespace backbone::contact_bar

@@ -127,8 +127,7 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
   // so kinks that coincide in exact arithmetic coincide here up to the round-off of a contact
   // instant they came from (a root of a displacement of size u over a step: eps u / (v dt)
   // steps, u / v ~ L / c). Kinks further apart stay apart: joining two kinks d steps apart
-  // loses energy in proportion to d (measured with the earlier 1e-9 steps at dt = 0.0123,
-  // where 123 L/c is 10^4 dt less 1.4e-13 steps: 3e-15 of the energy every 123 s).
+  // loses energy in proportion to d.
   merge_steps_ = 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, tau_ / dt);
   for (const auto* f : {&setup_.u0, &setup_.v0})
     for (double v : f->values())
@@ -333,9 +332,8 @@ void TdbemMarch::step_end(int e, GridTime ta, GridTime tb) {
     E.pending.pop_front();
     if (steps_between(p, ta) <= merge_steps_) {
       // A kink a round-off after ta (the previous step ended a round-off short of it) is the
-      // knot at ta: it stays tracked. Dropping it ended its echo train, and the untracked kink
-      // was then interpolated across (measured at dt = 0.0123, where 123 tau = 10^4 dt: 3e-15
-      // of the energy lost every 123 s).
+      // knot at ta: it stays tracked, so its echo train goes on and no later step interpolates
+      // across it (which would lose energy).
       mark_kink(e);
       continue;
     }
@@ -411,9 +409,9 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   // A crossing within round-off of ta or tb is put there, and the end is then held where it
   // is (a round-off off the wall): a closed end's outgoing wave is minus its incoming one, an
   // open end's plus, so moving the instant by a round-off leaves every slope of Q, and the
-  // energy, exact. Moving the end onto the wall instead (or joining ta and tb by a chord)
-  // changed the energy in proportion to the round-off, which shifted the next closing by more:
-  // on mode 1, whose closings all fall on grid points, that error grew 1.4x per period.
+  // energy, exact. Moving the end onto the wall (or joining ta and tb by a chord) would change
+  // the energy in proportion to the round-off and shift the next closing by more, an error that
+  // grows period after period on mode 1, whose closings all fall on grid points.
   E.closed = true;
   if (root <= root_snap_steps) {  // closed from ta
     E.contact_u = a.u;
@@ -489,7 +487,7 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
 
 // Q_0 - C and Q_L + C give the same u (u = ... + Q_L + Q_0) and the same end equations
 // (Q_e = U_e - R_e, R_e holding the other end's Q). The fixed end's S grows like its mean
-// strain times t, and with it both Q; u is then a difference of two large numbers, which lost
+// strain times t, and with it both Q; u is then a difference of two large numbers, which loses
 // digits in proportion to t. Moving C = (Q_0 - Q_L) / 2 of the newest knots brings both to the
 // size of u again: O(window), once every many steps.
 void TdbemMarch::regauge() {
@@ -512,8 +510,8 @@ bool TdbemMarch::advance_to(double target) {
   GridTime goal = grid_time(target);
   // A target between grid points holds the round-off of t (which grows with t): a kink of R
   // within it is the target. Stopping on the kink, rather than moving the kink to the target,
-  // keeps it exact: stops at t = k T on a periodic orbit otherwise smeared kinks (measured on
-  // a free bar at dt = 0.0123: energy 6e-12 off after 10^4 periods stopped at k T).
+  // keeps it exact, so stops at t = k T on a periodic orbit do not smear its kinks (and the
+  // energy) over long runs.
   const double target_round_off =
       8 * std::numeric_limits<double>::epsilon() * std::max(1.0, target / step_);
   while (ok_ && now_ < goal) {

@@ -223,12 +223,11 @@ class TdbemMarch {
   double dt_, L_, c_, tau_, ea_, body_coef_, v0_total_;
   bool v0_is_zero_ = false;  // every value of v0 is +0
   double step_ = 0;          // grid step [s]: dt, or tau / m when tau is m dt to round-off
-  GridTime tau_grid_;
-  double merge_steps_ = 0;  // sub-step instants closer than this (in steps) are one       // tau on
-                            // the grid (m steps exactly in that case)
-  double gauge_scale_ = 0;  // displacement scale of the scene; regauge() keeps Q within it
-  double t_ = 0;            // time() [s]: the last target reached
-  GridTime now_;            // the current time on the grid
+  GridTime tau_grid_;        // tau on the grid (m steps exactly when tau is m dt to round-off)
+  double merge_steps_ = 0;   // sub-step instants closer than this (in steps) are one
+  double gauge_scale_ = 0;   // displacement scale of the scene; regauge() keeps Q within it
+  double t_ = 0;             // time() [s]: the last target reached
+  GridTime now_;             // the current time on the grid
   bool ok_ = true;
   EndState ends_[2];  // 0: x = 0, 1: x = L
   // Knot index of the last retarded-time query of each end's R (r_end reads the OTHER end's

@@ -35,7 +35,8 @@ TEST(BenchReport, SectionsFollowTheCaseListAndMissingOnesGetTheirSummary) {
   const std::string text = read(report);
   const auto first = text.find("## First\n\nline one\n");
   const auto absent = text.find("## absent\n\nsummary absent");
-  const auto second = text.find("## Second\n\nline two\n");  // the newline was added
+  const auto second =
+      text.find("## Second\n\nline two\n");  // write_bench_section adds the final newline
   ASSERT_NE(first, std::string::npos) << text;
   ASSERT_NE(absent, std::string::npos) << text;
   ASSERT_NE(second, std::string::npos) << text;
@@ -47,7 +48,7 @@ TEST(BenchReport, SectionsFollowTheCaseListAndMissingOnesGetTheirSummary) {
   const std::string again = read(cli::write_bench_report(out, cases));
   EXPECT_NE(again.find("## First again\n"), std::string::npos);
   EXPECT_EQ(again.find("line one"), std::string::npos);
-  EXPECT_NE(again.find("## Second"), std::string::npos);  // kept from the earlier run
+  EXPECT_NE(again.find("## Second"), std::string::npos);  // kept from the first report
   std::filesystem::remove_all(out);
 }
 

@@ -155,14 +155,13 @@ bar::BarSetup mode1(double eps = -0.01, double gap = 1e-3) {
 }
 
 // A t_end that is no multiple of dt (3.1 / 0.007 = 442.86): the march takes N = ceil(t_end / dt)
-// equal steps of dt' = t_end / N <= dt, so the history ends at t_end (it used to stop at
-// floor(t_end / dt) dt and the CLI reported a false non-finite failure). Oracle 1: the same run
-// with dt = dt' given (t_end then a multiple of dt) is identical to the bit. Oracle 2: the exact
-// solution. Mode 1 has kinks (jumps of u_x) and at Courant 0.7 central differences disperse them,
-// so the worst contact-end error over the period falls like dt^(2/3), the max-norm rate of a
-// second-order dispersive scheme on a kinked solution (measured ratios 0.617, 0.618 per halving,
-// 2^(-2/3) = 0.630; error 2.34e-4 = 6.4e-3 dt^(2/3) at dt = 0.007): ratios in [0.58, 0.68] and
-// error below 1e-2 dt^(2/3). A march that stopped short or took a wrong last step fails both.
+// equal steps of dt' = t_end / N <= dt, so the history ends at t_end, not at floor(t_end / dt) dt.
+// Oracle 1: the same run with dt = dt' given (t_end then a multiple of dt) is identical to the bit.
+// Oracle 2: the exact solution. Mode 1 has kinks (jumps of u_x) and at Courant 0.7 central
+// differences disperse them, so the worst contact-end error over the period falls like dt^(2/3),
+// the max-norm rate of a second-order dispersive scheme on a kinked solution (2^(-2/3) = 0.630 per
+// halving): ratios in [0.58, 0.68] and error below 1e-2 dt^(2/3). A march that stopped short or
+// took a wrong last step fails both.
 TEST(FemBar, HistoryEndsAtTEndWhenTEndIsNoMultipleOfDt) {
   const bar::BarSetup s = mode1();
   const exact_bar::ExactBarSolution exact(s, 3.1);

@@ -1,4 +1,4 @@
-// The mode-1 branch-cost benchmark's pieces (problems/contact_bar/bench_branch_scaling.hpp): the
+// The mode-1 branch-cost benchmark's pieces (problems/contact_bar/bench/branch_scaling.hpp): the
 // exponent fit against an exact power law, the grid list, and the table of two tiny in-process
 // traces checked against the closed form.
 #include <gtest/gtest.h>
@@ -46,7 +46,7 @@ TEST(ContactBarBranchScaling, GridListsAreIncreasingIntervalCounts) {
 // Two tiny branches (N = 10, 20, up to E = 1.5e-6 J, about twice the start's 7.8e-7): the
 // orbits are piecewise linear and held exactly by the TD-BEM with event contact on both grids,
 // so the frequency is the closed form's up to the Newton tolerance 3e-9 g0, which moves T by
-// less than 1e-9 relative here (the bound of test_bench_peers.cpp; measured ~1e-15).
+// less than 1e-9 relative here (the bound of test_peers.cpp).
 TEST(ContactBarBranchScaling, TinyBranchesGiveTheTableColumnsAndTheClosedForm) {
   std::vector<Mode1BranchCost> runs;
   for (int n : {10, 20}) {

@@ -1,4 +1,4 @@
-// The benchmark metrics of problems/contact_bar/bench_metrics.hpp on exact oracles: power laws
+// The benchmark metrics of problems/contact_bar/bench/metrics.hpp on exact oracles: power laws
 // of known exponent, step means computed by hand, the closed-form bouncing bar and mode 1
 // (against the exact characteristics solver), and the residual scale the problem documents.
 #include <gtest/gtest.h>
@@ -184,7 +184,8 @@ TEST(BenchMetrics, Mode1ContactEpisodeIsTheExactSolversContact) {
 
 TEST(BenchMetrics, ResidualUnitIsTheGapTheProblemScalesBy) {
   // The orbit problem documents its residual in units of g0 (displacement_scale): the
-  // measured metres per residual unit must be that, whatever the formulation, mode and bar.
+  // metres per residual unit the metric finds must be that, whatever the formulation, mode and
+  // bar.
   bar::BarSetup s;
   s.material = {2.0, 3.0, 1.5, 0.5};
   s.left = {bar::EndType::fixed, 0};

@@ -1,4 +1,4 @@
-// The contact bar's peer benchmarks (problems/contact_bar/bench_peers.hpp): backbone's side of
+// The contact bar's peer benchmarks (problems/contact_bar/bench/peers.hpp): backbone's side of
 // lu_legrand against the mode-1 closed form, and the stored peer data against the summary the
 // peers' README gives.
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@ using namespace backbone;
 // Mode 1 at N = 10 over Lu & Legrand's range: the orbits are piecewise linear, which the
 // TD-BEM with event contact and a 10-interval grid hold exactly, so the frequency is the closed
 // form's up to the Newton tolerance, 3e-9 g0: the strain is at least 1.25 g0 / L on this range,
-// so a residual of 3e-9 g0 moves T (~3) by at most ~2.4e-9, dT / T <= 1e-9 (measured: max
-// 3.7e-12, median 2.8e-15). A point off the family is off by far more.
+// so a residual of 3e-9 g0 moves T (~3) by at most ~2.4e-9, dT / T <= 1e-9. A point off the
+// family is off by far more.
 TEST(ContactBarPeers, PaperMode1MatchesTheClosedFormOverLuAndLegrandsRange) {
   const contact_bar::Mode1Trace t = contact_bar::trace_paper_mode1(10);
   ASSERT_TRUE(t.complete) << t.message;

@@ -15,12 +15,11 @@ namespace {
 
 using backbone::core::Table;
 
-// Regression: with the grid-independent step norm and the turn check the branch stopped at
-// point 1 (the finite-difference tangent at the nonsmooth grazing limit was 43 degrees off the
-// family). Tolerances: energy and period are fixed by the energy row and the closed form to
-// round-off (measured spreads <= 1e-11), 1e-8 is the acceptance; the exact return is
-// round-off for exactly represented members (measured <= 5e-9 up to 1e-3 J), 1e-6 is
-// the branch's own return_tolerance.
+// The branch starts at a nonsmooth grazing limit, where a finite-difference tangent points off
+// the family, and must still pass the turn check with the grid-independent step norm.
+// Tolerances: energy and period are fixed by the energy row and the closed form to round-off,
+// 1e-8 is the acceptance; the exact return is round-off for exactly represented members, 1e-6
+// is the branch's own return_tolerance.
 TEST(SubharmonicContinuumCli, TracesFromGrazingLimitToGrazingLimitWithItsDefaults) {
   const std::string scene =
       std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";

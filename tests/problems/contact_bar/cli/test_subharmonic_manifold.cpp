@@ -1,5 +1,5 @@
 // `backbone trace ... --branch subharmonic_manifold`: the atlas of the subharmonic manifold
-// (problems/contact_bar/manifold.hpp) on a small energy range at N = 20 (about 3 s), checked
+// (problems/contact_bar/orbits/manifold.hpp) on a small energy range at N = 20, checked
 // against the closed forms of family.hpp (period 2 T2 whatever the shape) and the exact oracle
 // (return_error in manifold.csv), its extent against the bounds, its neighbours for symmetry.
 #include <gtest/gtest.h>
@@ -27,9 +27,9 @@ std::vector<int> split(const std::string& text) {
   return out;
 }
 
-// Tolerances: the period is fixed by the closed form to round-off (measured <= 3e-12 on
-// 1e-5 .. 1e-4 J), 1e-8 is the acceptance; the exact return of exactly represented
-// members is round-off too (measured <= 3e-7), 1e-6 is the return_tolerance every chart passed.
+// Tolerances: the period is fixed by the closed form to round-off, 1e-8 is the acceptance; the
+// exact return of exactly represented members is round-off too, 1e-6 is the return_tolerance
+// every chart passes.
 TEST(SubharmonicManifoldCli, CoversTheEnergyRangeAndBothGrazingSides) {
   const std::string scene =
       std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";

@@ -1,5 +1,6 @@
-// What the contact-bar figure jobs read from trace outputs (problems/contact_bar/figures.hpp),
-// on small hand-written branch folders: which orbit is drawn, and the closed-form summary.
+// What the contact-bar figure jobs read from trace outputs
+// (problems/contact_bar/figures/modes.hpp), on small hand-written branch folders: which orbit is
+// drawn, and the closed-form summary.
 #include <gtest/gtest.h>
 
 #include <filesystem>

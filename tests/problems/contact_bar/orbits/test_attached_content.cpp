@@ -1,11 +1,11 @@
-// attached_content (problems/contact_bar/attached_content.hpp) against linear modes: on a bar
-// that never reaches its wall the motion is the fixed-free bar's, so a linear mode k added to
+// attached_content (problems/contact_bar/orbits/attached_content.hpp) against linear modes: on a
+// bar that never reaches its wall the motion is the fixed-free bar's, so a linear mode k added to
 // another orbit of period 4L/c is content of exactly 2k - 1 oscillations per period.
 #include <gtest/gtest.h>
 
-#include "tests/problems/contact_bar/paper_setup.hpp"
 #include "problems/contact_bar/orbits/attached_content.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
+#include "tests/problems/contact_bar/paper_setup.hpp"
 
 namespace {
 

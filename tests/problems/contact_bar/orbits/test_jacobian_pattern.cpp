@@ -10,8 +10,8 @@
 
 #include "core/compressed_jacobian.hpp"
 #include "core/finite_difference.hpp"
-#include "problems/contact_bar/solver/bar_solvers.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
+#include "problems/contact_bar/solver/bar_solvers.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
 #include "tests/problems/contact_bar/paper_setup.hpp"
@@ -71,7 +71,7 @@ TEST(ContactBarJacobianPattern, CompressedEqualsColumnByColumnOnModesOneAndTwo) 
               // In the column-scaled Jacobian J diag(typical scale) (steps h_j = sqrt(eps) s_j),
               // a right pattern changes an entry only by F's round-off over h: the other columns
               // of its colour are absent from the row but change the rounding of the simulation,
-              // ~ sqrt(eps) |J| (measured <= 4e-8 |J|max here). A dropped entry of the size of
+              // ~ sqrt(eps) |J|, far below the bound. A dropped entry of the size of
               // the finite-difference error itself (1e-6, second-order terms) would fail.
               const Vector s = p.typical_scale();
               const double size = (dense * s.asDiagonal()).cwiseAbs().maxCoeff();
@@ -84,7 +84,7 @@ TEST(ContactBarJacobianPattern, HoldsOffTheFamilyWhereTheTdbemSmearsOverAStep) {
   // interpolates its end histories over a step, so a row reads u0 over c dt around each image
   // (at 40 steps per period and N = 160, 13 elements); on the linear pieces of the family
   // orbits that interpolation is exact and hides it. The bare supports then drop entries of
-  // the size of the largest one (measured at roughness 1e-1); the margin of c dt holds.
+  // the size of the largest one (at roughness 1e-1); the margin of c dt holds.
   const contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
   for (int n : {80, 160})
     for (double roughness : {1e-2, 1e-1}) {

@@ -1,6 +1,6 @@
-// Known-solution tests of the contact-bar shooting problem (problems/contact_bar/periodic_bar):
+// Known-solution tests of the contact-bar shooting problem (contact_bar/orbits/periodic_bar):
 // the exact mode-1 orbit u0 = eps x, T = (3L + g0/|eps|)/c (its README.md, 'Mode 1') and the
-// mode-2 tent (closed form derived in periodic_bar.cpp) are roots of both formulations; the
+// mode-2 tent (closed form derived in family.cpp) are roots of both formulations; the
 // regular Jacobian is regular (nullity 1), the paper's T column vanishes; Newton returns to
 // the family; short branches match the closed forms.
 #include <gtest/gtest.h>
@@ -98,8 +98,8 @@ TEST(ContactBarOrbit, RegularJacobianHasNullityOnePaperPeriodColumnVanishes) {
   ASSERT_EQ(core::finite_difference_jacobian(p, x, regular, central), core::EvalStatus::ok);
   const core::RankReport rep = core::rank_report(regular, core::RankOptions{});
   EXPECT_EQ(rep.nullity, 1) << rep.summary();
-  // Not a threshold artefact: the smallest kept singular value is far above the cut-off
-  // (measured 3.5e-3 of sigma_max 19; the cut-off is 1e-8 relative).
+  // Not a threshold artefact: the smallest kept singular value is far above the cut-off (1e-8
+  // relative), above 1e-5 of the largest.
   EXPECT_GT(rep.singular_values[n - 1], 1e-5 * rep.singular_values[0]) << rep.summary();
   EXPECT_GT(regular.col(n).norm(), 1e-2);  // the period matters at T/2
 
@@ -163,7 +163,7 @@ TEST(ContactBarOrbit, ShortModeOneBranchMatchesTheClosedForm) {
   int count = 0;
   const double worst = worst_branch_error(p, 1, 30, 0.02, &count);
   EXPECT_EQ(count, 30);
-  EXPECT_LE(worst, 1e-5);  // acceptance; measured ~1e-10 (Newton tolerance 1e-10 on |F|)
+  EXPECT_LE(worst, 1e-5);  // acceptance; the Newton tolerance 1e-10 on |F| leaves far less
 }
 
 TEST(ContactBarOrbit, ModeTwoTentIsExactWithAFreeKnotAndOnlyO_dx_OnAUniformGrid) {
@@ -191,10 +191,10 @@ TEST(ContactBarOrbit, ModeTwoTentIsExactWithAFreeKnotAndOnlyO_dx_OnAUniformGrid)
 
 // The square projected residual (N hat averages of v(T/2) for N unknowns) has spurious roots:
 // with N = 20, a branch traced through end amplitudes 2.8-3 g0 leaves the contact family for
-// orbits whose hat averages vanish while v(T/2) does not (measured: closed-form error 9e-2,
-// exact return error 0.2). Sampling the residual on 2N test functions makes the system
-// overdetermined but consistent: true orbits zero every test function, spurious ones cannot
-// zero 2N of them with N free values, and the same branch stays on the closed form.
+// orbits whose hat averages vanish while v(T/2) does not. Sampling the residual on 2N test
+// functions makes the system overdetermined but consistent: true orbits zero every test
+// function, spurious ones cannot zero 2N of them with N free values, and the same branch stays
+// on the closed form.
 TEST(ContactBarOrbit, OversampledResidualHasNoSpuriousRoots) {
   const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
   int square_count = 0, over_count = 0;
@@ -202,12 +202,12 @@ TEST(ContactBarOrbit, OversampledResidualHasNoSpuriousRoots) {
   ContactBarOrbitProblem over(paper_setup(), event, grid(20, 40, 0, 40));
   EXPECT_EQ(over.num_equations(), 40);
   // ds in scaled unknowns (RMS of u0 / g0 over the bar, T c / L): 0.45 is 2 in the Euclidean
-  // norm of the 20 nodal values the trace used to take.
+  // norm of the 20 nodal values.
   const double square_error = worst_branch_error(square, 1, 70, 0.45, &square_count);
   const double over_error = worst_branch_error(over, 1, 70, 0.45, &over_count);
   EXPECT_GT(square_error, 1e-3);  // the failure this option exists for
   EXPECT_EQ(over_count, 70);
-  EXPECT_LE(over_error, 1e-9);  // acceptance 1e-5; measured 1e-13 (Newton tolerance 1e-10 g0)
+  EXPECT_LE(over_error, 1e-9);  // acceptance 1e-5; the Newton tolerance 1e-10 g0 leaves less
 }
 
 // The continuation norm of the u0 unknowns is the L2 norm of u0 over the bar (trapezoid rule,
@@ -299,17 +299,15 @@ TEST(ContactBarOrbit, TestElementsBelowTheUnknownsAreRejected) {
 // mode 1 from end amplitude 1.05 g0 (E = 5.5e-7 J) to E = 1e4 J (1.4e5 g0) with the trace's
 // settings (20 intervals, 40 test elements, ds = ds_max = 0.45, Newton tolerance 3e-9, rank
 // report with threshold 1e-5 at every point). In units of the gap a step moves u0 by about
-// 0.45 g0 in L2, so the branch would need ~2e5 points (measured: 200 points end at 1.2e-2 J);
-// with amplitude_units the unit of u0 and of the residual is the orbit's amplitude and steps
-// are relative: 37 points (measured; asserted <= 50). Jacobians: one per Newton iteration plus
-// the tangent (4-9), except the last two points above 1.2e5 g0, where mode 1's own smallest
-// kept singular value falls below 1e-5 relative (it shrinks like g0 / A) and the rank report
-// probes a candidate (138 and 245): mean 15.2 a point (measured; asserted <= 30, since the
-// probes vary with the points' exact position). Before the chord check of the
-// tangent (pseudo_arclength.cpp), a forward-difference Jacobian across a kink of the contact
-// map at 8e3 J gave a tangent 52.8 degrees off: 24 points crawled there with rank probes, 60
-// points and 80 Jacobians a point. Every point is an exact mode-1 orbit: within 1e-10 of the
-// closed-form frequency (measured 7e-12; the Newton tolerance, relative to the amplitude,
+// 0.45 g0 in L2, so the branch would need ~2e5 points: 200 points stay below 0.1 J. With
+// amplitude_units the unit of u0 and of the residual is the orbit's amplitude and steps are
+// relative: at most 50 points. Jacobians: one per Newton iteration plus the tangent (4-9),
+// except above 1.2e5 g0, where mode 1's own smallest kept singular value falls below 1e-5
+// relative (it shrinks like g0 / A) and the rank report probes a candidate: at most 30 a point
+// on average (the probes vary with the points' exact position). The tangent's chord check
+// (pseudo_arclength.cpp) keeps a forward-difference Jacobian across a kink of the contact map
+// (near 8e3 J) from turning the tangent off the branch. Every point is an exact mode-1 orbit:
+// within 1e-10 of the closed-form frequency (the Newton tolerance, relative to the amplitude,
 // bounds the period error by ~1e-11).
 TEST(ContactBarOrbit, HighEnergyModeOneTakesRelativeSteps) {
   const contact_bar::TdbemSolver event(contact_bar::ContactMethod::event);
@@ -343,8 +341,8 @@ TEST(ContactBarOrbit, HighEnergyModeOneTakesRelativeSteps) {
   for (const auto& point : b.points) {
     jacobians += static_cast<double>(point.jacobian_evaluations);
     // Far above the gap the period column dominates the Jacobian (sigma_max 2e6 at 6e4 g0) and
-    // a probe can stall at the round-off (measured once, 1818 J: 3.5e-9 against 3e-9, verified
-    // 0, which the trace flags unconfirmed): at most one such point, and only there.
+    // a probe can stall at the round-off just above its tolerance (verified 0, which the trace
+    // flags unconfirmed): at most one such point, and only above 100 J.
     if (point.dimension != 1) {
       ++not_one;
       EXPECT_GT(point.observable("energy"), 100.0) << point.index;

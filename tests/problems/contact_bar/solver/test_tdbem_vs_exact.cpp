@@ -143,7 +143,7 @@ TEST(TdbemVsExact, SnapshotProjectionsMatch) {
 // over the sorted breakpoints. Both against the exact solution's energy, for a u0 with kinks off
 // the grid, v0 = 0, contact episodes and dt off the grid (0.0137): with v0 = 0 the tractions are
 // piecewise constant, which the event method reproduces to round-off, so only round-off
-// separates the energies (1e-13 relative; measured 1.2e-14, the quadrature on every row 1.4e-14).
+// separates the energies (1e-13 relative, for either integration).
 // (A v0 with kinks makes them piecewise linear, which no piecewise-constant march holds exactly.)
 TEST(TdbemVsExact, EnergyMatchesTheExactEnergyBeforeAndAfterOneTransit) {
   bar::BarSetup s;

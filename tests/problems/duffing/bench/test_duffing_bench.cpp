@@ -1,5 +1,5 @@
-// The Duffing benchmark against AUTO-07p (problems/duffing/bench.hpp): backbone's headline run
-// against the exact period, the reader of AUTO's branch file on a file with known errors, and
+// The Duffing benchmark against AUTO-07p (problems/duffing/bench/bench.hpp): backbone's headline
+// run against the exact period, the reader of AUTO's branch file on a file with known errors, and
 // the stored peer runs against the exact period recomputed here.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -31,11 +31,11 @@ std::filesystem::path scratch_folder(const std::string& name) {
 
 }  // namespace
 
-// The bench's default settings (rtol 1e-12, ds_max 1) reach amplitude 5 within the issue's
-// error bound 4e-11 of the exact period (the AUTO-07p NTST 50 error, 4.3e-11, rounded down):
-// measured 1.8e-12. The residual tolerance 1e-11 alone allows dT / T <= 1e-11 / 3, CVODE at rtol
-// 1e-12 adds ~1e-12 per flow, so a bound of 4e-11 is met with a margin and a broken Jacobian,
-// step or tolerance (errors 1e-9 and up) fails it.
+// The bench's default settings (rtol 1e-12, ds_max 1) reach amplitude 5 within the error bound
+// 4e-11 of the exact period (the AUTO-07p NTST 50 error, 4.3e-11, rounded down). The residual
+// tolerance 1e-11 alone allows dT / T <= 1e-11 / 3, CVODE at rtol 1e-12 adds ~1e-12 per flow, so a
+// bound of 4e-11 is met with a margin and a broken Jacobian, step or tolerance (errors 1e-9 and up)
+// fails it.
 TEST(DuffingBench, HeadlineRunReachesAmplitudeFiveWithinTheErrorTarget) {
   const duffing::BackboneSettings settings;
   const duffing::BackboneRun run = duffing::trace_backbone(settings);
