@@ -3,10 +3,11 @@
 // DIR/unknowns.csv, DIR/state.txt (the restart format), DIR/branch.png and DIR/summary.txt.
 //
 // The scene's `problem` key picks a plugin (continuation/cli/plugin.hpp); its setup builds the
-// problem and the guess. Continuation settings are scene keys too (continuation/
+// problem and the guess. Continuation settings are scene keys too (continuation/cli/
 // scene_options.hpp; defaults < scene file < command line). Bad input throws core::InputError
-// before anything is written (exit 2). A branch that ends early keeps and writes its points
-// (exit 0, reason printed and in summary.txt); exit 1 only when no point converged.
+// before anything is written (exit 2). A branch that ends before its bound or point budget keeps
+// and writes its points and exits 1 (reason on stderr and in summary.txt); a run stopped by a
+// signal exits 128 + the signal.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
