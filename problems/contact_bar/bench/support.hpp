@@ -1,11 +1,11 @@
 // What the contact-bar benchmark cases (bench_*.cpp) share besides their metrics: the mode-1
-// scene, an in-process trace, timing and figure reporting. Internal to problems/contact_bar.
+// scene, an in-process trace, timing, and the report of tables, figures and peer comparisons.
+// Internal to problems/contact_bar.
 //
 //   const bench::PaperMode1 m = bench::paper_mode1();   // m.episode.period = 3.1
 //   const double s = bench::best_seconds([&] { solver.simulate(setup, options); });
 //   const bench::InProcessTrace t = bench::trace_in_process(plugin, scene, "mode1");
 //   const std::vector<double> e = bench::mode1_frequency_errors(scene, t.traced.branch);
-//   bench::report_plot(core::render_png(png, script), png);
 //   const auto csv = bench::write_table(table, out, "lu_legrand", 3);  // out/lu_legrand.csv
 //   bench::plot(out / "lu_legrand.png", script, {1600, 700});
 //   bench::report_peer_case(out, "siconos_bar", table, figure, verdict, section);
