@@ -31,7 +31,6 @@
 
 namespace backbone::contact_bar {
 
-
 namespace {
 
 double wall_seconds_since(std::chrono::steady_clock::time_point start) {
@@ -57,9 +56,6 @@ void read_mode1_scene(Mode1Scene& s, const Mode1BranchSettings& settings) {
        std::to_string(settings.threads), "--rank_check_every",
        std::to_string(settings.rank_check_every)});
 }
-
-// Errors of exactly 0 (round-off luck) are drawn at this floor on the log axes.
-constexpr double plot_floor = 1e-17;
 
 // The 1-minute load average of the machine (Linux /proc/loadavg), "unknown" elsewhere: wall
 // times with threads mean little when other work keeps every core busy.
@@ -204,10 +200,9 @@ JacobianThreadsTiming time_jacobian_threads(int elements, int repetitions) {
   JacobianThreadsTiming t;
   t.elements = elements;
   core::Matrix J[2];
-  // One Jacobian takes about 15 ms at N = 200: a single run is at the mercy of whatever else
-  // the machine schedules in that time (best of 3 gave 1.4-2.0x on a quiet machine). The
-  // repetitions alternate 1 and 2 threads, so that a slow spell hits both, and the medians
-  // are compared.
+  // One Jacobian is short enough to be at the mercy of whatever else the machine schedules
+  // while it runs. The repetitions alternate 1 and 2 threads, so that a slow spell hits both,
+  // and the medians are compared.
   std::vector<double> wall[2], cpu[2];
   for (int r = 0; r < std::max(repetitions, 1); ++r) {
     for (int k = 0; k < 2; ++k) {
@@ -222,11 +217,7 @@ JacobianThreadsTiming time_jacobian_threads(int elements, int repetitions) {
       if (status != core::EvalStatus::ok) J[k].resize(0, 0);  // not identical to anything
     }
   }
-  const auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t h = v.size() / 2;
-    return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
-  };
+  const auto median = bench::median;
   t.rows = static_cast<int>(J[0].rows());
   t.columns = static_cast<int>(J[0].cols());
   t.repetitions = std::max(repetitions, 1);
@@ -237,23 +228,32 @@ JacobianThreadsTiming time_jacobian_threads(int elements, int repetitions) {
   return t;
 }
 
-int bench_mode1_scaling(const std::filesystem::path& out) {
+namespace {
+
+// The grids of the grid studies: BACKBONE_MODE1_SCALING_N, or 20 to 640 by doubling.
+std::vector<int> scaling_grids() {
   const char* grids_env = std::getenv("BACKBONE_MODE1_SCALING_N");
-  const std::vector<int> grids =
-      parse_element_list(grids_env && *grids_env ? grids_env : "20,40,80,160,320,640");
-  fmt::print(
-      "bench mode1_scaling: mode 1, T 3.8 -> 3.01 (paper scene, start_offset 0.25, energy_max "
-      "5e-3), whole-branch cost vs closed-form error over N = {} (BACKBONE_MODE1_SCALING_N), "
-      "steps per period, formulation, corrector and threads\n",
-      fmt::join(grids, ", "));
-  std::vector<Mode1BranchCost> runs, grid_runs;
-  int status = 0;
-  const double short_run_seconds = 2;
-  const auto run = [&](const Mode1BranchSettings& settings) -> const Mode1BranchCost& {
-    runs.push_back(trace_mode1_cost(settings));
-    Mode1BranchCost& c = runs.back();
-    // A short run is repeated and timed at its best (the branch is the same each time): the
-    // machine's load inflates even CPU time, by up to ~30 % measured on short runs.
+  return parse_element_list(grids_env && *grids_env ? grids_env : "20,40,80,160,320,640");
+}
+
+// The variants sit at N = 40, threads at 80 (where a residual costs enough to share), each
+// beside its baseline, the grid row of the same N; the Jacobian alone is timed at N = 200.
+constexpr int variant_n = 40, threads_n = 80, jacobian_n = 200;
+
+// Every run of the case: `all` in the table's order, the rest by study.
+struct ScalingRuns {
+  std::vector<Mode1BranchCost> all, grid, fine, unchecked;
+  Mode1BranchCost base, spp80, paper, eigen_square, kinsol_square, threads_base, threads;
+  bool threads_same = false;
+  int status = 0;  // 1 when a grid run stops early or threads change the branch
+
+  // Traces one setting, appends it to `all` and prints its line. A run under 2 s of CPU is
+  // repeated and timed at its best (the branch is the same each time): the machine's load
+  // inflates even CPU time, most on short runs.
+  const Mode1BranchCost& run(const Mode1BranchSettings& settings) {
+    const double short_run_seconds = 2;
+    all.push_back(trace_mode1_cost(settings));
+    Mode1BranchCost& c = all.back();
     for (int k = 1; k < 3 && c.cpu_seconds < short_run_seconds; ++k) {
       const Mode1BranchCost again = trace_mode1_cost(settings);
       if (again.cpu_seconds < c.cpu_seconds)
@@ -264,242 +264,250 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
                c.complete ? "" : "  stopped early: " + c.message);
     std::fflush(stdout);  // a long bench shows its progress run by run
     return c;
-  };
+  }
+  // Runs a grid study's setting into `study`; an incomplete branch sets status 1.
+  void run_into(std::vector<Mode1BranchCost>& study, const Mode1BranchSettings& settings) {
+    study.push_back(run(settings));
+    if (!study.back().complete) status = 1;
+  }
+  // The grid row of N, or a baseline run when the grids skip N.
+  Mode1BranchCost grid_run(int n) {
+    for (const Mode1BranchCost& c : grid)
+      if (c.settings.elements == n) return c;
+    Mode1BranchSettings s;
+    s.study = "baseline";
+    s.elements = n;
+    return run(s);
+  }
+};
+
+// The grid studies: the grids at 40 steps per period, at 2 N, and without rank reports.
+void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
   for (int n : grids) {
     Mode1BranchSettings s;
     s.elements = n;
-    grid_runs.push_back(run(s));
-    if (!grid_runs.back().complete) status = 1;
+    r.run_into(r.grid, s);
   }
   // The same grids at steps_per_period = 2 N (Courant number c dt / dx = T / 2L, about 1.75):
   // a row of the shooting residual then depends on u0 over a few elements about each
-  // characteristic image, so the compressed Jacobian needs about 15 colours at every N where
-  // the trace's 40 steps need about N / 2 (problems/contact_bar/README.md, 'Cost').
-  std::vector<Mode1BranchCost> fine_runs;
+  // characteristic image, so the compressed Jacobian needs a number of colours independent of
+  // N, where the trace's 40 steps need about N / 2 (problems/contact_bar/README.md, 'Cost').
   for (int n : grids) {
     if (2 * n <= 40) continue;  // that grid row is this setting already
     Mode1BranchSettings s;
     s.study = "grid_2N";
     s.elements = n;
     s.steps_per_period = 2 * n;
-    fine_runs.push_back(run(s));
-    if (!fine_runs.back().complete) status = 1;
+    r.run_into(r.fine, s);
   }
   // Without rank reports (--rank_check_every 0), up to N = 640: what the corrections cost
-  // alone, and the start at T = 3.8 is not probed (at N = 320 its many-dimensional verification
-  // is 43 of the trace's 45 s, problems/contact_bar/README.md, 'Cost').
-  std::vector<Mode1BranchCost> unchecked_runs;
+  // alone, without the verification of the many-dimensional start at T = 3.8, which dominates
+  // the checked trace at large N (problems/contact_bar/README.md, 'Cost').
   for (int n : {40, 80, 160, 320, 640}) {
     Mode1BranchSettings s;
     s.study = "grid_unchecked";
     s.elements = n;
     s.rank_check_every = 0;
-    unchecked_runs.push_back(run(s));
-    if (!unchecked_runs.back().complete) status = 1;
+    r.run_into(r.unchecked, s);
   }
-  const auto grid_run = [&](int n) -> Mode1BranchCost {
-    for (const Mode1BranchCost& c : grid_runs)
-      if (c.settings.elements == n) return c;
-    Mode1BranchSettings s;
-    s.study = "baseline";
-    s.elements = n;
-    return run(s);
-  };
-  // The variants at N = 40 (threads at 80, where a residual costs enough to share), each beside
-  // its baseline: the grid row of the same N.
-  const int variant_n = 40, threads_n = 80;
-  const Mode1BranchCost base = grid_run(variant_n), threads_base = grid_run(threads_n);
+}
+
+// The variants: steps per period, formulation, corrector and threads, each at its N.
+void run_variants(ScalingRuns& r) {
+  r.base = r.grid_run(variant_n);
+  r.threads_base = r.grid_run(threads_n);
   Mode1BranchSettings spp;
   spp.study = "steps_per_period";
   spp.elements = variant_n;
   spp.steps_per_period = 80;
-  const Mode1BranchCost spp80 = run(spp);
+  r.spp80 = r.run(spp);
   Mode1BranchSettings paper;
   paper.study = "formulation";
   paper.elements = variant_n;
   paper.formulation = "paper";
-  const Mode1BranchCost paper_run = run(paper);
+  r.paper = r.run(paper);
   Mode1BranchSettings square;
   square.study = "corrector";
   square.elements = variant_n;
   square.test_elements = 0;
-  const Mode1BranchCost eigen_square = run(square);
+  r.eigen_square = r.run(square);
   square.newton = "kinsol";
-  const Mode1BranchCost kinsol_square = run(square);
+  r.kinsol_square = r.run(square);
   Mode1BranchSettings two;
   two.study = "threads";
   two.elements = threads_n;
   two.threads = 2;
-  const Mode1BranchCost threads_run = run(two);
-  const bool threads_same = same_branch(threads_base, threads_run);
+  r.threads = r.run(two);
+  r.threads_same = same_branch(r.threads_base, r.threads);
   fmt::print("  2 threads at N = {}: {} branch as 1 thread\n", threads_n,
-             threads_same ? "the same" : "NOT the same");
-  if (!threads_same) status = 1;
+             r.threads_same ? "the same" : "NOT the same");
+  if (!r.threads_same) r.status = 1;
+}
 
-  const int jacobian_n = 200;
-  const std::string load = load_average();
-  const JacobianThreadsTiming jt = time_jacobian_threads(jacobian_n);
-  fmt::print(
-      "  FD Jacobian alone at N = {} ({} x {}), median of {} alternating runs: 1 thread {:.4g} s, "
-      "2 threads "
-      "{:.4g} s, speedup {:.3g}x, {}\n",
-      jacobian_n, jt.rows, jt.columns, jt.repetitions, jt.one_thread_seconds, jt.two_thread_seconds,
-      jt.speedup(), jt.identical ? "bit-identical" : "NOT identical");
-  if (!jt.identical) status = 1;
+// The exponent of ms per point over N >= 40 (NaN without two such grids), the constant of its
+// fit line and the point count of the largest grid against N = 40.
+struct GridFit {
+  double exponent = std::nan("");
+  double constant = std::nan("");  // C of ms = C N^p through the geometric mean of the runs
+  double point_ratio = 0;
+  const Mode1BranchCost* largest = nullptr;
+  const Mode1BranchCost* n160 = nullptr;  // the grid row of N = 160, if run
+};
 
-  const core::Table table = branch_cost_table(runs);
-  const std::filesystem::path csv = out / "mode1_scaling.csv";
-  table.write_csv(csv);
-  fmt::print("{}", table.aligned(3));
-
-  // The fit over N >= 40 and the point counts at the largest grid and at 40.
-  const double exponent = grids.size() >= 2 && std::count_if(grids.begin(), grids.end(),
-                                                             [](int n) { return n >= 40; }) >= 2
-                              ? time_per_point_exponent(grid_runs, 40)
-                              : std::nan("");
-  const Mode1BranchCost& largest = grid_runs.back();
-  const double point_ratio = static_cast<double>(largest.points) / base.points;
-  const Mode1BranchCost* n160 = nullptr;
-  for (const Mode1BranchCost& c : grid_runs)
-    if (c.settings.elements == 160) n160 = &c;
+GridFit fit_grid(const ScalingRuns& r, const std::vector<int>& grids) {
+  GridFit f;
+  if (grids.size() >= 2 &&
+      std::count_if(grids.begin(), grids.end(), [](int n) { return n >= 40; }) >= 2)
+    f.exponent = time_per_point_exponent(r.grid, 40);
+  f.largest = &r.grid.back();
+  f.point_ratio = static_cast<double>(f.largest->points) / r.base.points;
+  for (const Mode1BranchCost& c : r.grid)
+    if (c.settings.elements == 160) f.n160 = &c;
   fmt::print(
       "  exponent of ms per point over N >= 40: {:.3f}; points at N = {} / at N = 40: {:.3g}\n",
-      exponent, largest.settings.elements, point_ratio);
-
-  // Left: ms per point vs N with the fit; right: worst error vs CPU seconds per branch.
-  const std::string q = core::gnuplot_quote(csv);
-  double fit_constant = std::nan("");
-  if (std::isfinite(exponent)) {  // C of ms = C N^p through the geometric mean of the fitted runs
+      f.exponent, f.largest->settings.elements, f.point_ratio);
+  if (std::isfinite(f.exponent)) {
     double log_c = 0;
     int count = 0;
-    for (const Mode1BranchCost& c : grid_runs)
+    for (const Mode1BranchCost& c : r.grid)
       if (c.settings.elements >= 40)
-        log_c += std::log(c.ms_per_point()) - exponent * std::log(c.settings.elements), ++count;
-    fit_constant = std::exp(log_c / count);
+        log_c += std::log(c.ms_per_point()) - f.exponent * std::log(c.settings.elements), ++count;
+    f.constant = std::exp(log_c / count);
   }
-  const std::filesystem::path png = out / "mode1_scaling.png";
-  const std::string fit_clause =
-      std::isfinite(exponent)
-          ? fmt::format(", ({:.6g})*x**({:.6g}) dt 2 lw 2 title 'fit N^{:.2f} (N >= 40)'",
-                        fit_constant, exponent, exponent)
-          : std::string();
-  bench::report_plot(
-      core::render_png(
-          png,
-          fmt::format(
-              "set termoption noenhanced\nset multiplot layout 1,2\nset logscale xy\nset grid\n"
-              "floor = {2}\n"
-              "err(d) = column('worst_closed_form_error') > floor ? "
-              "column('worst_closed_form_error') : floor\n"
-              "cpu(s) = strcol('study') eq s && column('complete') == 1 ? "
-              "column('total_seconds') : NaN\n"
-              "square(n) = strcol('study') eq 'corrector' && strcol('newton') eq n && "
-              "column('complete') == 1 ? column('total_seconds') : NaN\n"
-              "set key left top\nset xlabel 'shooting intervals N'\n"
-              "set ylabel 'CPU ms per point'\nset title 'Mode 1, T 3.8 -> 3.01: cost per point'\n"
-              "plot {0} using (strcol('study') eq 'grid' ? column('N') : NaN):'ms_per_point' "
-              "with linespoints pt 7 ps 1.5 title 'regular, eigen, 1 thread, 40 steps per "
-              "period'{1}, {0} using (strcol('study') eq 'grid_unchecked' ? column('N') : NaN):"
-              "'ms_per_point' with linespoints pt 6 ps 1.5 title 'the same without rank checks', "
-              "25 dt 3 title 'target at N = 160: 25 ms'\n"
-              "set format y '%.0e'\nset xlabel 'CPU seconds per branch'\n"
-              "set ylabel 'worst relative frequency error (closed form)'\n"
-              "set title 'Work-precision: whole branches that reach E = 5e-3 (errors of 0 at "
-              "1e-17)'\nset key left top\n"
-              "plot {0} using (cpu('grid')):(err(0)) with linespoints pt 7 ps 1.5 title 'N "
-              "(labels): regular, eigen, 1 thread', "
-              "{0} using (cpu('grid')):(err(0)):(sprintf('%d', column('N'))) with labels offset "
-              "0,1 notitle, "
-              "{0} using (cpu('steps_per_period')):(err(0)) with points pt 5 ps 1.5 title 'N = "
-              "40, 80 steps per period', "
-              "{0} using (cpu('formulation')):(err(0)) with points pt 9 ps 1.5 title 'N = 40, "
-              "paper formulation (drawn only if it reaches the bound)', "
-              "{0} using (square('eigen')):(err(0)) with points pt 11 ps 1.5 title 'N = 40, "
-              "square system, eigen', "
-              "{0} using (square('kinsol')):(err(0)) with points pt 13 ps 1.5 title 'N = 40, "
-              "square system, kinsol', "
-              "{0} using (cpu('threads')):(err(0)) with points pt 3 ps 2 lw 2 title 'N = 80, 2 "
-              "threads (CPU of both)'\n"
-              "unset multiplot\n",
-              q, fit_clause, plot_floor),
-          {1600, 700}),
-      png);
+  return f;
+}
 
-  // BENCHMARKS.md: the grid table, the variants, the Jacobian alone.
-  const auto row = [](const Mode1BranchCost& c) {
-    const std::string stopped =
-        c.complete ? std::string()
-                   : fmt::format(" (stopped at E = {:.2g}: {})", c.energy_reached, c.stop_reason);
-    return fmt::format("| {}{} | {} | {} | {} | {} | {} | {} |\n", c.settings.label(), stopped,
-                       c.points, significant(c.jacobians_per_point()),
-                       significant(c.ms_per_point()), significant(c.cpu_seconds),
-                       error_text(c.worst_error), error_text(c.median_error));
-  };
-  const std::string header =
-      "| setting | points | Jacobians/point | ms/point (CPU) | total CPU s | worst error | "
-      "median error |\n|---|---|---|---|---|---|---|\n";
-  std::string grid_rows, variant_rows;
-  for (const Mode1BranchCost& c : grid_runs) grid_rows += row(c);
-  for (const Mode1BranchCost& c : fine_runs) grid_rows += row(c);
-  for (const Mode1BranchCost& c : unchecked_runs) grid_rows += row(c);
-  for (const Mode1BranchCost* c :
-       {&base, &spp80, &paper_run, &eigen_square, &kinsol_square, &threads_base, &threads_run})
-    variant_rows += row(*c);
-  const std::string grid_verdict = fmt::format(
+// Left: ms per point vs N with the fit; right: worst error vs CPU seconds per branch.
+void plot_scaling(const std::filesystem::path& csv, const std::filesystem::path& png,
+                  const GridFit& fit) {
+  const std::string q = core::gnuplot_quote(csv);
+  const std::string fit_clause =
+      std::isfinite(fit.exponent)
+          ? fmt::format(", ({:.6g})*x**({:.6g}) dt 2 lw 2 title 'fit N^{:.2f} (N >= 40)'",
+                        fit.constant, fit.exponent, fit.exponent)
+          : std::string();
+  bench::plot(
+      png,
+      fmt::format(
+          "set termoption noenhanced\nset multiplot layout 1,2\nset logscale xy\nset grid\n"
+          "floor = {2}\n"
+          "err(d) = column('worst_closed_form_error') > floor ? "
+          "column('worst_closed_form_error') : floor\n"
+          "cpu(s) = strcol('study') eq s && column('complete') == 1 ? "
+          "column('total_seconds') : NaN\n"
+          "square(n) = strcol('study') eq 'corrector' && strcol('newton') eq n && "
+          "column('complete') == 1 ? column('total_seconds') : NaN\n"
+          "set key left top\nset xlabel 'shooting intervals N'\n"
+          "set ylabel 'CPU ms per point'\nset title 'Mode 1, T 3.8 -> 3.01: cost per point'\n"
+          "plot {0} using (strcol('study') eq 'grid' ? column('N') : NaN):'ms_per_point' "
+          "with linespoints pt 7 ps 1.5 title 'regular, eigen, 1 thread, 40 steps per "
+          "period'{1}, {0} using (strcol('study') eq 'grid_unchecked' ? column('N') : NaN):"
+          "'ms_per_point' with linespoints pt 6 ps 1.5 title 'the same without rank checks', "
+          "25 dt 3 title 'target at N = 160: 25 ms'\n"
+          "set format y '%.0e'\nset xlabel 'CPU seconds per branch'\n"
+          "set ylabel 'worst relative frequency error (closed form)'\n"
+          "set title 'Work-precision: whole branches that reach E = 5e-3 (errors of 0 at "
+          "1e-17)'\nset key left top\n"
+          "plot {0} using (cpu('grid')):(err(0)) with linespoints pt 7 ps 1.5 title 'N "
+          "(labels): regular, eigen, 1 thread', "
+          "{0} using (cpu('grid')):(err(0)):(sprintf('%d', column('N'))) with labels offset "
+          "0,1 notitle, "
+          "{0} using (cpu('steps_per_period')):(err(0)) with points pt 5 ps 1.5 title 'N = "
+          "40, 80 steps per period', "
+          "{0} using (cpu('formulation')):(err(0)) with points pt 9 ps 1.5 title 'N = 40, "
+          "paper formulation (drawn only if it reaches the bound)', "
+          "{0} using (square('eigen')):(err(0)) with points pt 11 ps 1.5 title 'N = 40, "
+          "square system, eigen', "
+          "{0} using (square('kinsol')):(err(0)) with points pt 13 ps 1.5 title 'N = 40, "
+          "square system, kinsol', "
+          "{0} using (cpu('threads')):(err(0)) with points pt 3 ps 2 lw 2 title 'N = 80, 2 "
+          "threads (CPU of both)'\n"
+          "unset multiplot\n",
+          q, fit_clause, bench::plot_floor),
+      {1600, 700});
+}
+
+// One row of the BENCHMARKS.md tables.
+std::string cost_row(const Mode1BranchCost& c) {
+  const std::string stopped =
+      c.complete ? std::string()
+                 : fmt::format(" (stopped at E = {:.2g}: {})", c.energy_reached, c.stop_reason);
+  return fmt::format("| {}{} | {} | {} | {} | {} | {} | {} |\n", c.settings.label(), stopped,
+                     c.points, significant(c.jacobians_per_point()), significant(c.ms_per_point()),
+                     significant(c.cpu_seconds), error_text(c.worst_error),
+                     error_text(c.median_error));
+}
+
+std::string grid_verdict(const ScalingRuns& r, const GridFit& f) {
+  const Mode1BranchCost& largest = *f.largest;
+  return fmt::format(
       "ms per point grows like N^{:.2f} over N >= 40 (target <= 1.5: {}), N = 160 costs {} ms "
       "per point (target <= 25: {}), and N = {} takes {:.3g}x the points of N = 40 (target "
       "within 2x at 640: {}); Jacobians per point grow from {:.3g} at N = 40 to {:.3g} at N = "
       "{}.",
-      exponent, exponent <= 1.5 ? "met" : "not met",
-      n160 ? significant(n160->ms_per_point()) : std::string("(not run)"),
-      n160 ? (n160->ms_per_point() <= 25 ? "met" : "not met") : "not measured",
-      largest.settings.elements, point_ratio,
-      largest.settings.elements < 640 ? "640 not run here" : (point_ratio <= 2 ? "met" : "not met"),
-      base.jacobians_per_point(), largest.jacobians_per_point(), largest.settings.elements);
+      f.exponent, f.exponent <= 1.5 ? "met" : "not met",
+      f.n160 ? significant(f.n160->ms_per_point()) : std::string("(not run)"),
+      f.n160 ? (f.n160->ms_per_point() <= 25 ? "met" : "not met") : "not measured",
+      largest.settings.elements, f.point_ratio,
+      largest.settings.elements < 640 ? "640 not run here"
+                                      : (f.point_ratio <= 2 ? "met" : "not met"),
+      r.base.jacobians_per_point(), largest.jacobians_per_point(), largest.settings.elements);
+}
+
+std::string unchecked_verdict(const ScalingRuns& r) {
   const double unchecked_points =
-      static_cast<double>(unchecked_runs.back().points) / unchecked_runs.front().points;
-  const double unchecked_exponent = time_per_point_exponent(unchecked_runs, 40);
-  const std::string unchecked_verdict = fmt::format(
+      static_cast<double>(r.unchecked.back().points) / r.unchecked.front().points;
+  const double unchecked_exponent = time_per_point_exponent(r.unchecked, 40);
+  return fmt::format(
       " Without rank checks (`--rank_check_every 0`), ms per point grows like N^{:.2f} over N = "
       "40..640 ({} ms per point at 640, worst error {}) and N = 640 takes {:.3g}x the points of "
       "N = 40.",
-      unchecked_exponent, significant(unchecked_runs.back().ms_per_point()),
-      error_text(unchecked_runs.back().worst_error), unchecked_points);
-  fmt::print("  {}\n", unchecked_verdict);
-  std::string fine_verdict;
-  if (std::count_if(fine_runs.begin(), fine_runs.end(),
-                    [](const Mode1BranchCost& c) { return c.settings.elements >= 40; }) >= 2) {
-    const Mode1BranchCost* fine160 = nullptr;
-    for (const Mode1BranchCost& c : fine_runs)
-      if (c.settings.elements == 160) fine160 = &c;
-    fine_verdict = fmt::format(
-        " At steps_per_period = 2 N, ms per point grows like N^{:.2f} over N >= 40{}, with {:.3g} "
-        "Jacobians per point at N = {}.",
-        time_per_point_exponent(fine_runs, 40),
-        fine160 ? fmt::format(" and N = 160 costs {} ms per point",
-                              significant(fine160->ms_per_point()))
-                : std::string(),
-        fine_runs.back().jacobians_per_point(), fine_runs.back().settings.elements);
-  }
-  const std::string variant_verdict = fmt::format(
+      unchecked_exponent, significant(r.unchecked.back().ms_per_point()),
+      error_text(r.unchecked.back().worst_error), unchecked_points);
+}
+
+// Empty without two grid_2N runs at N >= 40.
+std::string fine_verdict(const ScalingRuns& r) {
+  if (std::count_if(r.fine.begin(), r.fine.end(),
+                    [](const Mode1BranchCost& c) { return c.settings.elements >= 40; }) < 2)
+    return std::string();
+  const Mode1BranchCost* fine160 = nullptr;
+  for (const Mode1BranchCost& c : r.fine)
+    if (c.settings.elements == 160) fine160 = &c;
+  return fmt::format(
+      " At steps_per_period = 2 N, ms per point grows like N^{:.2f} over N >= 40{}, with {:.3g} "
+      "Jacobians per point at N = {}.",
+      time_per_point_exponent(r.fine, 40),
+      fine160
+          ? fmt::format(" and N = 160 costs {} ms per point", significant(fine160->ms_per_point()))
+          : std::string(),
+      r.fine.back().jacobians_per_point(), r.fine.back().settings.elements);
+}
+
+std::string variant_verdict(const ScalingRuns& r) {
+  const Mode1BranchCost& base = r.base;
+  return fmt::format(
       "at N = 40, 80 steps per period cost {:.2g}x the CPU of 40 for a worst error of {} against "
       "{}; the paper formulation {}; the square system costs {:.2g}x (eigen) and {:.2g}x "
       "(kinsol) the overdetermined one; 2 threads at N = {} give {} branch at {:.2g}x the wall "
       "time and {:.2g}x the CPU time of one thread.",
-      spp80.cpu_seconds / base.cpu_seconds, error_text(spp80.worst_error),
+      r.spp80.cpu_seconds / base.cpu_seconds, error_text(r.spp80.worst_error),
       error_text(base.worst_error),
-      paper_run.complete
+      r.paper.complete
           ? fmt::format("reaches the bound at {:.2g}x the CPU with a worst error of {}",
-                        paper_run.cpu_seconds / base.cpu_seconds, error_text(paper_run.worst_error))
+                        r.paper.cpu_seconds / base.cpu_seconds, error_text(r.paper.worst_error))
           : fmt::format("stops at E = {:.3g} after {} point(s) ({}: its Jacobian is degenerate "
                         "on the family, problems/contact_bar/README.md, section 'Shooting on the "
                         "bar'), so it has no branch cost to compare",
-                        paper_run.energy_reached, paper_run.points, paper_run.stop_reason),
-      eigen_square.cpu_seconds / base.cpu_seconds, kinsol_square.cpu_seconds / base.cpu_seconds,
-      threads_n, threads_same ? "the same (bit for bit)" : "a DIFFERENT",
-      threads_run.wall_seconds / threads_base.wall_seconds,
-      threads_run.cpu_seconds / threads_base.cpu_seconds);
-  const std::string jacobian_verdict = fmt::format(
+                        r.paper.energy_reached, r.paper.points, r.paper.stop_reason),
+      r.eigen_square.cpu_seconds / base.cpu_seconds, r.kinsol_square.cpu_seconds / base.cpu_seconds,
+      threads_n, r.threads_same ? "the same (bit for bit)" : "a DIFFERENT",
+      r.threads.wall_seconds / r.threads_base.wall_seconds,
+      r.threads.cpu_seconds / r.threads_base.cpu_seconds);
+}
+
+std::string jacobian_verdict(const JacobianThreadsTiming& jt, const std::string& load) {
+  return fmt::format(
       "2 threads compute the {} x {} Jacobian {:.3g}x faster than one (target >= 1.7x: {}), "
       "{}; these are wall times on a machine of {} cores with a load average of {} when they "
       "were taken: the 2 threads ran on {:.2g} cores on average (process CPU / wall), and "
@@ -508,36 +516,86 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
       jt.identical ? "bit-identical to one thread's" : "NOT identical to one thread's",
       std::thread::hardware_concurrency(), load, jt.two_thread_cpu / jt.two_thread_seconds,
       jt.two_thread_cpu / jt.one_thread_cpu);
-  fmt::print("  {}\n  {}\n  {}\n", grid_verdict, variant_verdict, jacobian_verdict);
-  cli::write_bench_section(
-      out, "mode1_scaling",
-      fmt::format(
-          "## Mode 1 of the contact bar: branch cost against error (`mode1_scaling`)\n\n"
-          "Mode 1 of the paper scene from T = 3.8 to 3.01: `trace "
-          "problems/contact_bar/scenes/paper.ini --branch mode1 --start_offset 0.25 "
-          "--energy_max 5e-3 --shooting_elements N` (ds 0.45, steps_per_period 40, regular "
-          "formulation, eigen least squares, one thread unless stated), run in-process, one "
-          "run each (best of 3 for runs under 2 s CPU). Time: process CPU seconds of the "
-          "continuation (all threads), since the "
-          "machine may be shared; Jacobians per point: BranchPoint::jacobian_evaluations "
-          "averaged. Error: |omega / omega_exact(E) - 1| against the mode-1 closed form at "
-          "each point's own energy. Grids: BACKBONE_MODE1_SCALING_N (default "
-          "20,40,80,160,320,640; "
-          "`BACKBONE_MODE1_SCALING_N=20,40,80,160,320,640,1000 backbone bench --case "
-          "mode1_scaling` adds N = 1000).\n\n"
-          "### Over the grid\n\n{0}{1}\n**Where backbone stands:** {2}\n\n"
-          "### Steps per period, formulation, corrector, threads\n\n{0}{3}\n"
-          "**Where backbone stands:** {4}\n\n"
-          "### The finite-difference Jacobian alone, 1 vs 2 threads\n\n"
-          "At the trace's first point (the closed-form orbit of end amplitude 1.25 g0), N = {5}, "
-          "core::finite_difference_jacobian, {11} runs of each in alternation, median times.\n\n"
-          "| threads | wall s | process CPU s |\n|---|---|---|\n| 1 | {6:.4g} | {7:.4g} |\n"
-          "| 2 | {8:.4g} | {9:.4g} |\n\n**Where backbone stands:** {10}\n\n"
-          "![Mode 1 cost per point and work-precision](mode1_scaling.png)\n",
-          header, grid_rows, grid_verdict + fine_verdict + unchecked_verdict, variant_rows,
-          variant_verdict, jacobian_n, jt.one_thread_seconds, jt.one_thread_cpu,
-          jt.two_thread_seconds, jt.two_thread_cpu, jacobian_verdict, jt.repetitions));
-  return status;
+}
+
+// BENCHMARKS.md: the grid table, the variants, the Jacobian alone.
+std::string scaling_section(const ScalingRuns& r, const JacobianThreadsTiming& jt,
+                            const std::string& grid_verdicts, const std::string& variants,
+                            const std::string& jacobian) {
+  const std::string header =
+      "| setting | points | Jacobians/point | ms/point (CPU) | total CPU s | worst error | "
+      "median error |\n|---|---|---|---|---|---|---|\n";
+  std::string grid_rows, variant_rows;
+  for (const std::vector<Mode1BranchCost>* study : {&r.grid, &r.fine, &r.unchecked})
+    for (const Mode1BranchCost& c : *study) grid_rows += cost_row(c);
+  for (const Mode1BranchCost* c : {&r.base, &r.spp80, &r.paper, &r.eigen_square, &r.kinsol_square,
+                                   &r.threads_base, &r.threads})
+    variant_rows += cost_row(*c);
+  return fmt::format(
+      "## Mode 1 of the contact bar: branch cost against error (`mode1_scaling`)\n\n"
+      "Mode 1 of the paper scene from T = 3.8 to 3.01: `trace "
+      "problems/contact_bar/scenes/paper.ini --branch mode1 --start_offset 0.25 "
+      "--energy_max 5e-3 --shooting_elements N` (ds 0.45, steps_per_period 40, regular "
+      "formulation, eigen least squares, one thread unless stated), run in-process, one "
+      "run each (best of 3 for runs under 2 s CPU). Time: process CPU seconds of the "
+      "continuation (all threads), since the "
+      "machine may be shared; Jacobians per point: BranchPoint::jacobian_evaluations "
+      "averaged. Error: |omega / omega_exact(E) - 1| against the mode-1 closed form at "
+      "each point's own energy. Grids: BACKBONE_MODE1_SCALING_N (default "
+      "20,40,80,160,320,640; "
+      "`BACKBONE_MODE1_SCALING_N=20,40,80,160,320,640,1000 backbone bench --case "
+      "mode1_scaling` adds N = 1000).\n\n"
+      "### Over the grid\n\n{0}{1}\n**Where backbone stands:** {2}\n\n"
+      "### Steps per period, formulation, corrector, threads\n\n{0}{3}\n"
+      "**Where backbone stands:** {4}\n\n"
+      "### The finite-difference Jacobian alone, 1 vs 2 threads\n\n"
+      "At the trace's first point (the closed-form orbit of end amplitude 1.25 g0), N = {5}, "
+      "core::finite_difference_jacobian, {11} runs of each in alternation, median times.\n\n"
+      "| threads | wall s | process CPU s |\n|---|---|---|\n| 1 | {6:.4g} | {7:.4g} |\n"
+      "| 2 | {8:.4g} | {9:.4g} |\n\n**Where backbone stands:** {10}\n\n"
+      "![Mode 1 cost per point and work-precision](mode1_scaling.png)\n",
+      header, grid_rows, grid_verdicts, variant_rows, variants, jacobian_n, jt.one_thread_seconds,
+      jt.one_thread_cpu, jt.two_thread_seconds, jt.two_thread_cpu, jacobian, jt.repetitions);
+}
+
+}  // namespace
+
+int bench_mode1_scaling(const std::filesystem::path& out) {
+  const std::vector<int> grids = scaling_grids();
+  fmt::print(
+      "bench mode1_scaling: mode 1, T 3.8 -> 3.01 (paper scene, start_offset 0.25, energy_max "
+      "5e-3), whole-branch cost vs closed-form error over N = {} (BACKBONE_MODE1_SCALING_N), "
+      "steps per period, formulation, corrector and threads\n",
+      fmt::join(grids, ", "));
+  ScalingRuns r;
+  run_grid_studies(r, grids);
+  run_variants(r);
+
+  const std::string load = load_average();
+  const JacobianThreadsTiming jt = time_jacobian_threads(jacobian_n);
+  fmt::print(
+      "  FD Jacobian alone at N = {} ({} x {}), median of {} alternating runs: 1 thread {:.4g} s, "
+      "2 threads "
+      "{:.4g} s, speedup {:.3g}x, {}\n",
+      jacobian_n, jt.rows, jt.columns, jt.repetitions, jt.one_thread_seconds, jt.two_thread_seconds,
+      jt.speedup(), jt.identical ? "bit-identical" : "NOT identical");
+  if (!jt.identical) r.status = 1;
+
+  const std::filesystem::path csv =
+      bench::write_table(branch_cost_table(r.all), out, "mode1_scaling", 3);
+  const GridFit fit = fit_grid(r, grids);
+  plot_scaling(csv, out / "mode1_scaling.png", fit);
+
+  const std::string grid = grid_verdict(r, fit);
+  const std::string unchecked = unchecked_verdict(r);
+  fmt::print("  {}\n", unchecked);
+  const std::string fine = fine_verdict(r);
+  const std::string variants = variant_verdict(r);
+  const std::string jacobian = jacobian_verdict(jt, load);
+  fmt::print("  {}\n  {}\n  {}\n", grid, variants, jacobian);
+  cli::write_bench_section(out, "mode1_scaling",
+                           scaling_section(r, jt, grid + fine + unchecked, variants, jacobian));
+  return r.status;
 }
 
 }  // namespace backbone::contact_bar

@@ -1,5 +1,5 @@
 // What a whole mode-1 branch costs against the error it reaches (bench case mode1_scaling,
-// bench.hpp): the mode-1 trace of the paper scene (scenes/paper.ini, `--branch mode1
+// bench.hpp): the mode-1 trace of the paper scene (scenes/paper.ini, `--branch mode1
 // --start_offset 0.25 --energy_max 5e-3 --shooting_elements N`, T 3.8 -> 3.01), run in-process
 // as `backbone trace` runs it, once per setting (grid N, steps per period, formulation, corrector,
 // threads). Each run is timed (process CPU and wall seconds), counted (points, Jacobians) and

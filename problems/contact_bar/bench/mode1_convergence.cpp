@@ -154,9 +154,7 @@ int bench_mode1_convergence(const std::filesystem::path& out) {
     }
     fmt::print("  {} done\n", s.name);
   }
-  const std::filesystem::path csv = out / "mode1_convergence.csv";
-  table.write_csv(csv);
-  fmt::print("{}", table.aligned());
+  const std::filesystem::path csv = bench::write_table(table, out, "mode1_convergence");
   fmt::print(
       "  onset/release: |t - 1.1|, |t - 2| (TD-BEM: its contact events; FEM: first row "
       "with force > 0 and the next with force 0); force_error: relative L1 error of "
@@ -175,15 +173,12 @@ int bench_mode1_convergence(const std::filesystem::path& out) {
           k ? ", " : "", q, series[k].name, column, column, 5 + 2 * k, series[k].name);
     panels += ", x title 'order 1' dt 2 lc rgb 'gray'\n";
   }
-  const std::filesystem::path png = out / "mode1_convergence.png";
-  bench::report_plot(
-      core::render_png(png,
-                       "set multiplot layout 2,2 title 'Mode 1: errors vs dt (zero = "
-                       "round-off, not drawn)'\nset logscale xy\nset grid\nset format y '%.0e'\n"
-                       "set xlabel 'dt [s]'\nset key bottom right noenhanced\n" +
-                           panels + "unset multiplot\n",
-                       {1400, 1000}),
-      png);
+  bench::plot(out / "mode1_convergence.png",
+              "set multiplot layout 2,2 title 'Mode 1: errors vs dt (zero = "
+              "round-off, not drawn)'\nset logscale xy\nset grid\nset format y '%.0e'\n"
+              "set xlabel 'dt [s]'\nset key bottom right noenhanced\n" +
+                  panels + "unset multiplot\n",
+              {1400, 1000});
   return 0;
 }
 

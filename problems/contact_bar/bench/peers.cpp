@@ -16,8 +16,8 @@
 #include "core/scene.hpp"
 #include "core/table.hpp"
 #include "problems/contact_bar/bench/support.hpp"
-#include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/cli/trace.hpp"
+#include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/solver/scene.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"
 #include "problems/exact_bar/exact_solution.hpp"
@@ -27,7 +27,6 @@
 #endif
 
 namespace backbone::contact_bar {
-
 
 namespace {
 
@@ -40,9 +39,8 @@ std::filesystem::path contact_bar_folder() {
 }
 
 // Compute seconds of a run: the process CPU time on one thread, since the peers' figures are of
-// an otherwise idle core and a shared machine's load inflates wall time (measured: 2.6x during a
-// parallel build) but not CPU time; with `bench --threads K > 1` the wall time, which is what
-// threads shorten.
+// an otherwise idle core and a shared machine's load inflates wall time but not CPU time; with
+// `bench --threads K > 1` the wall time, which is what threads shorten.
 class Stopwatch {
  public:
   Stopwatch() : wall_(std::chrono::steady_clock::now()), cpu_(cpu_now()) {}
@@ -67,9 +65,6 @@ std::string clock_name() {
   return threads > 1 ? fmt::format("wall time with {} threads", threads)
                      : std::string("CPU time of one thread");
 }
-
-// Errors of exactly 0 (round-off luck) are drawn at this floor on the log axes.
-constexpr double plot_floor = 1e-17;
 
 }  // namespace
 
@@ -98,20 +93,19 @@ Mode1Trace trace_paper_mode1(int shooting_elements) {
   return t;
 }
 
-int bench_lu_legrand(const std::filesystem::path& out) {
-  fmt::print(
-      "bench lu_legrand: mode 1, T 3.8 -> 3.01, backbone (TD-BEM shooting) at several grids vs "
-      "Lu & Legrand's stored FD-BEM + HBM runs, errors vs the closed form\n");
-  core::Table table({"tool", "setting", "points", "seconds", "ms_per_point", "median_error",
-                     "max_error", "live"});
+namespace {
+
+// Lu & Legrand's stored runs: one per harmonic count, the errors over their admissible points.
+struct LuLegrandRun {
+  int harmonics;
+  int points;
+  double seconds, ms, median, max;
+};
+
+std::vector<LuLegrandRun> read_lu_legrand_runs() {
   const std::filesystem::path peers = contact_bar_peers_folder();
   const core::Table runs = core::Table::read_csv(peers / "lu_legrand_runs.csv");
-  struct PeerRow {
-    int harmonics;
-    int points;
-    double seconds, ms, median, max;
-  };
-  std::vector<PeerRow> peer_rows;
+  std::vector<LuLegrandRun> stored;
   for (std::size_t i = 0; i < runs.rows(); ++i) {
     const int harmonics = static_cast<int>(runs.column("harmonics")[i]);
     const core::Table points =
@@ -121,16 +115,16 @@ int bench_lu_legrand(const std::filesystem::path& out) {
                               error = points.column("relerr_freq");
     for (std::size_t j = 0; j < points.rows(); ++j)
       if (admissible[j] == 1) errors.push_back(error[j]);
-    peer_rows.push_back({harmonics, static_cast<int>(points.rows()), runs.column("seconds")[i],
-                         runs.column("ms_per_point")[i], bench::median(errors),
-                         *std::max_element(errors.begin(), errors.end())});
-    table.add_cells({std::string("lu_legrand"), fmt::format("{} harmonics", harmonics),
-                     double(points.rows()), runs.column("seconds")[i],
-                     runs.column("ms_per_point")[i], bench::median(errors), peer_rows.back().max,
-                     0.0});
+    stored.push_back({harmonics, static_cast<int>(points.rows()), runs.column("seconds")[i],
+                      runs.column("ms_per_point")[i], bench::median(errors),
+                      *std::max_element(errors.begin(), errors.end())});
   }
+  return stored;
+}
 
-  int status = 0;
+// backbone's mode-1 trace at each grid, timed at the median of `repetitions` runs (one for a
+// grid slower than 5 s); status 1 when a trace stops early.
+std::vector<Mode1Trace> trace_lu_legrand_grids(int& status) {
   std::vector<Mode1Trace> traces;
   for (int elements : {10, 20, 40}) {
     std::vector<double> seconds;
@@ -146,42 +140,166 @@ int bench_lu_legrand(const std::filesystem::path& out) {
       status = 1;
     }
     traces.push_back(t);
-    table.add_cells({std::string("backbone"), fmt::format("N = {}", elements), double(t.points),
-                     t.seconds, 1e3 * t.seconds / t.points, t.median_error, t.max_error, 1.0});
   }
-  const std::filesystem::path csv = out / "lu_legrand.csv";
-  table.write_csv(csv);
-  fmt::print("{}", table.aligned(3));
+  return traces;
+}
 
-  const std::string q = core::gnuplot_quote(csv);
-  const std::filesystem::path png = out / "lu_legrand.png";
-  bench::report_plot(
-      core::render_png(
-          png,
-          fmt::format(
-              "set termoption noenhanced\nset logscale xy\nset grid\nset format y '%.0e'\n"
-              "set xlabel 'CPU ms per point (backbone: one thread unless --threads)'\nset ylabel "
-              "'median relative "
-              "frequency error (closed form at the point energy)'\n"
-              "set title 'Mode 1, T 3.8 -> 3.01: backbone vs Lu & Legrand (stored)'\n"
-              "set key center right noenhanced\n"
-              "plot {0} using (strcol(1) eq 'lu_legrand' ? $5 : NaN):($6 > {1} ? $6 : {1}) with "
-              "linespoints pt 7 ps 1.5 title 'Lu & Legrand FD-BEM + HBM (20, 40 harmonics)', "
-              "{0} using (strcol(1) eq 'backbone' ? $5 : NaN):($6 > {1} ? $6 : {1}) with "
-              "linespoints pt 5 ps 1.5 title 'backbone TD-BEM shooting (N = 10, 20, 40)'\n",
-              q, plot_floor)),
-      png);
+core::Table lu_legrand_table(const std::vector<LuLegrandRun>& stored,
+                             const std::vector<Mode1Trace>& traces) {
+  core::Table table({"tool", "setting", "points", "seconds", "ms_per_point", "median_error",
+                     "max_error", "live"});
+  for (const LuLegrandRun& r : stored)
+    table.add_cells({std::string("lu_legrand"), fmt::format("{} harmonics", r.harmonics),
+                     double(r.points), r.seconds, r.ms, r.median, r.max, 0.0});
+  for (const Mode1Trace& t : traces)
+    table.add_cells({std::string("backbone"), fmt::format("N = {}", t.elements), double(t.points),
+                     t.seconds, 1e3 * t.seconds / t.points, t.median_error, t.max_error, 1.0});
+  return table;
+}
 
+std::string lu_legrand_section(const std::vector<LuLegrandRun>& stored,
+                               const std::vector<Mode1Trace>& traces, const std::string& verdict) {
   std::string rows;
-  for (const PeerRow& r : peer_rows)
+  for (const LuLegrandRun& r : stored)
     rows +=
         fmt::format("| Lu & Legrand (stored) | {} harmonics | {} | {:.3g} | {:.2g} | {:.2g} |\n",
                     r.harmonics, r.points, r.ms, r.median, r.max);
   for (const Mode1Trace& t : traces)
     rows += fmt::format("| backbone | N = {} | {} | {:.3g} | {:.2g} | {:.2g} |\n", t.elements,
                         t.points, 1e3 * t.seconds / t.points, t.median_error, t.max_error);
+  return fmt::format(
+      "## Mode 1 of the contact bar: backbone vs Lu & Legrand (`lu_legrand`)\n\n"
+      "Mode 1 of the paper scene from T = 3.8 to 3.01 (E = 7.8e-7 to 5e-3 J; Lu & Legrand's "
+      "g0 = 0.5 run covers the same range of E / g0^2). backbone: `trace "
+      "problems/contact_bar/scenes/paper.ini --branch mode1 --start_offset 0.25 "
+      "--energy_max 5e-3 --shooting_elements N`, run in-process, {}, median of {} runs "
+      "(one when it takes over 5 s). Lu & Legrand: their stored runs "
+      "(problems/contact_bar/peers/, "
+      "measured on the same kind of machine; not run here), errors over their admissible "
+      "points. Error: |omega / omega_exact(E) - 1| with the mode-1 closed form at each "
+      "point's own energy, for both.\n\n"
+      "| tool | setting | points | ms/point | median error | max error |\n"
+      "|---|---|---|---|---|---|\n{}\n"
+      "**Where backbone stands:** {}\n\n![Mode 1 vs Lu & Legrand](lu_legrand.png)\n",
+      clock_name(), repetitions, rows, verdict);
+}
+
+// The Siconos bar: mode 1 with eps = -0.002 (T = 3.5) over 10 time units at dt = 1e-3.
+struct SiconosBar {
+  double eps = -0.002, gap = 1e-3, t_end = 10, dt = 1e-3;
+  bar::BarSetup setup;
+  double amplitude = 0;  // |eps| L: the tip error's unit
+  long steps = 0;
+  SiconosBar() {
+    setup.left = {bar::EndType::fixed, 0};
+    setup.right = {bar::EndType::contact, gap};
+    setup.u0 = bar::PiecewiseLinear({0.0, 1.0}, {0.0, eps});
+    amplitude = std::abs(eps) * setup.material.length;
+    steps = std::lround(t_end / dt);
+  }
+};
+
+// One TD-BEM march of the Siconos bar: us per step, max tip error / amplitude, energy change.
+struct SiconosRow {
+  int elements;
+  double us, error, energy;
+};
+
+SiconosRow march_siconos_bar(const SiconosBar& b, const exact_bar::ExactBarSolution& exact,
+                             int elements, int& status) {
+  const TdbemSolver tdbem(ContactMethod::event);
+  bar::SimulationOptions o;
+  o.t_end = b.t_end;
+  o.dt = b.dt;
+  o.elements = elements;
+  o.history_samples = static_cast<int>(b.steps) + 2;  // every step: the tip error
+  o.energy = false;                                   // the bare march is timed
+  bar::History h;
+  std::vector<double> seconds;
+  for (int k = 0; k < repetitions; ++k) {
+    const Stopwatch stopwatch;
+    h = tdbem.simulate(b.setup, o);
+    seconds.push_back(stopwatch.seconds());
+  }
+  double error = 0;
+  for (std::size_t j = 0; j < h.t.size(); ++j)
+    error = std::max(error, std::abs(h.u_contact[j] - exact.u_end(h.t[j])) / b.amplitude);
+  if (h.t.empty() || h.t.back() < b.t_end - 1.01 * b.dt) {
+    fmt::print("  warning: the march at {} elements stopped early\n", elements);
+    error = std::nan("");
+    status = 1;
+  }
+  o.history_samples = 101;  // the energy on 101 rows (it costs an interior evaluation each)
+  o.energy = true;
+  const bar::History he = tdbem.simulate(b.setup, o);
+  const double energy_change =
+      he.energy.empty() ? std::nan("") : (he.energy.back() - he.energy.front()) / he.energy.front();
+  const double us = 1e6 * bench::median(seconds) / static_cast<double>(b.steps);
+  return {elements, us, error, energy_change};
+}
+
+core::Table siconos_table(const core::Table& siconos, const std::vector<SiconosRow>& rows,
+                          long steps) {
+  core::Table table(
+      {"tool", "elements", "steps", "us_per_step", "max_tip_error", "energy_change", "live"});
+  for (std::size_t i = 0; i < siconos.rows(); ++i)
+    table.add_cells({std::string("siconos"), siconos.column("elements")[i],
+                     siconos.column("steps")[i], siconos.column("us_per_step")[i],
+                     siconos.column("max_tip_error")[i], siconos.column("energy_change")[i], 0.0});
+  for (const SiconosRow& r : rows)
+    table.add_cells({std::string("backbone_tdbem"), double(r.elements), double(steps), r.us,
+                     r.error, r.energy, 1.0});
+  return table;
+}
+
+std::string siconos_verdict(const core::Table& siconos, const std::vector<SiconosRow>& rows) {
+  const SiconosRow& mid = rows[1];
+  return fmt::format(
+      "at 100 elements TD-BEM takes {:.3g} us per step, {:.0f}x less than Siconos' {:.3g} us, "
+      "with a tip error of {:.2g} against Siconos' {:.2g}, and its energy changes by {:.2g} "
+      "against {:.2g}.",
+      mid.us, siconos.column("us_per_step")[1] / mid.us, siconos.column("us_per_step")[1],
+      mid.error, siconos.column("max_tip_error")[1], mid.energy,
+      siconos.column("energy_change")[1]);
+}
+
+std::string siconos_section(const core::Table& siconos, const std::vector<SiconosRow>& rows,
+                            const std::string& verdict) {
+  std::string lines;
+  for (std::size_t i = 0; i < siconos.rows(); ++i)
+    lines += fmt::format("| Siconos (stored) | {} | {:.3g} | {:.2g} | {:.2g} |\n",
+                         siconos.column("elements")[i], siconos.column("us_per_step")[i],
+                         siconos.column("max_tip_error")[i], siconos.column("energy_change")[i]);
+  for (const SiconosRow& r : rows)
+    lines += fmt::format("| backbone TD-BEM | {} | {:.3g} | {:.2g} | {:.2g} |\n", r.elements, r.us,
+                         r.error, r.energy);
+  return fmt::format(
+      "## The Siconos bar: backbone's TD-BEM vs Siconos (`siconos_bar`)\n\n"
+      "L = E = rho = A = 1, clamped at x = 0, gap 1e-3 at x = L, u0 = -0.002 x, v0 = "
+      "0 (the exact mode 1, T = 3.5, contact on [1.5, 2] at force 0.002), 10 time "
+      "units at dt = 1e-3 (10^4 steps). backbone: the TD-BEM march with event "
+      "contact, timed without the energy column ({}, median of {}), tip error against "
+      "the exact characteristics solution at every step, energy change (E(10) - "
+      "E(0)) / E(0) from a second run with the energy on 101 rows. Siconos 4.4: "
+      "Moreau-Jean, P1 FEM with consistent mass, theta = 0.5, e = 0, its stored runs "
+      "(problems/contact_bar/peers/; not run here).\n\n"
+      "| tool | elements | us/step | max tip error / 2e-3 | energy change |\n"
+      "|---|---|---|---|---|\n{}\n"
+      "**Where backbone stands:** {}\n\n![Siconos bar](siconos_bar.png)\n",
+      clock_name(), repetitions, lines, verdict);
+}
+
+}  // namespace
+
+int bench_lu_legrand(const std::filesystem::path& out) {
+  fmt::print(
+      "bench lu_legrand: mode 1, T 3.8 -> 3.01, backbone (TD-BEM shooting) at several grids vs "
+      "Lu & Legrand's stored FD-BEM + HBM runs, errors vs the closed form\n");
+  const std::vector<LuLegrandRun> stored = read_lu_legrand_runs();
+  int status = 0;
+  const std::vector<Mode1Trace> traces = trace_lu_legrand_grids(status);
   const Mode1Trace& n20 = traces[1];
-  const PeerRow& h20 = peer_rows.front();
+  const LuLegrandRun& h20 = stored.front();
   const std::string verdict = fmt::format(
       "at N = 20 backbone costs {:.3g} ms per point ({:.2g}x Lu & Legrand's {:.3g} ms with 20 "
       "harmonics) at a median frequency error of {:.2g} against their {:.2g}; with {} points "
@@ -189,24 +307,17 @@ int bench_lu_legrand(const std::filesystem::path& out) {
       "{:.3g} s.",
       1e3 * n20.seconds / n20.points, 1e3 * n20.seconds / n20.points / h20.ms, h20.ms,
       n20.median_error, h20.median, n20.points, h20.points, n20.seconds, h20.seconds);
-  fmt::print("  {}\n", verdict);
-  cli::write_bench_section(
-      out, "lu_legrand",
-      fmt::format(
-          "## Mode 1 of the contact bar: backbone vs Lu & Legrand (`lu_legrand`)\n\n"
-          "Mode 1 of the paper scene from T = 3.8 to 3.01 (E = 7.8e-7 to 5e-3 J; Lu & Legrand's "
-          "g0 = 0.5 run covers the same range of E / g0^2). backbone: `trace "
-          "problems/contact_bar/scenes/paper.ini --branch mode1 --start_offset 0.25 "
-          "--energy_max 5e-3 --shooting_elements N`, run in-process, {}, median of {} runs "
-          "(one when it takes over 5 s). Lu & Legrand: their stored runs "
-          "(problems/contact_bar/peers/, "
-          "measured on the same kind of machine; not run here), errors over their admissible "
-          "points. Error: |omega / omega_exact(E) - 1| with the mode-1 closed form at each "
-          "point's own energy, for both.\n\n"
-          "| tool | setting | points | ms/point | median error | max error |\n"
-          "|---|---|---|---|---|---|\n{}\n"
-          "**Where backbone stands:** {}\n\n![Mode 1 vs Lu & Legrand](lu_legrand.png)\n",
-          clock_name(), repetitions, rows, verdict));
+  bench::PeerFigure figure;
+  figure.xlabel = "CPU ms per point (backbone: one thread unless --threads)";
+  figure.ylabel = "median relative frequency error (closed form at the point energy)";
+  figure.title = "Mode 1, T 3.8 -> 3.01: backbone vs Lu & Legrand (stored)";
+  figure.x_column = 5, figure.y_column = 6;
+  figure.peer_tool = "lu_legrand";
+  figure.peer_title = "Lu & Legrand FD-BEM + HBM (20, 40 harmonics)";
+  figure.backbone_tool = "backbone";
+  figure.backbone_title = "backbone TD-BEM shooting (N = 10, 20, 40)";
+  bench::report_peer_case(out, "lu_legrand", lu_legrand_table(stored, traces), figure, verdict,
+                          lu_legrand_section(stored, traces, verdict));
   return status;
 }
 
@@ -214,117 +325,24 @@ int bench_siconos_bar(const std::filesystem::path& out) {
   fmt::print(
       "bench siconos_bar: the Siconos bar (mode 1, eps = -0.002, T = 3.5) over 10 time units at "
       "dt = 1e-3, TD-BEM vs Siconos' stored Moreau-Jean runs, tip error vs the exact solution\n");
-  const double eps = -0.002, gap = 1e-3, t_end = 10, dt = 1e-3;
-  bar::BarSetup setup;
-  setup.left = {bar::EndType::fixed, 0};
-  setup.right = {bar::EndType::contact, gap};
-  setup.u0 = bar::PiecewiseLinear({0.0, 1.0}, {0.0, eps});
-  const double amplitude = std::abs(eps) * setup.material.length;
-  const exact_bar::ExactBarSolution exact = exact_bar::solve(setup, t_end);
-  const TdbemSolver tdbem(ContactMethod::event);
-
-  core::Table table(
-      {"tool", "elements", "steps", "us_per_step", "max_tip_error", "energy_change", "live"});
+  const SiconosBar b;
+  const exact_bar::ExactBarSolution exact = exact_bar::solve(b.setup, b.t_end);
   const core::Table siconos = core::Table::read_csv(contact_bar_peers_folder() / "siconos_bar.csv");
-  for (std::size_t i = 0; i < siconos.rows(); ++i)
-    table.add_cells({std::string("siconos"), siconos.column("elements")[i],
-                     siconos.column("steps")[i], siconos.column("us_per_step")[i],
-                     siconos.column("max_tip_error")[i], siconos.column("energy_change")[i], 0.0});
-  const long steps = std::lround(t_end / dt);
   int status = 0;
-  struct Row {
-    int elements;
-    double us, error, energy;
-  };
-  std::vector<Row> rows;
-  for (int elements : {50, 100, 200}) {
-    bar::SimulationOptions o;
-    o.t_end = t_end;
-    o.dt = dt;
-    o.elements = elements;
-    o.history_samples = static_cast<int>(steps) + 2;  // every step: the tip error
-    o.energy = false;                                 // the bare march is timed
-    bar::History h;
-    std::vector<double> seconds;
-    for (int k = 0; k < repetitions; ++k) {
-      const Stopwatch stopwatch;
-      h = tdbem.simulate(setup, o);
-      seconds.push_back(stopwatch.seconds());
-    }
-    double error = 0;
-    for (std::size_t j = 0; j < h.t.size(); ++j)
-      error = std::max(error, std::abs(h.u_contact[j] - exact.u_end(h.t[j])) / amplitude);
-    if (h.t.empty() || h.t.back() < t_end - 1.01 * dt) {
-      fmt::print("  warning: the march at {} elements stopped early\n", elements);
-      error = std::nan("");
-      status = 1;
-    }
-    o.history_samples = 101;  // the energy on 101 rows (it costs an interior evaluation each)
-    o.energy = true;
-    const bar::History he = tdbem.simulate(setup, o);
-    const double energy_change = he.energy.empty()
-                                     ? std::nan("")
-                                     : (he.energy.back() - he.energy.front()) / he.energy.front();
-    const double us = 1e6 * bench::median(seconds) / static_cast<double>(steps);
-    rows.push_back({elements, us, error, energy_change});
-    table.add_cells({std::string("backbone_tdbem"), double(elements), double(steps), us, error,
-                     energy_change, 1.0});
-  }
-  const std::filesystem::path csv = out / "siconos_bar.csv";
-  table.write_csv(csv);
-  fmt::print("{}", table.aligned(3));
-
-  const std::string q = core::gnuplot_quote(csv);
-  const std::filesystem::path png = out / "siconos_bar.png";
-  bench::report_plot(
-      core::render_png(
-          png,
-          fmt::format(
-              "set termoption noenhanced\nset logscale xy\nset grid\nset format y '%.0e'\n"
-              "set xlabel 'CPU microseconds per time step (one thread)'\n"
-              "set ylabel 'max tip error / amplitude 2e-3 (10 time units)'\n"
-              "set title 'Siconos bar, dt = 1e-3, 50/100/200 elements: backbone TD-BEM vs "
-              "Siconos (stored)'\nset key center right noenhanced\n"
-              "plot {0} using (strcol(1) eq 'siconos' ? $4 : NaN):($5 > {1} ? $5 : {1}) with "
-              "linespoints pt 7 ps 1.5 title 'Siconos Moreau-Jean, P1 FEM, e = 0', "
-              "{0} using (strcol(1) eq 'backbone_tdbem' ? $4 : NaN):($5 > {1} ? $5 : {1}) with "
-              "linespoints pt 5 ps 1.5 title 'backbone TD-BEM, event contact (errors of 0 at "
-              "1e-17)'\n",
-              q, plot_floor)),
-      png);
-
-  std::string lines;
-  for (std::size_t i = 0; i < siconos.rows(); ++i)
-    lines += fmt::format("| Siconos (stored) | {} | {:.3g} | {:.2g} | {:.2g} |\n",
-                         siconos.column("elements")[i], siconos.column("us_per_step")[i],
-                         siconos.column("max_tip_error")[i], siconos.column("energy_change")[i]);
-  for (const Row& r : rows)
-    lines += fmt::format("| backbone TD-BEM | {} | {:.3g} | {:.2g} | {:.2g} |\n", r.elements, r.us,
-                         r.error, r.energy);
-  const Row& mid = rows[1];
-  const std::string verdict = fmt::format(
-      "at 100 elements TD-BEM takes {:.3g} us per step, {:.0f}x less than Siconos' {:.3g} us, "
-      "with a tip error of {:.2g} against Siconos' {:.2g}, and its energy changes by {:.2g} "
-      "against {:.2g}.",
-      mid.us, siconos.column("us_per_step")[1] / mid.us, siconos.column("us_per_step")[1],
-      mid.error, siconos.column("max_tip_error")[1], mid.energy,
-      siconos.column("energy_change")[1]);
-  fmt::print("  {}\n", verdict);
-  cli::write_bench_section(
-      out, "siconos_bar",
-      fmt::format("## The Siconos bar: backbone's TD-BEM vs Siconos (`siconos_bar`)\n\n"
-                  "L = E = rho = A = 1, clamped at x = 0, gap 1e-3 at x = L, u0 = -0.002 x, v0 = "
-                  "0 (the exact mode 1, T = 3.5, contact on [1.5, 2] at force 0.002), 10 time "
-                  "units at dt = 1e-3 (10^4 steps). backbone: the TD-BEM march with event "
-                  "contact, timed without the energy column ({}, median of {}), tip error against "
-                  "the exact characteristics solution at every step, energy change (E(10) - "
-                  "E(0)) / E(0) from a second run with the energy on 101 rows. Siconos 4.4: "
-                  "Moreau-Jean, P1 FEM with consistent mass, theta = 0.5, e = 0, its stored runs "
-                  "(problems/contact_bar/peers/; not run here).\n\n"
-                  "| tool | elements | us/step | max tip error / 2e-3 | energy change |\n"
-                  "|---|---|---|---|---|\n{}\n"
-                  "**Where backbone stands:** {}\n\n![Siconos bar](siconos_bar.png)\n",
-                  clock_name(), repetitions, lines, verdict));
+  std::vector<SiconosRow> rows;
+  for (int elements : {50, 100, 200}) rows.push_back(march_siconos_bar(b, exact, elements, status));
+  const std::string verdict = siconos_verdict(siconos, rows);
+  bench::PeerFigure figure;
+  figure.xlabel = "CPU microseconds per time step (one thread)";
+  figure.ylabel = "max tip error / amplitude 2e-3 (10 time units)";
+  figure.title = "Siconos bar, dt = 1e-3, 50/100/200 elements: backbone TD-BEM vs Siconos (stored)";
+  figure.x_column = 4, figure.y_column = 5;
+  figure.peer_tool = "siconos";
+  figure.peer_title = "Siconos Moreau-Jean, P1 FEM, e = 0";
+  figure.backbone_tool = "backbone_tdbem";
+  figure.backbone_title = "backbone TD-BEM, event contact (errors of 0 at 1e-17)";
+  bench::report_peer_case(out, "siconos_bar", siconos_table(siconos, rows, b.steps), figure,
+                          verdict, siconos_section(siconos, rows, verdict));
   return status;
 }
 

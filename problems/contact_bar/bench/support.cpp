@@ -8,6 +8,7 @@
 #include <ctime>
 #include <limits>
 
+#include "continuation/cli/bench_report.hpp"
 #include "continuation/cli/scene_options.hpp"
 #include "core/errors.hpp"
 #include "core/newton.hpp"
@@ -23,8 +24,8 @@ core::Scene read_paper_scene(const cli::ProblemPlugin& plugin,
   namespace po = boost::program_options;
   po::options_description keys = plugin.scene_keys();
   keys.add(cli::continuation_keys(keys));
-  const std::filesystem::path paper =
-      contact_bar_peers_folder().parent_path().parent_path() / "scenes" / "paper.ini";  // bench/peers
+  const std::filesystem::path paper = contact_bar_peers_folder().parent_path().parent_path() /
+                                      "scenes" / "paper.ini";  // bench/peers
   return core::read_scene(keys, paper.string(), args, po::options_description());
 }
 
@@ -72,8 +73,7 @@ InProcessTrace trace_in_process(const cli::ProblemPlugin& plugin, const core::Sc
   InProcessTrace t;
   const double cpu_start = process_cpu_seconds();
   const auto wall_start = std::chrono::steady_clock::now();
-  t.traced =
-      cli::run_continuation(*periodic, setup.guess, direction, run, *corrector, hooks);
+  t.traced = cli::run_continuation(*periodic, setup.guess, direction, run, *corrector, hooks);
   t.cpu_seconds = process_cpu_seconds() - cpu_start;
   t.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -114,6 +114,39 @@ void report_plot(const core::PlotResult& result, const std::filesystem::path& pn
     fmt::print("  wrote {}\n", png.string());
   else
     fmt::print("  figure skipped: {}\n", result.message);
+}
+
+void plot(const std::filesystem::path& png, const std::string& script, core::PlotSize size) {
+  report_plot(core::render_png(png, script, size), png);
+}
+
+std::filesystem::path write_table(const core::Table& table, const std::filesystem::path& out,
+                                  const std::string& name, int digits) {
+  const std::filesystem::path csv = out / (name + ".csv");
+  table.write_csv(csv);
+  fmt::print("{}", table.aligned(digits));
+  return csv;
+}
+
+std::string peer_figure_script(const std::filesystem::path& csv, const PeerFigure& f) {
+  return fmt::format(
+      "set termoption noenhanced\nset logscale xy\nset grid\nset format y '%.0e'\n"
+      "set xlabel '{2}'\nset ylabel '{3}'\nset title '{4}'\nset key center right noenhanced\n"
+      "plot {0} using (strcol(1) eq '{7}' ? ${5} : NaN):(${6} > {1} ? ${6} : {1}) with "
+      "linespoints pt 7 ps 1.5 title '{8}', "
+      "{0} using (strcol(1) eq '{9}' ? ${5} : NaN):(${6} > {1} ? ${6} : {1}) with "
+      "linespoints pt 5 ps 1.5 title '{10}'\n",
+      core::gnuplot_quote(csv), plot_floor, f.xlabel, f.ylabel, f.title, f.x_column, f.y_column,
+      f.peer_tool, f.peer_title, f.backbone_tool, f.backbone_title);
+}
+
+void report_peer_case(const std::filesystem::path& out, const std::string& name,
+                      const core::Table& table, const PeerFigure& figure,
+                      const std::string& verdict, const std::string& section) {
+  const std::filesystem::path csv = write_table(table, out, name, 3);
+  plot(out / (name + ".png"), peer_figure_script(csv, figure));
+  fmt::print("  {}\n", verdict);
+  cli::write_bench_section(out, name, section);
 }
 
 }  // namespace backbone::contact_bar::bench

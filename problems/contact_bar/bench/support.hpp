@@ -1,11 +1,14 @@
 // What the contact-bar benchmark cases (bench_*.cpp) share besides their metrics: the mode-1
-// scene, an in-process trace, timing and figure reporting. Internal to problems/contact_bar.
+// scene, an in-process trace, timing, and the report of tables, figures and peer comparisons.
+// Internal to problems/contact_bar.
 //
 //   const bench::PaperMode1 m = bench::paper_mode1();   // m.episode.period = 3.1
 //   const double s = bench::best_seconds([&] { solver.simulate(setup, options); });
 //   const bench::InProcessTrace t = bench::trace_in_process(plugin, scene, "mode1");
 //   const std::vector<double> e = bench::mode1_frequency_errors(scene, t.traced.branch);
-//   bench::report_plot(core::render_png(png, script), png);
+//   const auto csv = bench::write_table(table, out, "lu_legrand", 3);  // out/lu_legrand.csv
+//   bench::plot(out / "lu_legrand.png", script, {1600, 700});
+//   bench::report_peer_case(out, "siconos_bar", table, figure, verdict, section);
 #pragma once
 
 #include <filesystem>
@@ -17,6 +20,7 @@
 #include "continuation/switching.hpp"
 #include "core/plot.hpp"
 #include "core/scene.hpp"
+#include "core/table.hpp"
 #include "problems/bar/bar.hpp"
 #include "problems/contact_bar/bench/metrics.hpp"
 
@@ -67,5 +71,36 @@ double best_seconds(const std::function<void()>& run, double single = 0.5);
 
 // "  wrote PNG" or "  figure skipped: why" on stdout.
 void report_plot(const core::PlotResult& result, const std::filesystem::path& png);
+
+// Renders the gnuplot script into png (core::render_png) and reports it (report_plot).
+void plot(const std::filesystem::path& png, const std::string& script, core::PlotSize size = {});
+
+// Writes the table to out/<name>.csv, prints it aligned to `digits` significant digits, and
+// returns the CSV's path.
+std::filesystem::path write_table(const core::Table& table, const std::filesystem::path& out,
+                                  const std::string& name, int digits = 6);
+
+// Errors of exactly 0 (round-off luck) are drawn at this floor on the log axes.
+constexpr double plot_floor = 1e-17;
+
+// The work-precision figure of a case that puts backbone beside a peer: the rows whose first
+// column is `peer_tool`, then those whose first column is `backbone_tool`, each drawn as cost
+// (column x_column) against error (column y_column, 1-based, floored at plot_floor), on log
+// axes.
+struct PeerFigure {
+  std::string xlabel, ylabel, title;
+  int x_column = 0, y_column = 0;
+  std::string peer_tool, peer_title;
+  std::string backbone_tool, backbone_title;
+};
+// The gnuplot script of that figure, reading csv.
+std::string peer_figure_script(const std::filesystem::path& csv, const PeerFigure& figure);
+
+// What a peer case reports once its table is complete: out/<name>.csv, written and printed
+// with 3 significant digits; out/<name>.png, the figure; the verdict on stdout; and the
+// BENCHMARKS.md section <name>.md (cli::write_bench_section).
+void report_peer_case(const std::filesystem::path& out, const std::string& name,
+                      const core::Table& table, const PeerFigure& figure,
+                      const std::string& verdict, const std::string& section);
 
 }  // namespace backbone::contact_bar::bench

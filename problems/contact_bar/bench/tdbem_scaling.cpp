@@ -41,16 +41,13 @@ int bench_tdbem_scaling(const std::filesystem::path& out) {
   fit.write_csv(out / "tdbem_scaling_fit.csv");
   fmt::print("{}", table.aligned());
   fmt::print("  fitted slope of log(seconds) vs log(steps): {:.3f} (1 = linear cost)\n", slope);
-  const std::filesystem::path png = out / "tdbem_scaling.png";
-  bench::report_plot(
-      core::render_png(
-          png, fmt::format("set logscale xy\nset grid\nset xlabel 'time steps n'\n"
-                           "set ylabel 'CPU seconds'\nset title 'TD-BEM march cost, fitted "
-                           "slope {:.3f}'\nset key left top\n"
-                           "plot {} using 1:2 with linespoints pt 7 title 'TD-BEM (event)', "
-                           "{:.6g}*x title 'linear (through n = 1e6)' dt 2\n",
-                           slope, core::gnuplot_quote(csv), seconds.back() / steps.back())),
-      png);
+  bench::plot(out / "tdbem_scaling.png",
+              fmt::format("set logscale xy\nset grid\nset xlabel 'time steps n'\n"
+                          "set ylabel 'CPU seconds'\nset title 'TD-BEM march cost, fitted "
+                          "slope {:.3f}'\nset key left top\n"
+                          "plot {} using 1:2 with linespoints pt 7 title 'TD-BEM (event)', "
+                          "{:.6g}*x title 'linear (through n = 1e6)' dt 2\n",
+                          slope, core::gnuplot_quote(csv), seconds.back() / steps.back()));
   return 0;
 }
 

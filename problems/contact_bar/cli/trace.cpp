@@ -8,7 +8,7 @@
 // elements = the u0 grid); trace_keys add the shooting setup. The start is the grazing-side
 // orbit of the contact family (end amplitude (1 + start_offset) g0), not the sine of the
 // linear mode: at grazing every initial condition is 4L/c-periodic and a nodal Newton from the
-// sine lands on such a non-contact orbit (measured: T = 4L/c exactly). Mode 2 moves one knot
+// sine lands on such a non-contact orbit, of period 4L/c. Mode 2 moves one knot
 // with the physics (free_knots = 1, the crest of the tent) because its kink travels with T and
 // a uniform grid holds it only to O(dx) (README.md, section "Shooting on the bar").
 //
@@ -24,15 +24,15 @@
 
 #include "core/errors.hpp"
 #include "core/table.hpp"
+#include "problems/contact_bar/cli/simulate.hpp"
+#include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/orbits/attached_content.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
-#include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/orbits/grazing_limits.hpp"
 #include "problems/contact_bar/orbits/manifold.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
-#include "problems/contact_bar/solver/scene.hpp"
-#include "problems/contact_bar/cli/simulate.hpp"
 #include "problems/contact_bar/orbits/subharmonic.hpp"
+#include "problems/contact_bar/solver/scene.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
 
@@ -130,8 +130,8 @@ po::options_description trace_keys() {
 cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch);
 
 // The run's size against max_residual_work, before anything runs (simulate's max_steps habit):
-// one residual marches about elements x steps_per_period element-steps (measured: 0.1-0.15 us
-// per step at 20 intervals, problems/contact_bar/README.md, section 'Cost').
+// one residual marches about elements x steps_per_period element-steps
+// (problems/contact_bar/README.md, section 'Cost').
 void check_residual_work(const core::Scene& scene, const OrbitOptions& options) {
   const double limit = scene.positive("max_residual_work");
   const double work = static_cast<double>(options.elements) * options.steps_per_period;
@@ -145,79 +145,63 @@ void check_residual_work(const core::Scene& scene, const OrbitOptions& options) 
                   steps ? "steps_per_period" : "shooting_elements"));
 }
 
-cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
-  if (branch.rfind("subharmonic", 0) == 0) return setup_subharmonic(scene, branch);
-  const int mode = branch == "mode2" ? 2 : 1;
-  bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
-  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
-    throw core::InputError("right_end",
-                           "the contact-bar modes need right_end = contact and gap > 0");
-  const ContactFamily family(setup.material, setup.right.gap, mode);
-
-  std::shared_ptr<const bar::BarSolver> solver;
-  if (scene.choice("shooting_solver", {"tdbem", "exact"}) == "exact")
-    solver = std::make_shared<exact_bar::ExactBarSolver>();
-  else
-    solver = std::make_shared<TdbemSolver>(contact_method_from_scene(scene));
-
+// The shooting grid of the scene: shooting_elements (0: the scene's elements) and
+// steps_per_period, checked against max_residual_work.
+OrbitOptions shooting_grid(const core::Scene& scene) {
   OrbitOptions options;
   const long shooting_elements = scene.integer("shooting_elements", 0);
   options.elements =
       static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
   options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
   check_residual_work(scene, options);
-  const long knots = scene.integer("free_knots", -1);
-  options.free_knots = knots < 0 ? (mode == 2 ? 1 : 0) : static_cast<int>(knots);
-  const long test_elements = scene.integer("test_elements", -1);
-  options.test_elements = static_cast<int>(
-      test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);
-  // A followed family's probes and paths are measured in units of the gap: with follow the gap
-  // stays the unit. (Branch-point detection works in either: its samples are kept in the unit
-  // scale, continuation/README.md, section 'Branch points'.)
-  options.amplitude_units = scene.flag("amplitude_units") && scene.text("follow") == "none";
+  return options;
+}
 
-  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, solver, options);
-  const double ratio = 1 + scene.positive("start_offset");
-  const std::string guess = scene.choice("start_guess", {"contact_family", "linear_mode"});
+std::shared_ptr<const bar::BarSolver> shooting_solver(const core::Scene& scene) {
+  if (scene.choice("shooting_solver", {"tdbem", "exact"}) == "exact")
+    return std::make_shared<exact_bar::ExactBarSolver>();
+  return std::make_shared<TdbemSolver>(contact_method_from_scene(scene));
+}
 
-  cli::TraceSetup s;
-  if (options.amplitude_units) {
-    // In units of the amplitude a step ds is a relative change of the orbit and F's round-off
-    // is relative too (README.md, section 'Cost'): 10 % steps (mode 1 to 1e-2 J in 54 points,
-    // to 1e4 J in 126; 0.45 gave 18 and 37, too few for the figures) and a tolerance of 1e-10
-    // of the amplitude (closed-form error 4e-13 at 20 intervals and 1e-13 at 100, against 7e-12
-    // with the gap units' 3e-9, at the same Jacobians per point).
-    const bool ds_given = !scene.values()["ds"].defaulted();
-    const bool ds_max_given = !scene.values()["ds_max"].defaulted();
-    const bool tolerance_given = !scene.values()["newton_tolerance"].defaulted();
-    s.branch_options = [=](continuation::ContinuationOptions& o, core::NewtonOptions& newton) {
-      if (!ds_max_given) o.ds_max = 0.1;
-      if (!ds_given) o.ds = std::min(0.1, o.ds_max);
-      if (!tolerance_given) newton.residual_tolerance = 1e-10;
-    };
-  }
-  s.guess = guess == "linear_mode" ? problem->linear_mode_guess(mode, ratio)
-                                   : problem->contact_family_guess(mode, ratio);
-  // Energy grows along the family: the direction of the contact family's own tangent.
-  s.direction = problem->contact_family_guess(mode, ratio * 1.01) -
-                problem->contact_family_guess(mode, ratio);
-
-  const ContactBarOrbitProblem* p = problem.get();
+// The reject_point hook of return_tolerance > 0: a converged point whose orbit, re-simulated by
+// the exact oracle on check_elements intervals, misses its start by more than the tolerance.
+// None for return_tolerance 0.
+std::function<std::string(const core::Vector&)> return_check(const core::Scene& scene,
+                                                             const ContactBarOrbitProblem* p,
+                                                             int check_elements) {
   const double return_tolerance = scene.non_negative("return_tolerance");
-  if (return_tolerance > 0) {
-    // Exact oracle sampled on 4x as many intervals as unknowns (finer than the default test
-    // grid): a spurious root of the projected equations is not a root of these.
-    const int check_elements = 4 * p->state_size();
-    s.reject_point = [p, return_tolerance, check_elements](const core::Vector& x) {
-      const exact_bar::ExactBarSolver oracle;
-      const ReturnError e = return_error(*p, x, oracle, check_elements);
-      if (e.worst() <= return_tolerance) return std::string();
-      return fmt::format(
-          "exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
-          "return_tolerance {:g}",
-          e.displacement, e.velocity, return_tolerance);
-    };
-  }
+  if (!(return_tolerance > 0)) return {};
+  return [p, return_tolerance, check_elements](const core::Vector& x) {
+    const exact_bar::ExactBarSolver oracle;
+    const ReturnError e = return_error(*p, x, oracle, check_elements);
+    if (e.worst() <= return_tolerance) return std::string();
+    return fmt::format(
+        "exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
+        "return_tolerance {:g}",
+        e.displacement, e.velocity, return_tolerance);
+  };
+}
+
+// mode1 and mode2 in units of the amplitude: a step ds is a relative change of the orbit and
+// F's round-off is relative too (README.md, section 'Cost'), so the defaults become 10 % steps,
+// which give a branch enough points for the figures, and a tolerance of 1e-10 of the amplitude,
+// above that round-off. Keys the scene gives are kept.
+std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)>
+amplitude_unit_options(const core::Scene& scene) {
+  const bool ds_given = !scene.values()["ds"].defaulted();
+  const bool ds_max_given = !scene.values()["ds_max"].defaulted();
+  const bool tolerance_given = !scene.values()["newton_tolerance"].defaulted();
+  return [=](continuation::ContinuationOptions& o, core::NewtonOptions& newton) {
+    if (!ds_max_given) o.ds_max = 0.1;
+    if (!ds_given) o.ds = std::min(0.1, o.ds_max);
+    if (!tolerance_given) newton.residual_tolerance = 1e-10;
+  };
+}
+
+// What a mode's trace reports besides the branch: the attached content of its branch points,
+// each point's closed-form error, and closed_form_check.csv.
+void describe_mode(cli::TraceSetup& s, const ContactBarOrbitProblem* p,
+                   const ContactFamily& family) {
   // Branch points: the frequency ratio of the attached orbit's extra end content, measured
   // from exact re-simulations of both orbits (attached_content.hpp).
   s.describe_branch_point = [p](const core::Vector& on_branch, const core::Vector& attached) {
@@ -248,14 +232,46 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
     }
     check.write_csv(out / "closed_form_check.csv");
   };
-  s.problem = std::move(problem);
-  return s;
 }
 
-std::shared_ptr<const bar::BarSolver> shooting_solver(const core::Scene& scene) {
-  if (scene.choice("shooting_solver", {"tdbem", "exact"}) == "exact")
-    return std::make_shared<exact_bar::ExactBarSolver>();
-  return std::make_shared<TdbemSolver>(contact_method_from_scene(scene));
+cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
+  if (branch.rfind("subharmonic", 0) == 0) return setup_subharmonic(scene, branch);
+  const int mode = branch == "mode2" ? 2 : 1;
+  bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
+  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
+    throw core::InputError("right_end",
+                           "the contact-bar modes need right_end = contact and gap > 0");
+  const ContactFamily family(setup.material, setup.right.gap, mode);
+  const std::shared_ptr<const bar::BarSolver> solver = shooting_solver(scene);
+
+  OrbitOptions options = shooting_grid(scene);
+  const long knots = scene.integer("free_knots", -1);
+  options.free_knots = knots < 0 ? (mode == 2 ? 1 : 0) : static_cast<int>(knots);
+  const long test_elements = scene.integer("test_elements", -1);
+  options.test_elements = static_cast<int>(
+      test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);
+  // A followed family's probes and paths are measured in units of the gap: with follow the gap
+  // stays the unit. (Branch-point detection works in either: its samples are kept in the unit
+  // scale, continuation/README.md, section 'Branch points'.)
+  options.amplitude_units = scene.flag("amplitude_units") && scene.text("follow") == "none";
+
+  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, solver, options);
+  const double ratio = 1 + scene.positive("start_offset");
+  const std::string guess = scene.choice("start_guess", {"contact_family", "linear_mode"});
+
+  cli::TraceSetup s;
+  if (options.amplitude_units) s.branch_options = amplitude_unit_options(scene);
+  s.guess = guess == "linear_mode" ? problem->linear_mode_guess(mode, ratio)
+                                   : problem->contact_family_guess(mode, ratio);
+  // Energy grows along the family: the direction of the contact family's own tangent.
+  s.direction = problem->contact_family_guess(mode, ratio * 1.01) -
+                problem->contact_family_guess(mode, ratio);
+  // Exact oracle sampled on 4x as many intervals as unknowns (finer than the default test
+  // grid): a spurious root of the projected equations is not a root of these.
+  s.reject_point = return_check(scene, problem.get(), 4 * problem->state_size());
+  describe_mode(s, problem.get(), family);
+  s.problem = std::move(problem);
+  return s;
 }
 
 // The continuum's own continuation settings (README.md, section 'Subharmonic continuum'):
@@ -305,42 +321,42 @@ std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)> co
   };
 }
 
-// The subharmonic branches (README.md, section 'Subharmonic continuum'): mode 2 taken over two
-// periods, T = 2 T2, started at rest at the centre of a contact phase (start_on_wall), two free
-// knots at its two kinks. The periodic orbits form a 2D manifold (energy x shape); a path on it
-// is picked by one path row: the shape (subharmonic: the backbone at constant shape) or the
-// energy (subharmonic_continuum: the members at one energy, from a grazing limit on).
-cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch) {
-  bar::BarSetup setup = bar_from_scene(scene);
-  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
-    throw core::InputError("right_end",
-                           "the subharmonic branches need right_end = contact and gap > 0");
-  // The manifold's seed is a member of the continuum at sqrt(energy_min energy_max) (manifold.hpp).
-  const bool manifold = branch == "subharmonic_manifold";
-  const bool continuum = branch == "subharmonic_continuum" || manifold;
-  const bar::Material& material = setup.material;
-  const double g0 = setup.right.gap;
-  const ContactFamily mode2(material, g0, 2);
-  double energy = scene.non_negative("energy");
-  if (energy == 0) energy = 0.5 * material.axial_stiffness() * 25 * g0 * g0 / material.length;
-  if (manifold) energy = manifold_seed_energy(scene);
-  const double shape_key = scene.number("shape");
-  const double shape = shape_key >= 0 ? shape_key : (continuum && !manifold ? 1.0 : 0.3);
-  if (!(shape > 0 && shape <= 1))
-    throw core::InputError("shape", fmt::format("must be in (0, 1] (got {})", shape));
-  // The backbone starts near the mode-2 grazing energy (end amplitude (1 + start_offset) g0).
-  const double ratio = 1 + scene.positive("start_offset");
-  const double start_energy = continuum ? energy
-                                        : 0.5 * material.axial_stiffness() *
-                                              std::pow((2 * ratio + 1) * g0, 2) / material.length;
-  const SubharmonicMember first = subharmonic_member(material, g0, start_energy, shape);
+// Where a subharmonic branch starts: the members' energy (continuum) or the backbone's first
+// energy near the mode-2 grazing energy (end amplitude (1 + start_offset) g0), and the shape.
+struct SubharmonicStart {
+  bool manifold = false, continuum = false;
+  double energy = 0;        // of the continuum's members
+  double shape = 0;         // kept (subharmonic) or of the first member (continuum)
+  double start_energy = 0;  // of the first point
+  SubharmonicMember first;  // the closed-form member there
+};
 
-  OrbitOptions options;
-  const long shooting_elements = scene.integer("shooting_elements", 0);
-  options.elements =
-      static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
-  options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
-  check_residual_work(scene, options);
+SubharmonicStart subharmonic_start(const core::Scene& scene, const std::string& branch,
+                                   const bar::Material& material, double g0) {
+  SubharmonicStart st;
+  // The manifold's seed is a member of the continuum at sqrt(energy_min energy_max) (manifold.hpp).
+  st.manifold = branch == "subharmonic_manifold";
+  st.continuum = branch == "subharmonic_continuum" || st.manifold;
+  st.energy = scene.non_negative("energy");
+  if (st.energy == 0) st.energy = 0.5 * material.axial_stiffness() * 25 * g0 * g0 / material.length;
+  if (st.manifold) st.energy = manifold_seed_energy(scene);
+  const double shape_key = scene.number("shape");
+  st.shape = shape_key >= 0 ? shape_key : (st.continuum && !st.manifold ? 1.0 : 0.3);
+  if (!(st.shape > 0 && st.shape <= 1))
+    throw core::InputError("shape", fmt::format("must be in (0, 1] (got {})", st.shape));
+  const double ratio = 1 + scene.positive("start_offset");
+  st.start_energy = st.continuum ? st.energy
+                                 : 0.5 * material.axial_stiffness() *
+                                       std::pow((2 * ratio + 1) * g0, 2) / material.length;
+  st.first = subharmonic_member(material, g0, st.start_energy, st.shape);
+  return st;
+}
+
+// The subharmonic chart: started on the wall, two free knots (or more) at the first member's
+// kinks, the path row fixing the energy (continuum) or the shape.
+OrbitOptions subharmonic_chart(const core::Scene& scene, const bar::Material& material,
+                               const SubharmonicStart& st) {
+  OrbitOptions options = shooting_grid(scene);
   options.start_on_wall = true;
   const long knots = scene.integer("free_knots", -1);
   options.free_knots = knots < 0 ? 2 : static_cast<int>(knots);
@@ -348,9 +364,9 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
     throw core::InputError("free_knots", "the subharmonic members have two kinks: >= 2 or -1");
   // Knot 1 on the node nearest the first kink; the last knot on node N - 1: beyond the second
   // kink u0 is linear up to L for every member, and that segment shrinks to nothing at the
-  // shape-0 limit, where interior nodes would be free of the residual (spurious roots,
-  // measured: return errors 1e-5 from shape 0.09 on at N = 20). Further knots (free_knots > 2)
-  // spread between the two.
+  // shape-0 limit, where interior nodes would be free of the residual (spurious roots).
+  // Further knots (free_knots > 2) spread between the two.
+  const SubharmonicMember& first = st.first;
   std::vector<double> at{first.kinks[0]};
   for (int j = 1; j + 1 < options.free_knots; ++j)
     at.push_back(first.kinks[0] + (first.kinks[1] - first.kinks[0]) * j / (options.free_knots - 1));
@@ -362,53 +378,27 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements =
       static_cast<int>(test_elements < 0 ? 2 * options.state_size() : test_elements);
-  if (continuum)
-    options.fixed_energy = energy;
+  if (st.continuum)
+    options.fixed_energy = st.energy;
   else
-    options.fixed_shape = shape;
+    options.fixed_shape = st.shape;
+  return options;
+}
 
-  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, shooting_solver(scene), options);
-  cli::TraceSetup s;
-  s.guess = problem->subharmonic_guess(start_energy, shape);
-  if (continuum) {
-    // Towards the other grazing limit: the shape decreases from 1 (increases from below 1/2).
-    // The closed-form direction of the family: the first step follows it, since the start at
-    // a grazing limit is a nonsmooth boundary point where the finite-difference tangent mixes
-    // the free and the contact side (measured: 8 to 83 degrees off the family).
-    const double toward = shape > 0.5 ? -1.0 : 1.0;
-    s.direction = problem->subharmonic_guess(energy, shape + toward * 1e-4) - s.guess;
-    s.branch_options = continuum_options(scene, *problem, energy, shape, toward);
-  } else {
-    s.direction = problem->subharmonic_guess(start_energy * 1.01, shape) - s.guess;
-  }
-  const ContactBarOrbitProblem* p = problem.get();
-  const double return_tolerance = scene.non_negative("return_tolerance");
-  if (return_tolerance > 0) {
-    // 1000 intervals: finer than any knot segment the branch keeps (a coarser check grid let
-    // spurious roots through near the shape-0 limit).
-    s.reject_point = [p, return_tolerance](const core::Vector& x) {
-      const exact_bar::ExactBarSolver oracle;
-      const ReturnError e = return_error(*p, x, oracle, 1000);
-      if (e.worst() <= return_tolerance) return std::string();
-      return fmt::format(
-          "exact re-simulation misses the orbit by {:.2e} (u) / {:.2e} (v) > "
-          "return_tolerance {:g}",
-          e.displacement, e.velocity, return_tolerance);
-    };
-  }
-  s.describe_point = [mode2](const continuation::BranchPoint& point) {
-    const double exact = 2 * mode2.period(point.observable("energy"));
-    return fmt::format("T / (2 T2) - 1 = {:.2e}, shape {:.4f}",
-                       point.observable("period") / exact - 1, point.observable("shape"));
-  };
+// The subharmonic branches' outputs beside the branch (write_subharmonic_outputs) and, for
+// the continuum, limits.csv: both grazing limits at this energy, located by NLopt
+// (grazing_limits.hpp) on the continuum's grid and time step.
+std::function<void(const std::filesystem::path&, const continuation::Branch&)> subharmonic_outputs(
+    const core::Scene& scene, const ContactBarOrbitProblem* p, const ContactFamily& mode2,
+    const SubharmonicStart& st) {
   const bool dimension_check = scene.flag("dimension_check");
   const double rank_threshold = scene.positive("rank_threshold");
-  s.write_extra_outputs = [p, mode2, dimension_check, rank_threshold, continuum, energy](
-                              const std::filesystem::path& out, const continuation::Branch& b) {
+  const bool continuum = st.continuum;
+  const double energy = st.energy;
+  return [p, mode2, dimension_check, rank_threshold, continuum, energy](
+             const std::filesystem::path& out, const continuation::Branch& b) {
     write_subharmonic_outputs(*p, mode2, b, out, dimension_check ? rank_threshold : std::nan(""));
     if (!continuum) return;
-    // limits.csv: both grazing limits at this energy, located by NLopt (grazing_limits.hpp)
-    // on the continuum's grid and time step.
     GrazingLimitOptions o;
     o.elements = p->options().elements;
     o.steps_per_period = p->options().steps_per_period;
@@ -423,8 +413,48 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
     fmt::print("grazing limits: shape_1 simulated by T2 = {:.9g} s vs shape_0: {:.2e} relative\n",
                g.half_period, g.shift_distance);
   };
+}
+
+// The subharmonic branches (README.md, section 'Subharmonic continuum'): mode 2 taken over two
+// periods, T = 2 T2, started at rest at the centre of a contact phase (start_on_wall), two free
+// knots at its two kinks. The periodic orbits form a 2D manifold (energy x shape); a path on it
+// is picked by one path row: the shape (subharmonic: the backbone at constant shape) or the
+// energy (subharmonic_continuum: the members at one energy, from a grazing limit on).
+cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch) {
+  bar::BarSetup setup = bar_from_scene(scene);
+  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
+    throw core::InputError("right_end",
+                           "the subharmonic branches need right_end = contact and gap > 0");
+  const bar::Material& material = setup.material;
+  const ContactFamily mode2(material, setup.right.gap, 2);
+  const SubharmonicStart st = subharmonic_start(scene, branch, material, setup.right.gap);
+  const OrbitOptions options = subharmonic_chart(scene, material, st);
+
+  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, shooting_solver(scene), options);
+  cli::TraceSetup s;
+  s.guess = problem->subharmonic_guess(st.start_energy, st.shape);
+  if (st.continuum) {
+    // Towards the other grazing limit: the shape decreases from 1 (increases from below 1/2).
+    // The closed-form direction of the family: the first step follows it, since the start at
+    // a grazing limit is a nonsmooth boundary point where the finite-difference tangent mixes
+    // the free and the contact side.
+    const double toward = st.shape > 0.5 ? -1.0 : 1.0;
+    s.direction = problem->subharmonic_guess(st.energy, st.shape + toward * 1e-4) - s.guess;
+    s.branch_options = continuum_options(scene, *problem, st.energy, st.shape, toward);
+  } else {
+    s.direction = problem->subharmonic_guess(st.start_energy * 1.01, st.shape) - s.guess;
+  }
+  // 1000 intervals: finer than any knot segment the branch keeps (a coarser check grid lets
+  // spurious roots through near the shape-0 limit).
+  s.reject_point = return_check(scene, problem.get(), 1000);
+  s.describe_point = [mode2](const continuation::BranchPoint& point) {
+    const double exact = 2 * mode2.period(point.observable("energy"));
+    return fmt::format("T / (2 T2) - 1 = {:.2e}, shape {:.4f}",
+                       point.observable("period") / exact - 1, point.observable("shape"));
+  };
+  s.write_extra_outputs = subharmonic_outputs(scene, problem.get(), mode2, st);
   problem->set_path_rows(scene.flag("path_rows"));
-  if (manifold) add_manifold_outputs(scene, s, *problem);
+  if (st.manifold) add_manifold_outputs(scene, s, *problem);
   s.problem = std::move(problem);
   return s;
 }

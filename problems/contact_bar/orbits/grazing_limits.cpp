@@ -217,145 +217,143 @@ OrbitOptions chart(const GrazingLimitOptions& o, const bar::Material& material,
   return chart;
 }
 
-GrazingLimit locate(const bar::BarSetup& setup, const bar::BarSolver& solver, double energy,
-                    const GrazingLimitOptions& o, bool shape_one) {
-  const auto started = std::chrono::steady_clock::now();
-  const bar::Material& material = setup.material;
-  const double g0 = setup.right.gap;
-  const SubharmonicMember start =
-      subharmonic_member(material, g0, energy, shape_one ? 1 - o.start_distance : o.start_distance);
-  const int knots = shape_one ? 2 : 1;
-  const ContactBarOrbitProblem problem(setup, solver, chart(o, material, start, knots));
+// The start in the chart's unknowns: the closed-form member (shape 1), or the member sampled on
+// the one-knot chart, its first kink on the knot (shape 0).
+core::Vector start_unknowns(const ContactBarOrbitProblem& problem, const SubharmonicMember& start,
+                            double energy, const GrazingLimitOptions& o, bool shape_one) {
   core::Vector x0(problem.num_unknowns());
-  if (shape_one) {
-    x0 = problem.subharmonic_guess(energy, 1 - o.start_distance);
-  } else {
-    // The one-knot chart: the first kink on the knot, u0 sampled at the mapped nodes.
-    x0[problem.knot_index(0)] = start.kinks[0];
-    const core::Vector y = problem.node_positions(x0);
-    for (int i = 1; i <= problem.options().nodal_unknowns(); ++i) x0[i - 1] = start.u0(y[i - 1]);
-    x0[problem.period_index()] = start.period;
-  }
-  LimitProblem p;
-  p.problem = &problem;
-  p.scale = problem.typical_scale().cwiseAbs();
-  p.energy = energy;
-  // Shape 1: maximise the phase around t = 0, which grows smoothly up to the limit and beyond
-  // it (where the rows stop having solutions), rather than minimise the one around T/2, which
-  // is flat (0) beyond the limit and let SLSQP stop there. Shape 0: the one-knot chart holds
-  // the limit alone; minimise the phase around t = 0.
-  p.around_half = false;
-  p.sign = shape_one ? -1.0 : 1.0;
-  const unsigned n = static_cast<unsigned>(x0.size());
-  std::vector<double> z(n), lower(n, -HUGE_VAL), upper(n, HUGE_VAL);
-  for (unsigned i = 0; i < n; ++i) z[i] = x0[i] / p.scale[i];
-  // A box around the start (scaled units: g0, L, L/c) keeps SLSQP's first steps, taken on
-  // a linearisation of a piecewise-smooth map, near the curve; the limit lies well inside it
-  // (the knots move by start_distance (1 - 3b) L <= 0.25 start_distance L to reach it).
+  if (shape_one) return problem.subharmonic_guess(energy, 1 - o.start_distance);
+  x0[problem.knot_index(0)] = start.kinks[0];
+  const core::Vector y = problem.node_positions(x0);
+  for (int i = 1; i <= problem.options().nodal_unknowns(); ++i) x0[i - 1] = start.u0(y[i - 1]);
+  x0[problem.period_index()] = start.period;
+  return x0;
+}
+
+// A box around the start z (scaled units: g0, L, L/c) keeps SLSQP's first steps, taken on a
+// linearisation of a piecewise-smooth map, near the curve; the limit lies well inside it (the
+// knots move by start_distance (1 - 3b) L <= 0.25 start_distance L to reach it). The knots stay
+// inside (0, L).
+struct Box {
+  std::vector<double> lower, upper;
+};
+
+Box start_box(const ContactBarOrbitProblem& problem, const core::Vector& x0,
+              const std::vector<double>& z, const GrazingLimitOptions& o, int knots) {
+  const std::size_t n = z.size();
+  Box box{std::vector<double>(n, -HUGE_VAL), std::vector<double>(n, HUGE_VAL)};
   for (unsigned i = 0; i < n; ++i) {
     const double half_width =
         static_cast<int>(i) == problem.period_index() ? 1e-2
         : static_cast<int>(i) >= problem.options().nodal_unknowns()
             ? 2 * o.start_distance
             : 0.5 + 20 * o.start_distance * x0.cwiseAbs().maxCoeff() / problem.displacement_scale();
-    lower[i] = z[i] - half_width;
-    upper[i] = z[i] + half_width;
+    box.lower[i] = z[i] - half_width;
+    box.upper[i] = z[i] + half_width;
   }
   for (int j = 0; j < knots; ++j) {  // knots inside (0, L), in units of L
-    lower[problem.knot_index(j)] = std::max(lower[problem.knot_index(j)], 1e-6);
-    upper[problem.knot_index(j)] = std::min(upper[problem.knot_index(j)], 1 - 1e-6);
+    box.lower[problem.knot_index(j)] = std::max(box.lower[problem.knot_index(j)], 1e-6);
+    box.upper[problem.knot_index(j)] = std::min(box.upper[problem.knot_index(j)], 1 - 1e-6);
   }
-  // One SLSQP run from z in [lower, upper]: the projection Q from the rows' Jacobian at z.
-  const auto run = [&](std::vector<double>& from, const std::vector<double>& lo,
-                       const std::vector<double>& hi, nlopt_result& result) {
-    core::Vector c0;
-    core::Matrix J0;
-    if (!rows(p, n, from.data(), c0, &J0)) return false;
-    const Eigen::JacobiSVD<core::Matrix> svd(J0, Eigen::ComputeThinU);
-    const auto& sigma = svd.singularValues();
-    int rank = 0;
-    while (rank < sigma.size() && sigma[rank] > 1e-6 * sigma[0]) ++rank;
-    p.range = svd.matrixU().leftCols(rank);
-    p.last.clear();
-    const unsigned m = static_cast<unsigned>(rank);
-    nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
-    nlopt_set_min_objective(opt, objective, &p);
-    const std::vector<double> tolerances(m, o.constraint_tolerance);
-    nlopt_add_equality_mconstraint(opt, m, equalities, &p, tolerances.data());
-    nlopt_set_lower_bounds(opt, lo.data());
-    nlopt_set_upper_bounds(opt, hi.data());
-    nlopt_set_xtol_rel(opt, o.tolerance);
-    nlopt_set_maxeval(opt, o.max_evaluations);
-    double value = 0;
-    result = nlopt_optimize(opt, from.data(), &value);
-    nlopt_destroy(opt);
-    if (!p.last.empty()) from = p.last;
-    return true;
-  };
-  // Polish onto all rows (least-squares Newton on F plus the energy row): NLopt stops within
-  // constraint_tolerance of them; the polish moves the point by about that much.
-  OrbitOptions polished = problem.options();
-  polished.fixed_energy = energy;
-  const ContactBarOrbitProblem on_rows(setup, solver, polished);
+  return box;
+}
+
+// One SLSQP run from z in `box`, the projection Q from the rows' Jacobian at z; `from` becomes
+// the last iterate. False when z is outside the chart.
+bool run_slsqp(LimitProblem& p, const GrazingLimitOptions& o, std::vector<double>& from,
+               const Box& box, nlopt_result& result) {
+  const unsigned n = static_cast<unsigned>(from.size());
+  core::Vector c0;
+  core::Matrix J0;
+  if (!rows(p, n, from.data(), c0, &J0)) return false;
+  const Eigen::JacobiSVD<core::Matrix> svd(J0, Eigen::ComputeThinU);
+  const auto& sigma = svd.singularValues();
+  int rank = 0;
+  while (rank < sigma.size() && sigma[rank] > 1e-6 * sigma[0]) ++rank;
+  p.range = svd.matrixU().leftCols(rank);
+  p.last.clear();
+  const unsigned m = static_cast<unsigned>(rank);
+  nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
+  nlopt_set_min_objective(opt, objective, &p);
+  const std::vector<double> tolerances(m, o.constraint_tolerance);
+  nlopt_add_equality_mconstraint(opt, m, equalities, &p, tolerances.data());
+  nlopt_set_lower_bounds(opt, box.lower.data());
+  nlopt_set_upper_bounds(opt, box.upper.data());
+  nlopt_set_xtol_rel(opt, o.tolerance);
+  nlopt_set_maxeval(opt, o.max_evaluations);
+  double value = 0;
+  result = nlopt_optimize(opt, from.data(), &value);
+  nlopt_destroy(opt);
+  if (!p.last.empty()) from = p.last;
+  return true;
+}
+
+// The polish onto all rows (least-squares Newton on F plus the energy row): NLopt stops within
+// constraint_tolerance of them; the polish moves the point by about that much.
+struct Polish {
+  const LimitProblem& p;
+  const ContactBarOrbitProblem& on_rows;  // the chart with the energy row
   core::NewtonOptions newton;
-  newton.residual_tolerance = 1e-12;
-  const auto polish = [&](std::vector<double>& at) {
+  Polish(const LimitProblem& limit, const ContactBarOrbitProblem& rows) : p(limit), on_rows(rows) {
+    newton.residual_tolerance = 1e-12;
+  }
+  // Moves `at` (scaled) onto the rows when Newton converges.
+  core::NewtonSummary operator()(std::vector<double>& at) const {
     core::Vector y = p.unknowns(at.data());
     const core::NewtonSummary s = core::make_corrector("eigen", newton)->solve(on_rows, y);
     if (s.converged())
-      for (unsigned i = 0; i < n; ++i) at[i] = y[i] / p.scale[i];
+      for (std::size_t i = 0; i < at.size(); ++i) at[i] = y[i] / p.scale[i];
     return s;
-  };
-  nlopt_result result = NLOPT_FAILURE;
-  if (!run(z, lower, upper, result)) {
-    GrazingLimit failed;
-    failed.name = shape_one ? "shape_1" : "shape_0";
-    failed.message = "the start is outside the chart";
-    return failed;
   }
-  core::NewtonSummary polished_summary = polish(z);
-  const int first_pass = p.evaluations;
-  if (shape_one) {
-    // A second pass from the first one's limit with a 100x smaller difference step in a box
-    // of 1e-3: the first locates the kink at the end of the curve only to the resolution of
-    // its gradients (measured: the vanishing phase left at up to 1.6e-7 L/c).
-    p.step = 1e-9;
-    std::vector<double> lo(n), hi(n);
-    for (unsigned i = 0; i < n; ++i)
-      lo[i] = std::max(lower[i], z[i] - 1e-3), hi[i] = std::min(upper[i], z[i] + 1e-3);
-    std::vector<double> again = z;
-    nlopt_result second = NLOPT_FAILURE;
-    if (run(again, lo, hi, second)) {
-      const core::NewtonSummary s = polish(again);
-      if (s.converged() && second > 0) z = again, result = second, polished_summary = s;
-    }
-    p.step = 1e-7;
-    // A sliver of the phase left (measured: 1.2e-7 s at 2 of 12 energies and grids, 2 contact
-    // phases instead of 1 plus a grazing instant): Newton on the rows plus the phase.
-    p.around_half = true;
-    const core::Vector at = p.unknowns(z.data());
-    if (p.phase(at) > 0) {
-      const RowsAndPhase closing(on_rows, p);
-      core::Vector y = at;
-      const core::NewtonSummary s = core::make_corrector("eigen", newton)->solve(closing, y);
-      // It stalls near the rows' round-off, the kink making the last steps oscillate (measured:
-      // 1.1e-12 and 2.2e-11, phase 0 and 8e-14 s): kept when the rows hold to 1e-10 (the trace's
-      // members hold 1e-12..3e-9) and the phase shrank.
-      core::Vector f;
-      if (on_rows.residual(y, f) == core::EvalStatus::ok && f.cwiseAbs().maxCoeff() <= 1e-10 &&
-          p.phase(y) < p.phase(at)) {
-        for (unsigned i = 0; i < n; ++i) z[i] = y[i] / p.scale[i];
-        polished_summary = s;
-      }
-    }
-    p.around_half = false;
-  }
+};
 
+// Shape 1's second pass from the first one's limit z, with a 100x smaller difference step in a
+// box of 1e-3: the first locates the kink at the end of the curve only to the resolution of its
+// gradients. Then, if a sliver of the phase around T/2 is left (two contact phases instead of
+// one plus a grazing instant), Newton on the rows plus the phase.
+void refine_shape_one(LimitProblem& p, const GrazingLimitOptions& o, const Box& box,
+                      const Polish& polish, std::vector<double>& z, nlopt_result& result,
+                      core::NewtonSummary& polished) {
+  const std::size_t n = z.size();
+  p.step = 1e-9;
+  Box near{std::vector<double>(n), std::vector<double>(n)};
+  for (unsigned i = 0; i < n; ++i)
+    near.lower[i] = std::max(box.lower[i], z[i] - 1e-3),
+    near.upper[i] = std::min(box.upper[i], z[i] + 1e-3);
+  std::vector<double> again = z;
+  nlopt_result second = NLOPT_FAILURE;
+  if (run_slsqp(p, o, again, near, second)) {
+    const core::NewtonSummary s = polish(again);
+    if (s.converged() && second > 0) z = again, result = second, polished = s;
+  }
+  p.step = 1e-7;
+  p.around_half = true;
+  const core::Vector at = p.unknowns(z.data());
+  if (p.phase(at) > 0) {
+    const RowsAndPhase closing(polish.on_rows, p);
+    core::Vector y = at;
+    const core::NewtonSummary s = core::make_corrector("eigen", polish.newton)->solve(closing, y);
+    // It stalls near the rows' round-off, the kink making the last steps oscillate: its point
+    // is kept when the rows hold to 1e-10 (inside the trace's newton_tolerance, 3e-9) and the
+    // phase shrank.
+    core::Vector f;
+    if (polish.on_rows.residual(y, f) == core::EvalStatus::ok && f.cwiseAbs().maxCoeff() <= 1e-10 &&
+        p.phase(y) < p.phase(at)) {
+      for (unsigned i = 0; i < n; ++i) z[i] = y[i] / p.scale[i];
+      polished = s;
+    }
+  }
+  p.around_half = false;
+}
+
+// The limit at z: its orbit, vanishing phase, residual, exact return and contact structure.
+GrazingLimit describe_limit(const ContactBarOrbitProblem& problem, LimitProblem& p,
+                            const std::vector<double>& z, bool shape_one, nlopt_result result,
+                            int first_pass, const core::NewtonSummary& polished) {
   GrazingLimit limit;
   limit.name = shape_one ? "shape_1" : "shape_0";
-  limit.free_knots = knots;
+  limit.free_knots = problem.options().free_knots;
   limit.x = p.unknowns(z.data());
-  const core::NewtonSummary& polish_summary = polished_summary;
   limit.evaluations = p.evaluations;
   limit.period = limit.x[problem.period_index()];
   limit.energy = problem.energy(limit.x);
@@ -371,7 +369,49 @@ GrazingLimit locate(const bar::BarSetup& setup, const bar::BarSolver& solver, do
   limit.ok = result > 0 && std::isfinite(limit.return_error) && limit.return_error < 1e-6;
   limit.message =
       fmt::format("nlopt slsqp: {} after {} evaluations ({} in the first pass); polish: {}",
-                  nlopt_result_name(result), limit.evaluations, first_pass, polish_summary.message);
+                  nlopt_result_name(result), limit.evaluations, first_pass, polished.message);
+  return limit;
+}
+
+GrazingLimit locate(const bar::BarSetup& setup, const bar::BarSolver& solver, double energy,
+                    const GrazingLimitOptions& o, bool shape_one) {
+  const auto started = std::chrono::steady_clock::now();
+  const bar::Material& material = setup.material;
+  const SubharmonicMember start = subharmonic_member(
+      material, setup.right.gap, energy, shape_one ? 1 - o.start_distance : o.start_distance);
+  const int knots = shape_one ? 2 : 1;
+  const ContactBarOrbitProblem problem(setup, solver, chart(o, material, start, knots));
+  const core::Vector x0 = start_unknowns(problem, start, energy, o, shape_one);
+  LimitProblem p;
+  p.problem = &problem;
+  p.scale = problem.typical_scale().cwiseAbs();
+  p.energy = energy;
+  // Shape 1: maximise the phase around t = 0, which grows smoothly up to the limit and beyond
+  // it (where the rows stop having solutions), rather than minimise the one around T/2, which
+  // is flat (0) beyond the limit and let SLSQP stop there. Shape 0: the one-knot chart holds
+  // the limit alone; minimise the phase around t = 0.
+  p.around_half = false;
+  p.sign = shape_one ? -1.0 : 1.0;
+  const unsigned n = static_cast<unsigned>(x0.size());
+  std::vector<double> z(n);
+  for (unsigned i = 0; i < n; ++i) z[i] = x0[i] / p.scale[i];
+  const Box box = start_box(problem, x0, z, o, knots);
+  OrbitOptions polished_chart = problem.options();
+  polished_chart.fixed_energy = energy;
+  const ContactBarOrbitProblem on_rows(setup, solver, polished_chart);
+  const Polish polish(p, on_rows);
+
+  nlopt_result result = NLOPT_FAILURE;
+  if (!run_slsqp(p, o, z, box, result)) {
+    GrazingLimit failed;
+    failed.name = shape_one ? "shape_1" : "shape_0";
+    failed.message = "the start is outside the chart";
+    return failed;
+  }
+  core::NewtonSummary polished = polish(z);
+  const int first_pass = p.evaluations;
+  if (shape_one) refine_shape_one(p, o, box, polish, z, result, polished);
+  GrazingLimit limit = describe_limit(problem, p, z, shape_one, result, first_pass, polished);
   limit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return limit;
 }
@@ -386,8 +426,8 @@ GrazingLimits grazing_limits(const bar::BarSetup& setup, const bar::BarSolver& s
   ContactFamily(setup.material, setup.right.gap, 2);
   GrazingLimits g;
   for (const bool shape_one : {true, false}) {
-    // A start that SLSQP leaves for another root (measured: shape 0 at 1e-3 J, N = 80, from
-    // the member at shape 0.02 cut to one knot) is retried from nearer the limit.
+    // A start that SLSQP leaves for another root (the shape-0 start, its second kink cut off,
+    // is not itself a solution) is retried from nearer the limit.
     GrazingLimitOptions o = options;
     GrazingLimit limit = locate(setup, solver, energy, o, shape_one);
     for (int retry = 0; retry < 2 && !limit.ok; ++retry) {

@@ -284,6 +284,79 @@ void fold_interval(double a, double b, double length, std::vector<std::pair<doub
     out.emplace_back(std::min(f0, f1), std::max(f0, f1));
   }
 }
+
+// What the Jacobian pattern of the shooting residual is built from: the representation grid,
+// the contact events (paper formulation) and the reach of the characteristics over the
+// residual's time. Shared with the `wider` pattern, which is built after jacobian_pattern
+// returns, when a check asks for it.
+struct PatternGeometry {
+  std::vector<double> node;  // positions of the nodes 0..N (mapped by the free knots)
+  bar::History events;       // paper: the run at x, every step sampled; empty otherwise
+  int n = 0, nodal = 0, m = 0, equations = 0;  // elements, nodal unknowns, test rows, rows
+  std::vector<int> knot_and_period_columns;    // dense in every row
+  double length = 0, c = 0;
+  double reach = 0;         // c T (paper) or c T / 2 (regular)
+  double test_element = 0;  // L / m
+  bool paper = false;
+};
+
+// The pattern with every support widened by `margin` on either side.
+core::JacobianPattern pattern_with_margin(const PatternGeometry& g, double margin) {
+  const std::vector<double>& knot = g.node;
+  const bar::History& events = g.events;
+  std::vector<std::pair<double, double>> pieces;
+  // Unknowns k whose support [node[k], node[k + 2]] meets a folded piece.
+  auto columns_meeting = [&](const std::pair<double, double>& piece, auto&& add) {
+    const auto [lo, hi] = piece;
+    const int first = static_cast<int>(std::lower_bound(knot.begin(), knot.end(), lo) -
+                                       knot.begin());  // knot[first] >= lo
+    for (int k = std::max(0, first - 2); k < g.nodal; ++k) {
+      if (knot[static_cast<std::size_t>(k)] > hi) break;
+      if (knot[static_cast<std::size_t>(std::min(k + 2, g.n))] >= lo) add(k);
+    }
+  };
+  core::JacobianPattern pattern;
+  pattern.row_columns.resize(static_cast<std::size_t>(g.equations));
+  pattern.dense_columns = g.knot_and_period_columns;
+  std::vector<char> dense(static_cast<std::size_t>(g.nodal), 0);
+  for (std::size_t k = 1; k < events.t.size(); ++k) {
+    const bool before = events.contact_force[k - 1] > 0, after = events.contact_force[k] > 0;
+    if (before == after) continue;  // closings too: the margin of one step costs little
+    pieces.clear();
+    fold_interval(g.length - g.c * events.t[k] - margin, g.length - g.c * events.t[k - 1] + margin,
+                  g.length, pieces);
+    for (const auto& piece : pieces)
+      columns_meeting(piece, [&](int col) { dense[static_cast<std::size_t>(col)] = 1; });
+  }
+  for (int k = 0; k < g.nodal; ++k)
+    if (dense[static_cast<std::size_t>(k)]) pattern.dense_columns.push_back(k);
+  for (int i = 1; i <= g.m; ++i) {
+    // The test function of row i: the hat of node i (regular), the point x_i (paper).
+    const double xi = g.length * i / g.m;
+    const double a = (g.paper ? xi : xi - g.test_element) - margin;
+    const double b = (g.paper ? xi : std::min(xi + g.test_element, g.length)) + margin;
+    pieces.clear();
+    fold_interval(a + g.reach, b + g.reach, g.length, pieces);
+    fold_interval(a - g.reach, b - g.reach, g.length, pieces);
+    if (g.paper) fold_interval(a, b, g.length, pieces);  // the u0(x_i) term
+    std::vector<int>& columns = pattern.row_columns[static_cast<std::size_t>(i - 1)];
+    for (const auto& piece : pieces) columns_meeting(piece, [&](int k) { columns.push_back(k); });
+    std::sort(columns.begin(), columns.end());
+    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+  }
+  return pattern;
+}
+
+// Nodes 0..N of the representation grid from the mapped interior positions y; false when the
+// knots are out of order (the residual fails there anyway).
+bool grid_nodes(const Vector& y, int n, double length, std::vector<double>& node) {
+  node.assign(static_cast<std::size_t>(n) + 1, 0.0);
+  for (int i = 1; i < n; ++i) node[static_cast<std::size_t>(i)] = y[i - 1];
+  node[static_cast<std::size_t>(n)] = length;
+  for (int i = 1; i <= n; ++i)
+    if (!(node[static_cast<std::size_t>(i)] > node[static_cast<std::size_t>(i - 1)])) return false;
+  return true;
+}
 }  // namespace
 
 std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
@@ -294,23 +367,20 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   if (path_rows_enabled_ && options_.path_rows() > 0) return std::nullopt;
   const double period = x[period_index()];
   if (!std::isfinite(period) || !(period > 0)) return std::nullopt;
-  const int n = options_.elements, nodal = options_.nodal_unknowns();
-  const int m = options_.test_elements > 0 ? options_.test_elements : state_size();
-  const double length = setup_.material.length, c = setup_.material.wave_speed();
-  // Node positions 0..N of the representation grid (mapped by the free knots).
-  const Vector y = node_positions(x);
-  std::vector<double> node(static_cast<std::size_t>(n) + 1);
-  node[0] = 0;
-  for (int i = 1; i < n; ++i) node[static_cast<std::size_t>(i)] = y[i - 1];
-  node[static_cast<std::size_t>(n)] = length;
-  for (int i = 1; i <= n; ++i)  // knots out of order: the residual fails anyway
-    if (!(node[static_cast<std::size_t>(i)] > node[static_cast<std::size_t>(i - 1)]))
-      return std::nullopt;
-  const double test_element = length / m;
-  const bool paper = formulation() == core::ShootingFormulation::displacement_periodicity;
-  const double reach = c * (paper ? period : 0.5 * period);
-  bar::History history;
-  if (paper) {
+  auto g = std::make_shared<PatternGeometry>();
+  g->n = options_.elements;
+  g->nodal = options_.nodal_unknowns();
+  g->m = options_.test_elements > 0 ? options_.test_elements : state_size();
+  g->equations = num_equations();
+  for (int j = 0; j < options_.free_knots; ++j) g->knot_and_period_columns.push_back(knot_index(j));
+  g->knot_and_period_columns.push_back(period_index());
+  g->length = setup_.material.length;
+  g->c = setup_.material.wave_speed();
+  if (!grid_nodes(node_positions(x), g->n, g->length, g->node)) return std::nullopt;
+  g->test_element = g->length / g->m;
+  g->paper = formulation() == core::ShootingFormulation::displacement_periodicity;
+  g->reach = g->c * (g->paper ? period : 0.5 * period);
+  if (g->paper) {
     // u(x, T) also holds the displacement the free end keeps from each contact release: after
     // a release at t_r the end moves from the wall g0 by the incoming wave since t_r, so every
     // row reached from the end after t_r depends on u0 near fold(L - c t_r), the point that
@@ -323,60 +393,11 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
     run.energy = false;
     run.history_samples = static_cast<int>(std::min(1e7, std::ceil(period / run.dt) + 2));
     try {
-      history = solver_.simulate(setup_at(x), run);
+      g->events = solver_.simulate(setup_at(x), run);
     } catch (const InputError&) {
       return std::nullopt;
     }
   }
-  // By value: the wider pattern is built after this returns, when a check asks for it.
-  const auto nodes = std::make_shared<const std::vector<double>>(std::move(node));
-  const auto contact = std::make_shared<const bar::History>(std::move(history));
-  auto with_margin = [=, this](double margin) {
-    const std::vector<double>& knot = *nodes;
-    const bar::History& events = *contact;
-    std::vector<std::pair<double, double>> pieces;
-    // Unknowns k whose support [node[k], node[k + 2]] meets a folded piece.
-    auto columns_meeting = [&](const std::pair<double, double>& piece, auto&& add) {
-      const auto [lo, hi] = piece;
-      const int first = static_cast<int>(std::lower_bound(knot.begin(), knot.end(), lo) -
-                                         knot.begin());  // knot[first] >= lo
-      for (int k = std::max(0, first - 2); k < nodal; ++k) {
-        if (knot[static_cast<std::size_t>(k)] > hi) break;
-        if (knot[static_cast<std::size_t>(std::min(k + 2, n))] >= lo) add(k);
-      }
-    };
-    core::JacobianPattern pattern;
-    pattern.row_columns.resize(static_cast<std::size_t>(num_equations()));
-    for (int j = 0; j < options_.free_knots; ++j) pattern.dense_columns.push_back(knot_index(j));
-    pattern.dense_columns.push_back(period_index());
-    std::vector<char> dense(static_cast<std::size_t>(nodal), 0);
-    for (std::size_t k = 1; k < events.t.size(); ++k) {
-      const bool before = events.contact_force[k - 1] > 0, after = events.contact_force[k] > 0;
-      if (before == after) continue;  // closings too: the margin of one step costs little
-      pieces.clear();
-      fold_interval(length - c * events.t[k] - margin, length - c * events.t[k - 1] + margin,
-                    length, pieces);
-      for (const auto& piece : pieces)
-        columns_meeting(piece, [&](int col) { dense[static_cast<std::size_t>(col)] = 1; });
-    }
-    for (int k = 0; k < nodal; ++k)
-      if (dense[static_cast<std::size_t>(k)]) pattern.dense_columns.push_back(k);
-    for (int i = 1; i <= m; ++i) {
-      // The test function of row i: the hat of node i (regular), the point x_i (paper).
-      const double xi = length * i / m;
-      const double a = (paper ? xi : xi - test_element) - margin;
-      const double b = (paper ? xi : std::min(xi + test_element, length)) + margin;
-      pieces.clear();
-      fold_interval(a + reach, b + reach, length, pieces);
-      fold_interval(a - reach, b - reach, length, pieces);
-      if (paper) fold_interval(a, b, length, pieces);  // the u0(x_i) term
-      std::vector<int>& columns = pattern.row_columns[static_cast<std::size_t>(i - 1)];
-      for (const auto& piece : pieces) columns_meeting(piece, [&](int k) { columns.push_back(k); });
-      std::sort(columns.begin(), columns.end());
-      columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
-    }
-    return pattern;
-  };
   // Margin. The bare supports (plus one test element against the rounding of the folded
   // images at element boundaries) hold every entry where u0 is linear between its kinks, as
   // on the closed-form orbits of the branch: the TD-BEM's interpolation over a step is exact
@@ -385,32 +406,28 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   // histories between its knots, reads u0 over one step c dt on either side of each image (at
   // 40 steps per period, 13 elements at N = 160), with entries as large as the largest
   // (tests/problems/contact_bar/test_jacobian_pattern.cpp). So the bare supports come first,
-  // checked to 1e-4 of each row's size instead of the default 1e-3, and the c dt margin is
-  // their `wider` pattern. Measured on the mode-1 trace at N = 100 (README.md, section
-  // 'Cost'): the bare supports' check errors reach 2.5e-5 of the row (the c dt pattern's own
-  // 1.1e-5: finite-difference error and kinks), 18 of 369 Jacobians were widened, 3x fewer
-  // residuals than the c dt pattern alone; the c dt pattern is built only for those (building
-  // both every time was 5 % of the N = 160 trace). The exact solver follows the characteristics
+  // checked to 1e-4 of each row's size instead of the default 1e-3 (above what the check's
+  // finite differences and kinks leave on a complete pattern, README.md, section 'Cost'), and
+  // the c dt margin is their `wider` pattern, built only for the Jacobians whose check fails:
+  // the bare supports take fewer residuals. The exact solver follows the characteristics
   // exactly: the bare supports are its structural pattern.
   // Without free knots, the exact solver's bare supports and the TD-BEM's c dt margin hold
   // every entry, so a check that fails on them is a kink of F (a contact event moved by the
-  // check's step): structural, kept by a corrector (core/problem.hpp). At the grazing start
-  // of mode 1 at N = 320 (a family of 23 verified dimensions) most of the probes' Jacobians
-  // fell back column by column; kept, the same probes reached the same verdicts with the same
-  // number of Jacobians on 47,305 residuals instead of 128,450 (11,247 instead of 26,703 once
-  // the probes had their region, core/rank_report.cpp). With free knots (the subharmonic members)
-  // they are not: kept, the probes of SubharmonicRepresentation.VerifiedDimensionIsTwo
-  // stalled at |F| ~ 1e-8 where the column-by-column Jacobians converge.
+  // check's step): structural, kept by a corrector (core/problem.hpp), which spares the rank
+  // report's probes a column-by-column Jacobian each. With free knots (the subharmonic
+  // members) they are not: a kept pattern there stalls the probes of
+  // SubharmonicRepresentation.VerifiedDimensionIsTwo where column-by-column Jacobians converge.
   const bool structural = options_.free_knots == 0;
-  core::JacobianPattern pattern = with_margin(test_element);
+  core::JacobianPattern pattern = pattern_with_margin(*g, g->test_element);
   if (!tdbem) {
     pattern.structural = structural;
     return pattern;
   }
   pattern.check_tolerance = 1e-4;
-  const double wide = test_element + c * time_step(period);
-  pattern.wider = [with_margin, wide, structural] {
-    core::JacobianPattern margin = with_margin(wide);
+  const double wide = g->test_element + g->c * time_step(period);
+  std::shared_ptr<const PatternGeometry> shared = std::move(g);
+  pattern.wider = [shared, wide, structural] {
+    core::JacobianPattern margin = pattern_with_margin(*shared, wide);
     margin.structural = structural;
     return margin;
   };

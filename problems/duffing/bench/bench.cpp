@@ -196,26 +196,32 @@ std::vector<AutoRun> stored_auto07p_runs() {
   return runs;
 }
 
-int bench_duffing_auto(const std::filesystem::path& out) {
-  fmt::print(
-      "bench duffing_auto: Duffing backbone x'' + x + x^3 = 0, amplitude 0.01 -> 5, backbone "
-      "(shooting) vs AUTO-07p (collocation), errors vs the exact period\n");
-  constexpr int repetitions = 3;  // medians of 3, as the stored peer runs
-  const BackboneSettings headline;
+namespace {
+
+constexpr int repetitions = 3;  // medians of 3, as the stored peer runs
+
+// The AUTO-07p runs of the case, and where they come from.
+struct AutoRuns {
+  std::vector<AutoRun> runs;
+  bool live = false;   // run in this bench (false: the stored runs)
+  std::string source;  // for the section: "run live in this bench" or why the stored runs
+};
+
+// AUTO-07p at NTST 20 and 50, live when installed, the stored runs otherwise or when a live run
+// fails. AUTO and backbone alternate, so that both see the same load on a shared machine.
+AutoRuns auto07p_runs(const BackboneSettings& headline) {
+  AutoRuns a;
   std::string why;
   const bool installed = auto07p_available(why);
-  std::string auto_source = "run live in this bench";
+  a.source = "run live in this bench";
   if (!installed) {
     fmt::print("  AUTO-07p {}: using the stored runs\n", why);
-    auto_source =
+    a.source =
         fmt::format("{}: the stored runs of problems/duffing/bench/peers/auto07p_runs.csv", why);
   }
   const std::filesystem::path scratch =
       std::filesystem::temp_directory_path() / fmt::format("backbone_auto07p_{}", ::getpid());
-
-  // AUTO and backbone alternate, so that both see the same load on a shared machine.
-  std::vector<AutoRun> autos;
-  bool live = installed;
+  a.live = installed;
   if (installed) {
     for (int ntst : {20, 50}) {
       std::vector<double> seconds;
@@ -227,18 +233,22 @@ int bench_duffing_auto(const std::filesystem::path& out) {
       }
       if (!run) {
         fmt::print("  {}: using the stored runs\n", why);
-        auto_source = fmt::format("{}: the stored runs", why);
-        autos.clear();
-        live = false;
+        a.source = fmt::format("{}: the stored runs", why);
+        a.runs.clear();
+        a.live = false;
         break;
       }
       run->seconds = median(seconds);
-      autos.push_back(*run);
+      a.runs.push_back(*run);
     }
     std::filesystem::remove_all(scratch);
   }
-  if (autos.empty()) autos = stored_auto07p_runs();
+  if (a.runs.empty()) a.runs = stored_auto07p_runs();
+  return a;
+}
 
+// backbone's settings: CVODE tolerances 1e-8 to 1e-13 at step caps 0.25 and 1.
+std::vector<BackboneSettings> backbone_sweep(const BackboneSettings& headline) {
   std::vector<BackboneSettings> sweep;
   for (double ds_max : {0.25, 1.0})
     for (double rtol : {1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13}) {
@@ -250,8 +260,15 @@ int bench_duffing_auto(const std::filesystem::path& out) {
       s.newton_tolerance = std::max(headline.newton_tolerance, rtol);
       sweep.push_back(s);
     }
+  return sweep;
+}
+
+// Each setting traced `repetitions` times: seconds are the median wall time beside live AUTO
+// runs and the median CPU time beside stored ones (an idle core: a loaded machine inflates wall
+// time). status 1 when a trace stops early.
+std::vector<BackboneRun> run_sweep(const std::vector<BackboneSettings>& sweep, bool live,
+                                   int& status) {
   std::vector<BackboneRun> runs;
-  int status = 0;
   for (const BackboneSettings& s : sweep) {
     std::vector<double> seconds, cpu;
     BackboneRun run;
@@ -260,7 +277,6 @@ int bench_duffing_auto(const std::filesystem::path& out) {
       seconds.push_back(run.seconds);
       cpu.push_back(run.cpu_seconds);
     }
-    // Against stored runs (an idle core) the CPU time: a loaded machine inflates wall time.
     run.seconds = median(live ? seconds : cpu);
     run.cpu_seconds = median(cpu);
     if (!run.complete) {
@@ -270,7 +286,10 @@ int bench_duffing_auto(const std::filesystem::path& out) {
     }
     runs.push_back(run);
   }
+  return runs;
+}
 
+core::Table duffing_table(const std::vector<AutoRun>& autos, const std::vector<BackboneRun>& runs) {
   core::Table table({"tool", "setting", "ntst", "rtol", "ds_max", "points", "seconds",
                      "ms_per_point", "max_error", "live", "residuals", "jacobians", "cpu_seconds"});
   const double nan = std::nan("");
@@ -285,32 +304,32 @@ int bench_duffing_auto(const std::filesystem::path& out) {
          nan, b.settings.relative_tolerance, b.settings.ds_max, double(b.points), b.seconds,
          1e3 * b.seconds / b.points, b.max_error, 1.0, double(b.residuals), double(b.jacobians),
          b.cpu_seconds});
-  const std::filesystem::path csv = out / "duffing_auto.csv";
-  table.write_csv(csv);
-  fmt::print("{}", table.aligned(3));
+  return table;
+}
 
-  // The headline: backbone's default settings against AUTO at NTST 50.
+// The headline: backbone's default settings against AUTO at NTST 50.
+std::string headline_verdict(const BackboneSettings& headline, const std::vector<AutoRun>& autos,
+                             const std::vector<BackboneRun>& runs) {
   const auto auto50 =
       std::find_if(autos.begin(), autos.end(), [](const AutoRun& a) { return a.ntst == 50; });
   const auto best = std::find_if(runs.begin(), runs.end(), [&](const BackboneRun& b) {
     return b.settings.relative_tolerance == headline.relative_tolerance &&
            b.settings.ds_max == headline.ds_max;
   });
-  std::string verdict = "no AUTO-07p run at NTST 50 to compare with";
-  if (auto50 != autos.end() && best != runs.end()) {
-    const double ratio = best->seconds / auto50->seconds;
-    verdict = fmt::format(
-        "backbone (rtol {:g}, ds_max {:g}) traces the backbone in {:.3g} s with error {:.2g}; "
-        "AUTO-07p (NTST 50) takes {:.3g} s with error {:.2g}{}: time backbone / AUTO = {:.2f} "
-        "at {} error.",
-        headline.relative_tolerance, headline.ds_max, best->seconds, best->max_error,
-        auto50->seconds, auto50->max_error, auto50->live ? " in the same run" : " (stored run)",
-        ratio, best->max_error <= auto50->max_error ? "a smaller" : "a larger");
-  }
-  fmt::print("  {}\n", verdict);
+  if (auto50 == autos.end() || best == runs.end())
+    return "no AUTO-07p run at NTST 50 to compare with";
+  const double ratio = best->seconds / auto50->seconds;
+  return fmt::format(
+      "backbone (rtol {:g}, ds_max {:g}) traces the backbone in {:.3g} s with error {:.2g}; "
+      "AUTO-07p (NTST 50) takes {:.3g} s with error {:.2g}{}: time backbone / AUTO = {:.2f} "
+      "at {} error.",
+      headline.relative_tolerance, headline.ds_max, best->seconds, best->max_error, auto50->seconds,
+      auto50->max_error, auto50->live ? " in the same run" : " (stored run)", ratio,
+      best->max_error <= auto50->max_error ? "a smaller" : "a larger");
+}
 
+void plot_duffing(const std::filesystem::path& csv, const std::filesystem::path& png) {
   const std::string q = core::gnuplot_quote(csv);
-  const std::filesystem::path png = out / "duffing_auto.png";
   const core::PlotResult plot = core::render_png(
       png,
       fmt::format(
@@ -332,34 +351,57 @@ int bench_duffing_auto(const std::filesystem::path& out) {
     fmt::print("  wrote {}\n", png.string());
   else
     fmt::print("  figure skipped: {}\n", plot.message);
+}
 
+std::string duffing_section(const core::Table& table, const AutoRuns& autos,
+                            const std::vector<BackboneRun>& runs, const std::string& verdict) {
   std::string rows;
+  const std::vector<AutoRun>& a = autos.runs;
   for (std::size_t i = 0; i < table.rows(); ++i) {
-    const bool is_auto = i < autos.size();
-    const double seconds = is_auto ? autos[i].seconds : runs[i - autos.size()].seconds;
-    const double error = is_auto ? autos[i].max_error : runs[i - autos.size()].max_error;
-    const int points = is_auto ? autos[i].points : runs[i - autos.size()].points;
+    const bool is_auto = i < a.size();
+    const double seconds = is_auto ? a[i].seconds : runs[i - a.size()].seconds;
+    const double error = is_auto ? a[i].max_error : runs[i - a.size()].max_error;
+    const int points = is_auto ? a[i].points : runs[i - a.size()].points;
     rows += fmt::format("| {} | {} | {} | {:.3g} | {:.3g} | {:.2g} |\n",
                         is_auto ? "AUTO-07p" : "backbone", table.text_column("setting")[i], points,
                         seconds, 1e3 * seconds / points, error);
   }
-  cli::write_bench_section(
-      out, "duffing_auto",
-      fmt::format(
-          "## Duffing backbone: backbone vs AUTO-07p (`duffing_auto`)\n\n"
-          "x'' + x + x^3 = 0 from amplitude 0.01 to 5. AUTO-07p 0.9.2 (orthogonal collocation, "
-          "NCOL 4, DSMAX 0.1; input files in problems/duffing/bench/peers/) {}. backbone: shooting on "
-          "the regular residual v(T/2) / v_max (CVODE Adams, Jacobian from the variational "
-          "equations), pseudo-arclength from ds 0.5, eigen Newton to max(1e-11, rtol), no rank "
-          "reports. Error: the largest |T - T_exact(A)| / T_exact(A) over the points, T_exact "
-          "the elliptic integral (problems/duffing/README.md); AUTO's amplitude is taken from its "
-          "energy, printed to 11 digits. Seconds: median of {}, wall clock of one thread (AUTO: "
-          "its own Total Time of the periodic-orbit run; against stored runs, backbone's CPU "
-          "time).\n\n"
-          "| tool | setting | points | seconds | ms/point | max error |\n"
-          "|---|---|---|---|---|---|\n{}\n"
-          "**Where backbone stands:** {}\n\n![Duffing work-precision](duffing_auto.png)\n",
-          auto_source, repetitions, rows, verdict));
+  return fmt::format(
+      "## Duffing backbone: backbone vs AUTO-07p (`duffing_auto`)\n\n"
+      "x'' + x + x^3 = 0 from amplitude 0.01 to 5. AUTO-07p 0.9.2 (orthogonal collocation, "
+      "NCOL 4, DSMAX 0.1; input files in problems/duffing/bench/peers/) {}. backbone: shooting on "
+      "the regular residual v(T/2) / v_max (CVODE Adams, Jacobian from the variational "
+      "equations), pseudo-arclength from ds 0.5, eigen Newton to max(1e-11, rtol), no rank "
+      "reports. Error: the largest |T - T_exact(A)| / T_exact(A) over the points, T_exact "
+      "the elliptic integral (problems/duffing/README.md); AUTO's amplitude is taken from its "
+      "energy, printed to 11 digits. Seconds: median of {}, wall clock of one thread (AUTO: "
+      "its own Total Time of the periodic-orbit run; against stored runs, backbone's CPU "
+      "time).\n\n"
+      "| tool | setting | points | seconds | ms/point | max error |\n"
+      "|---|---|---|---|---|---|\n{}\n"
+      "**Where backbone stands:** {}\n\n![Duffing work-precision](duffing_auto.png)\n",
+      autos.source, repetitions, rows, verdict);
+}
+
+}  // namespace
+
+int bench_duffing_auto(const std::filesystem::path& out) {
+  fmt::print(
+      "bench duffing_auto: Duffing backbone x'' + x + x^3 = 0, amplitude 0.01 -> 5, backbone "
+      "(shooting) vs AUTO-07p (collocation), errors vs the exact period\n");
+  const BackboneSettings headline;
+  const AutoRuns autos = auto07p_runs(headline);
+  int status = 0;
+  const std::vector<BackboneRun> runs = run_sweep(backbone_sweep(headline), autos.live, status);
+
+  const core::Table table = duffing_table(autos.runs, runs);
+  const std::filesystem::path csv = out / "duffing_auto.csv";
+  table.write_csv(csv);
+  fmt::print("{}", table.aligned(3));
+  const std::string verdict = headline_verdict(headline, autos.runs, runs);
+  fmt::print("  {}\n", verdict);
+  plot_duffing(csv, out / "duffing_auto.png");
+  cli::write_bench_section(out, "duffing_auto", duffing_section(table, autos, runs, verdict));
   return status;
 }
 
