@@ -67,10 +67,9 @@ po::options_description trace_keys() {
   po::options_description shooting("contact bar shooting");
   shooting.add_options()  //
       ("shooting_elements", po::value<long>()->default_value(20),
-       "intervals of the u0 grid (0: the scene's elements). 20 holds modes 1 and 2 exactly "
-       "(mode 2 with its free knot); at 100 mode 1 meets a continuum of other periodic orbits "
-       "at end amplitude 2 g0 and steps over it (max_turn_degrees; detect_branch_points "
-       "locates it), at ~100x the cost per point")  //
+       "intervals of the u0 grid (>= 1; 0: the scene's elements). 20 holds modes 1 and 2 "
+       "exactly (mode 2 with its free knot); finer grids resolve the families attached to "
+       "mode 1 (detect_branch_points) and cost more per point (bench case mode1_scaling)")  //
       ("test_elements", po::value<long>()->default_value(-1),
        "elements of the grid the residual is sampled on (its equations): 0 = as many as "
        "unknowns (square), -1 = auto (2x the unknowns: overdetermined, consistent, no "
@@ -93,10 +92,9 @@ po::options_description trace_keys() {
       ("rank_check_every", po::value<long>()->default_value(1),
        "verified rank report every k points (0: never)")  //
       ("rank_threshold", po::value<double>()->default_value(1e-5),
-       "rank report: singular values below this times the largest are candidate null "
-       "directions. Measured along the paper scene's branches (branch.csv sigma_zero, "
-       "sigma_kept): the forward-difference Jacobian's null value reaches 2.8e-6 (kinks of "
-       "the contact map), the smallest kept one is 5.6e-5; verify decides")  //
+       "rank report: singular values below this times the largest, in (0, 1), are candidate "
+       "null directions; it lies between the null and the smallest kept values of branch.csv "
+       "(sigma_zero, sigma_kept); the probes verify each candidate")  //
       ("ds", po::value<double>()->default_value(0.45),
        "first step, dimensionless: the L2 norm of the change of u0 / gap over the bar "
        "(independent of the grid), knot / L and T c / L; mode1 and mode2 in amplitude units "
@@ -104,11 +102,9 @@ po::options_description trace_keys() {
       ("ds_max", po::value<double>()->default_value(0.45),
        "largest step (dimensionless; mode1, mode2 in amplitude units: 0.1)")  //
       ("newton_tolerance", po::value<double>()->default_value(3e-9),
-       "||F||_inf to converge; F is in units of the gap, so this is relative to g0. The "
-       "residual's round-off grows with the amplitude: measured at shooting_elements 100 on "
-       "mode 1, 2e-10 at E = 3e-3 and up to 9.7e-10 at E = 1e-2 (1e-10 stalls there). mode1 "
-       "and mode2 in amplitude units (F relative to the amplitude above the gap) default to "
-       "1e-10")  //
+       "||F||_inf to converge (> 0); F is in units of the gap, so this is relative to g0 and "
+       "stays above the residual's round-off, which grows with the amplitude. mode1 and mode2 "
+       "in amplitude units (F relative to the amplitude above the gap) default to 1e-10")  //
       ("amplitude_units", po::value<bool>()->default_value(true),
        "mode1, mode2: above the gap, steps and rank reports in units of the orbit's amplitude "
        "(the L2 norm of u0) instead of the gap, so that ds is relative and a branch covers "
