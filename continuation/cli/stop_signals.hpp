@@ -6,8 +6,8 @@
 //   ... run ...
 //   if (stop.requested()) return 128 + stop.signal();  // handlers restored by the destructor
 //
-// A point can take minutes (a many-dimensional start on a fine grid, problems/contact_bar/
-// README.md 'Where it stands'), and a run writes each point as soon as it is accepted, so a
+// A point can take minutes (a many-dimensional start on a fine grid, problems/contact_bar/bench/
+// README.md 'Cost'), and a run writes each point as soon as it is accepted, so a
 // second signal loses only the point under way: `trace --resume` continues from the last one
 // written. The first signal prints one line saying so (write(2), safe in a handler).
 #pragma once

@@ -11,7 +11,7 @@
 // number of signal segments (never a number of time steps). This is the reference of every
 // test and the accuracy limit of every benchmark.
 //
-//   bar::BarSetup s;                                        // contact_bar/README.md 'Mode 1'
+//   bar::BarSetup s;                                        // problems/contact_bar/orbits/README.md 'Mode 1'
 //   s.right = {bar::EndType::contact, 1e-3};
 //   s.u0 = bar::PiecewiseLinear({0.0, 1.0}, {0.0, -0.01});
 //   exact_bar::ExactBarSolution sol = exact_bar::solve(s, 3.1);

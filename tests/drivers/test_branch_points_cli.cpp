@@ -4,7 +4,7 @@
 //
 // At shooting_elements 40 and E <= 3e-5 the run is short and finds two candidates: a dip near
 // T = 3.33 that its probes do not verify, and T = 3.2 with an attached family of dimension 6 or
-// 7 (it depends on N and on round-off, problems/contact_bar/README.md, 'Dimension changes').
+// 7 (it depends on N and on round-off, problems/contact_bar/orbits/README.md, 'Dimension changes').
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -49,7 +49,7 @@ TEST(BranchPointsCli, BadFollowExitsTwoAndWritesNothing) {
 }
 
 // The exact branch point: mode 1 of the paper scene (E = rho = L = A = 1, g0 = 1e-3) has
-// u0 = eps x and T = 3 + g0 / |eps| (problems/contact_bar/README.md, 'Mode 1'); at T = 3.2,
+// u0 = eps x and T = 3 + g0 / |eps| (problems/contact_bar/orbits/README.md, 'Mode 1'); at T = 3.2,
 // |eps| = 5e-3, E = eps^2 / 2 = 1.25e-5 and end amplitude 5e-3. Location: 1e-6 relative, the
 // acceptance for a point found at two resolutions.
 TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
@@ -78,7 +78,7 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   EXPECT_GT(at("frequency_ratio"), 2);
   // The attached family leaves transversally to mode 1. The angle is the smallest over the
   // probes of a 7-8 dimensional null space that re-correct, and which do, and where, follows the
-  // round-off of the march (problems/contact_bar/README.md, 'Hard cases'), so the angle moves by
+  // round-off of the march (problems/contact_bar/solver/README.md, 'Hard cases'), so the angle moves by
   // degrees under equivalent formulas. Bound 60 (mode 1 itself would give 0).
   EXPECT_GT(at("tangent_angle"), 60);
   fs::remove_all(out);

@@ -1,6 +1,6 @@
 // `backbone trace` end to end on the contact bar: bad input names its key (exit 2, nothing
 // written); another scene than the paper's (other L, E, rho, g0 on the command line, nothing
-// else changed) traces mode 1 onto the closed form of problems/contact_bar/README.md, 'Mode 1',
+// else changed) traces mode 1 onto the closed form of problems/contact_bar/orbits/README.md, 'Mode 1',
 // because the continuation works in units of the scene (u0 / g0, T c / L) and checks each point.
 #include <gtest/gtest.h>
 
@@ -140,7 +140,7 @@ std::string file_text(const fs::path& path) {
 }
 
 // mode 1 on a coarse grid up to 2e-3 J: 88 cheap points (steps of 5 % of the amplitude above
-// the gap: amplitude_units, problems/contact_bar/README.md 'Cost').
+// the gap: amplitude_units, problems/contact_bar/orbits/README.md 'Amplitude units').
 const std::string small_mode1 =
     paper + " --branch mode1 --shooting_elements 10 --energy_max 2e-3 --ds 0.05 --ds_max 0.05";
 
@@ -237,7 +237,7 @@ TEST(TraceCli, FinishedBranchFarAboveTheGapExtends) {
 
 // A resumed run reads the resolved scene.ini, where keys left at their defaults are comments: in
 // the amplitude units (mode 1's default) newton_tolerance is then still "not given" and the
-// branch keeps its own 1e-10 (problems/contact_bar/README.md, 'Cost'), so the resumed branch
+// branch keeps its own 1e-10 (problems/contact_bar/orbits/README.md, 'Amplitude units'), so the resumed branch
 // is the uninterrupted one's point for point.
 TEST(TraceCli, ResumeInTheAmplitudeUnitsKeepsTheBranchsOwnSettings) {
   const fs::path full = cli::scratch("trace_cli", "full_amp"),

@@ -10,7 +10,7 @@
 //   detect_one_thread  the same on the loop's thread (--locate_in_background false).
 // Accuracy: every point's closed-form frequency error (mode 1 stays mode 1), and each verified
 // candidate's period against the value it approaches, the nearest of 3.6, 3.5, 3.25 and 3.2 L/c
-// (problems/contact_bar/README.md, 'Dimension changes': the attached families sit at these
+// (problems/contact_bar/orbits/README.md, 'Dimension changes': the attached families sit at these
 // periods; the CLI test asserts T = 3.2 from the closed form).
 #include <fmt/format.h>
 #include <fmt/ranges.h>

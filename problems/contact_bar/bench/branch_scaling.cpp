@@ -291,7 +291,7 @@ void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
   // The same grids at steps_per_period = 2 N (Courant number c dt / dx = T / 2L, about 1.75):
   // a row of the shooting residual then depends on u0 over a few elements about each
   // characteristic image, so the compressed Jacobian needs a number of colours independent of
-  // N, where the trace's 40 steps need about N / 2 (problems/contact_bar/README.md, 'Cost').
+  // N, where the trace's 40 steps need about N / 2 (problems/contact_bar/bench/README.md, 'Cost').
   for (int n : grids) {
     if (2 * n <= 40) continue;  // that grid row is this setting already
     Mode1BranchSettings s;
@@ -302,7 +302,7 @@ void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
   }
   // Without rank reports (--rank_check_every 0), up to N = 640: what the corrections cost
   // alone, without the verification of the many-dimensional start at T = 3.8, which dominates
-  // the checked trace at large N (problems/contact_bar/README.md, 'Cost').
+  // the checked trace at large N (problems/contact_bar/bench/README.md, 'Cost').
   for (int n : {40, 80, 160, 320, 640}) {
     Mode1BranchSettings s;
     s.study = "grid_unchecked";
@@ -497,7 +497,7 @@ std::string variant_verdict(const ScalingRuns& r) {
           ? fmt::format("reaches the bound at {:.2g}x the CPU with a worst error of {}",
                         r.paper.cpu_seconds / base.cpu_seconds, error_text(r.paper.worst_error))
           : fmt::format("stops at E = {:.3g} after {} point(s) ({}: its Jacobian is degenerate "
-                        "on the family, problems/contact_bar/README.md, section 'Shooting on the "
+                        "on the family, problems/contact_bar/orbits/README.md, section 'Shooting on the "
                         "bar'), so it has no branch cost to compare",
                         r.paper.energy_reached, r.paper.points, r.paper.stop_reason),
       r.eigen_square.cpu_seconds / base.cpu_seconds, r.kinsol_square.cpu_seconds / base.cpu_seconds,

@@ -57,7 +57,7 @@ InProcessTrace trace_in_process(const cli::ProblemPlugin& plugin, const core::Sc
                                 const std::string& branch);
 
 // |omega / omega_exact(E) - 1| at each point of a mode-1 branch of the scene, against the
-// closed form (problems/contact_bar/README.md, 'Mode 1').
+// closed form (problems/contact_bar/orbits/README.md, 'Mode 1').
 std::vector<double> mode1_frequency_errors(const core::Scene& scene,
                                            const continuation::Branch& branch);
 

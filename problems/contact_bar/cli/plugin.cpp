@@ -38,7 +38,7 @@ void register_plugin(cli::PluginRegistry& registry) {
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic", "--out", "{out}/subharmonic"}},
       // The continuum at two energies, from the grazing limit shape 1 to shape_end (about one
-      // second each; README.md, section 'Subharmonic continuum').
+      // second each; problems/contact_bar/orbits/README.md, section 'Subharmonic continuum').
       {"subharmonic_continuum",
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1.25e-5", "--out",

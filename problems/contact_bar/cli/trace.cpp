@@ -1,7 +1,7 @@
 // The contact bar's trace branches (trace.hpp): mode1 and mode2
 // (the nonlinear modes born from the linear modes omega_k = (2k-1) pi c / (2L) at grazing),
 // subharmonic and subharmonic_continuum (mode 2 over two periods: a 2D manifold of orbits,
-// README.md section 'Subharmonic continuum'),
+// problems/contact_bar/orbits/README.md section 'Subharmonic continuum'),
 // and `simulate` (simulate.hpp).
 //
 // The scene gives the bar (scene.hpp: length, youngs_modulus, density, area, gap, contact,
@@ -10,7 +10,7 @@
 // linear mode: at grazing every initial condition is 4L/c-periodic and a nodal Newton from the
 // sine lands on such a non-contact orbit, of period 4L/c. Mode 2 moves one knot
 // with the physics (free_knots = 1, the crest of the tent) because its kink travels with T and
-// a uniform grid holds it only to O(dx) (README.md, section "Shooting on the bar").
+// a uniform grid holds it only to O(dx) (problems/contact_bar/orbits/README.md, section "Shooting on the bar").
 //
 //   backbone trace problems/contact_bar/scenes/paper.ini --branch mode1 --out out/m1
 //   backbone trace problems/contact_bar/scenes/paper.ini --branch mode2 --free_knots 0
@@ -108,7 +108,7 @@ po::options_description trace_keys() {
       ("amplitude_units", po::value<bool>()->default_value(true),
        "mode1, mode2: above the gap, steps and rank reports in units of the orbit's amplitude "
        "(the L2 norm of u0) instead of the gap, so that ds is relative and a branch covers "
-       "decades of energy (README.md, section 'Cost'); false: the gap throughout")  //
+       "decades of energy (problems/contact_bar/orbits/README.md, section 'Amplitude units'); false: the gap throughout")  //
       ("max_residual_work", po::value<double>()->default_value(1e7),
        "refuse a trace whose residual costs more than this many element-steps "
        "(shooting_elements x steps_per_period; a point evaluates the residual about 2 x "
@@ -127,7 +127,7 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
 
 // The run's size against max_residual_work, before anything runs (simulate's max_steps habit):
 // one residual marches about elements x steps_per_period element-steps
-// (problems/contact_bar/README.md, section 'Cost').
+// (problems/contact_bar/orbits/README.md, section 'Amplitude units').
 void check_residual_work(const core::Scene& scene, const OrbitOptions& options) {
   const double limit = scene.positive("max_residual_work");
   const double work = static_cast<double>(options.elements) * options.steps_per_period;
@@ -179,7 +179,7 @@ std::function<std::string(const core::Vector&)> return_check(const core::Scene& 
 }
 
 // mode1 and mode2 in units of the amplitude: a step ds is a relative change of the orbit and
-// F's round-off is relative too (README.md, section 'Cost'), so the defaults become 10 % steps,
+// F's round-off is relative too (problems/contact_bar/orbits/README.md, section 'Amplitude units'), so the defaults become 10 % steps,
 // which give a branch enough points for the figures, and a tolerance of 1e-10 of the amplitude,
 // above that round-off. Keys the scene gives are kept.
 std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)>
@@ -270,7 +270,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   return s;
 }
 
-// The continuum's own continuation settings (README.md, section 'Subharmonic continuum'):
+// The continuum's own continuation settings (problems/contact_bar/orbits/README.md, section 'Subharmonic continuum'):
 //  - the first step along the closed-form direction (start_along_direction);
 //  - ds = ds_max = 1/40 of the closed-form path length in the scaled step norm, so every
 //    energy has about 40 members (the path grows like sqrt(E) / g0 in that norm), unless the
@@ -411,7 +411,7 @@ std::function<void(const std::filesystem::path&, const continuation::Branch&)> s
   };
 }
 
-// The subharmonic branches (README.md, section 'Subharmonic continuum'): mode 2 taken over two
+// The subharmonic branches (problems/contact_bar/orbits/README.md, section 'Subharmonic continuum'): mode 2 taken over two
 // periods, T = 2 T2, started at rest at the centre of a contact phase (start_on_wall), two free
 // knots at its two kinks. The periodic orbits form a 2D manifold (energy x shape); a path on it
 // is picked by one path row: the shape (subharmonic: the backbone at constant shape) or the

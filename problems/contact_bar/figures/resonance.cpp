@@ -51,7 +51,7 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
   std::string curves;
   for (const fs::path& dir : attached) {
     // The highest-energy orbit of the followed branch, and mode 1 at its period: the closed form
-    // u0 = eps x with T = (3 L + g0 / |eps|) / c (README.md, 'Mode 1').
+    // u0 = eps x with T = (3 L + g0 / |eps|) / c (problems/contact_bar/orbits/README.md, 'Mode 1').
     const auto orbit = load_traced_orbit(dir, 1e300, L);
     if (!orbit) continue;
     const double eps = -g0 / (c * orbit->period - 3 * L);

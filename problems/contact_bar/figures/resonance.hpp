@@ -1,4 +1,4 @@
-// Figures of the internal resonances of mode 1 (problems/contact_bar/README.md, section
+// Figures of the internal resonances of mode 1 (problems/contact_bar/orbits/README.md, section
 // 'Dimension changes'), drawn from the outputs of `backbone trace --branch mode1
 // --follow all` into OUT/mode1_resonances (the main job's step of that name: 40 intervals, E up
 // to 3e-5 J): its branch.csv and the followed branches branch_point_K/.

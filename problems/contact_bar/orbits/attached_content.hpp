@@ -1,5 +1,5 @@
 // What an orbit attached to a traced branch adds to it: the extra content of the contacting-end
-// displacement, computed from simulations (problems/contact_bar/README.md, section 'Dimension
+// displacement, computed from simulations (problems/contact_bar/orbits/README.md, section 'Dimension
 // changes').
 //
 // Both orbits (the point on the branch and a nearby point of the attached family, e.g. the probe

@@ -407,7 +407,7 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   // 40 steps per period, 13 elements at N = 160), with entries as large as the largest
   // (tests/problems/contact_bar/test_jacobian_pattern.cpp). So the bare supports come first,
   // checked to 1e-4 of each row's size instead of the default 1e-3 (above what the check's
-  // finite differences and kinks leave on a complete pattern, README.md, section 'Cost'), and
+  // finite differences and kinks leave on a complete pattern, problems/contact_bar/orbits/README.md, section 'Jacobian pattern'), and
   // the c dt margin is their `wider` pattern, built only for the Jacobians whose check fails:
   // the bare supports take fewer residuals. The exact solver follows the characteristics
   // exactly: the bare supports are its structural pattern.

@@ -75,7 +75,7 @@ struct OrbitOptions {
   // Units that follow the orbit (continuation::LocalScale): above the gap, the unit of u0 in
   // continuation is the orbit's amplitude (its L2 norm over the bar), not g0, so that a step
   // is relative and the rank report's column scaling does not degrade as the amplitude grows
-  // (README.md, section 'Cost'). false: g0 throughout.
+  // (problems/contact_bar/orbits/README.md, section 'Amplitude units'). false: g0 throughout.
   bool amplitude_units = false;
   int path_rows() const { return (fixed_energy > 0 ? 1 : 0) + (fixed_shape >= 0 ? 1 : 0); }
   int nodal_unknowns() const { return elements - (start_on_wall ? 1 : 0); }
@@ -138,7 +138,7 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continu
   // The same ratio for the M periodicity rows (in units of u_s: then of max(u_s, A)), 1 for
   // the path rows; empty without options.amplitude_units.
   core::Vector local_residual_factor(const core::Vector& x) const override;
-  // Sparsity of the residual's Jacobian (README.md, section 'Cost'), for the TD-BEM and exact
+  // Sparsity of the residual's Jacobian (problems/contact_bar/orbits/README.md, section 'Amplitude units'), for the TD-BEM and exact
   // solvers: row i depends on u0 only near the images of its test support under x -> x +- c t
   // (t = T/2 regular, T paper; reflected at both ends, open or closed: contact instants and
   // fronts travel on the same characteristics), widened by one test element and, for the

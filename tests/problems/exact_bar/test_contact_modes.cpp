@@ -1,4 +1,4 @@
-// Contact: the exact first nonlinear mode (problems/contact_bar/README.md, 'Mode 1': onset
+// Contact: the exact first nonlinear mode (problems/contact_bar/orbits/README.md, 'Mode 1': onset
 // (L + g0/|eps|)/c, release 2L/c, force EA|eps|, period T = (3L + g0/|eps|)/c), its mirror
 // image with the contact at x = 0, energy conservation with contact, grazing and exact ties.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // `backbone trace ... --branch subharmonic_continuum` with the branch's own defaults
-// (problems/contact_bar/README.md, section 'Subharmonic continuum'): from the grazing limit
+// (problems/contact_bar/orbits/README.md, section 'Subharmonic continuum'): from the grazing limit
 // shape 1 to the bound near shape 0, exit code 0, members checked against the closed forms of
 // family.hpp (period 2 T2, energy) and the exact oracle (subharmonic_check.csv).
 #include <gtest/gtest.h>

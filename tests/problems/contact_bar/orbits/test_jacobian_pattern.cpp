@@ -1,5 +1,5 @@
 // The contact bar's Jacobian pattern (ContactBarOrbitProblem::jacobian_pattern,
-// problems/contact_bar/README.md, section 'Cost') against the column-by-column
+// problems/contact_bar/orbits/README.md, section 'Jacobian pattern') against the column-by-column
 // finite-difference Jacobian, which knows nothing of characteristics: modes 1 and 2 (free
 // knot), both formulations, the TD-BEM and the exact solver, N = 20 and 80, energies from just
 // above grazing (|u0(L)| = 1.02 g0) to 141 g0 (2e4 times the grazing energy), at the

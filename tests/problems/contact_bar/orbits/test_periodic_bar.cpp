@@ -1,5 +1,5 @@
 // Known-solution tests of the contact-bar shooting problem (contact_bar/orbits/periodic_bar):
-// the exact mode-1 orbit u0 = eps x, T = (3L + g0/|eps|)/c (its README.md, 'Mode 1') and the
+// the exact mode-1 orbit u0 = eps x, T = (3L + g0/|eps|)/c (its problems/contact_bar/orbits/README.md, 'Mode 1') and the
 // mode-2 tent (closed form derived in family.cpp) are roots of both formulations; the
 // regular Jacobian is regular (nullity 1), the paper's T column vanishes; Newton returns to
 // the family; short branches match the closed forms.
@@ -295,7 +295,7 @@ TEST(ContactBarOrbit, TestElementsBelowTheUnknownsAreRejected) {
 
 }  // namespace
 
-// Step control over ten decades of energy (problems/contact_bar/README.md, section 'Cost'):
+// Step control over ten decades of energy (problems/contact_bar/orbits/README.md, section 'Jacobian pattern'):
 // mode 1 from end amplitude 1.05 g0 (E = 5.5e-7 J) to E = 1e4 J (1.4e5 g0) with the trace's
 // settings (20 intervals, 40 test elements, ds = ds_max = 0.45, Newton tolerance 3e-9, rank
 // report with threshold 1e-5 at every point). In units of the gap a step moves u0 by about

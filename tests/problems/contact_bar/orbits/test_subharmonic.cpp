@@ -1,4 +1,4 @@
-// The subharmonic continuum near omega2 / 2 (problems/contact_bar/README.md, section
+// The subharmonic continuum near omega2 / 2 (problems/contact_bar/orbits/README.md, section
 // 'Subharmonic continuum'): its closed-form members checked by the exact characteristics
 // solver (problems/exact_bar), and the TD-BEM started from their in-contact state.
 #include <gtest/gtest.h>
@@ -52,7 +52,7 @@ TEST(SubharmonicContinuum, ClosedFormMembersArePeriodic) {
     }
 }
 
-// The contact structure (README.md, 'Subharmonic continuum'): interior members have two contact
+// The contact structure (problems/contact_bar/orbits/README.md, 'Subharmonic continuum'): interior members have two contact
 // phases per period of the closed-form durations (the first one split across t = 0 and t = T); at
 // the limits one phase has shrunk to a grazing instant. Durations are exact event times (1e-12).
 TEST(SubharmonicContinuum, ContactPhasesAndGrazingLimits) {
@@ -166,7 +166,7 @@ TEST(SubharmonicRepresentation, TwoKnotsHoldTheMembersExactly) {
 }
 
 // One knot cannot hold a member with two kinks off the grid: the residual stays O(1) in units
-// of g0 (above 1e-2), so the count of knots matters (README.md, 'Representability').
+// of g0 (above 1e-2), so the count of knots matters (problems/contact_bar/orbits/README.md, 'Representability').
 TEST(SubharmonicRepresentation, OneKnotIsNotEnough) {
   const TdbemSolver tdbem(ContactMethod::event);
   OrbitOptions o = on_wall(20, 2);
@@ -203,7 +203,7 @@ TEST(SubharmonicRepresentation, KnotSettingsAreChecked) {
 // residual Jacobian finds two null directions (energy and shape) at N = 20 and 40, with a gap
 // of at least 1e4 between the kept and the dropped singular values.
 // Shapes 0.1 and 0.8: at some other shapes (0.5 = mode 2 itself, 0.25 at N = 40) forward
-// differences see one side of a non-smooth coincidence and report extra candidates (README.md,
+// differences see one side of a non-smooth coincidence and report extra candidates (problems/contact_bar/orbits/README.md,
 // 'Subharmonic continuum'). The knots' reference nodes are the nodes nearest the kinks.
 TEST(SubharmonicRepresentation, VerifiedDimensionIsTwo) {
   const TdbemSolver tdbem(ContactMethod::event);
@@ -230,7 +230,7 @@ TEST(SubharmonicRepresentation, VerifiedDimensionIsTwo) {
 }
 
 // The contact structure counted from the exact simulation: two phases inside the continuum, one
-// phase plus one grazing instant at either limit (README.md, 'Subharmonic continuum'), no
+// phase plus one grazing instant at either limit (problems/contact_bar/orbits/README.md, 'Subharmonic continuum'), no
 // penetration (min_gap >= 0 to round-off) and the phase through t = 0 counted across t = T.
 TEST(SubharmonicContinuum, ContactStructureFromTheExactSimulation) {
   const bar::Material m;

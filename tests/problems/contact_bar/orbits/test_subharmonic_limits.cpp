@@ -1,5 +1,5 @@
 // The grazing limits of the subharmonic continuum located by NLopt (grazing_limits.hpp) and the
-// continuum traced between them (problems/contact_bar/README.md, section 'Subharmonic
+// continuum traced between them (problems/contact_bar/orbits/README.md, section 'Subharmonic
 // continuum'), against the closed forms of family.hpp and the exact solver.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Hard cases of the TD-BEM contact bar (problems/contact_bar/README.md, section 'Hard cases'):
+// Hard cases of the TD-BEM contact bar (problems/contact_bar/solver/README.md, section 'Hard cases'):
 // each with its expectation and an independent oracle (the exact characteristics solver of
 // problems/exact_bar, the closed forms of family.hpp). Every case either meets a stated error or
 // stops with a status; none may hang, crash or return NaN silently.
@@ -20,7 +20,7 @@ namespace backbone::contact_bar {
 namespace {
 
 // The paper's bar (E = rho = L = A = 1, c = 1), fixed at 0, wall at `gap` beyond x = L, started
-// on the exact mode 1 u0 = eps x (README.md, section 'Mode 1').
+// on the exact mode 1 u0 = eps x (problems/contact_bar/orbits/README.md, section 'Mode 1').
 bar::BarSetup mode1_setup(double gap, double eps) {
   bar::BarSetup s;
   s.left = {bar::EndType::fixed, 0};
@@ -67,7 +67,7 @@ TEST(HardCases, ContactFreePartShorterThanAStep) {
 }
 
 // Gap -> 0 (1e-12 and 0) and a bar that starts on the wall (u0(L) = g0 with a compressive
-// strain: the subharmonic member of README.md 'Subharmonic continuum' at shape 0.3). Oracle:
+// strain: the subharmonic member of problems/contact_bar/orbits/README.md 'Subharmonic continuum' at shape 0.3). Oracle:
 // the exact solver, u(L, t) over two of its periods, relative to max |u0| (1e-12).
 TEST(HardCases, VanishingGapAndStartInContactMatchTheExactSolver) {
   std::vector<std::pair<bar::BarSetup, double>> cases;
@@ -103,7 +103,7 @@ TEST(HardCases, CourantNumbersOtherThanOne) {
 }
 
 // 10^4 periods of mode 1, the paper scene (dt = 0.01). Mode 1 is piecewise linear with every
-// kink on a grid point, and the march holds it to round-off for ever (README.md 'Hard cases':
+// kink on a grid point, and the march holds it to round-off for ever (problems/contact_bar/solver/README.md 'Hard cases':
 // step-grid times, round-off closings held where they are, Q re-gauged): after 10^4 periods the
 // energy, u(L) and the projected u (relative to its largest entry) are the start's, and half a
 // period later u(L) is a fresh march's. Bounds 1e-13 relative: above round-off, and orders of
