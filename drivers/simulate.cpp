@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "continuation/cli/scene_options.hpp"
 #include "core/errors.hpp"
 #include "core/output_folder.hpp"
 #include "core/scene.hpp"
@@ -32,6 +33,29 @@ po::options_description driver_keys() {
   return keys;
 }
 
+// The keys of a trace of the same problem that a simulation does not take: a scene.ini written
+// by `trace` holds them and simulates as it is; on the command line they are refused.
+po::options_description trace_only_keys(const cli::ProblemPlugin& plugin,
+                                        const po::options_description& simulate_keys) {
+  po::options_description extra("keys of a trace's scene (unused by simulate)");
+  if (!plugin.can_trace()) return extra;
+  po::options_description trace = plugin.scene_keys();
+  trace.add(cli::continuation_keys(trace));
+  for (const auto& option : trace.options())
+    if (!simulate_keys.find_nothrow(option->long_name(), false)) extra.add(option);
+  return extra;
+}
+
+void refuse_on_command_line(const po::options_description& trace_only,
+                            const std::vector<std::string>& args) {
+  for (const std::string& word : args) {
+    if (word.rfind("--", 0) != 0) continue;
+    const std::string name = word.substr(2, word.find('=') - 2);
+    if (trace_only.find_nothrow(name, false))
+      throw core::InputError(name, "is a key of `backbone trace`; a simulation does not use it");
+  }
+}
+
 int run_simulate(const std::vector<std::string>& args) {
   const bool help = std::any_of(args.begin(), args.end(),
                                 [](const std::string& a) { return a == "--help" || a == "-h"; });
@@ -52,9 +76,12 @@ int run_simulate(const std::vector<std::string>& args) {
     fmt::print("usage: backbone simulate {}\n\n{}", usage, keys.str());
     return core::exit_ok;
   }
-  const core::Scene scene =
-      core::read_scene(plugin.simulate_keys(), scene_path,
-                       std::vector<std::string>(args.begin() + 1, args.end()), driver_keys());
+  const std::vector<std::string> rest(args.begin() + 1, args.end());
+  po::options_description keys = plugin.simulate_keys();
+  const po::options_description trace_only = trace_only_keys(plugin, keys);
+  refuse_on_command_line(trace_only, rest);
+  keys.add(trace_only);
+  const core::Scene scene = core::read_scene(keys, scene_path, rest, driver_keys());
   const fs::path out(scene.text("out"));
   core::check_output_folder("out", out);
   const int code = plugin.simulate(scene, out);

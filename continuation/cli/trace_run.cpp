@@ -4,6 +4,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "continuation/cli/progress.hpp"
@@ -17,18 +18,46 @@ namespace backbone::cli {
 
 namespace {
 
-// Every bound names an observable of the problem (its observables at the guess).
-void check_bounds(const core::Problem& problem, const core::Vector& guess,
-                  const continuation::ContinuationOptions& options) {
+// The scene key a bound came from: OBSERVABLE_min / _max when the scene gives that key, else
+// `bound` (the NAME:MIN:MAX key).
+std::string bound_key(const core::Scene& scene, const std::string& observable,
+                      const char* side) {
+  const std::string key = observable + side;
+  const auto& values = scene.values();
+  return values.count(key) && !values[key].defaulted() ? key : "bound";
+}
+
+// Every bound names an observable of the problem (its observables at the guess), and a fresh
+// start lies inside every bound: a start outside would end the branch at its first point.
+void check_bounds(const core::Scene& scene, const core::Problem& problem,
+                  const core::Vector& guess, const continuation::ContinuationOptions& options,
+                  bool restarting) {
   if (options.bounds.empty()) return;
+  const core::Observables observables = problem.observables(guess);
   std::vector<std::string> names;
-  for (const auto& [name, value] : problem.observables(guess)) names.push_back(name);
-  for (const continuation::Bound& b : options.bounds)
-    if (std::find(names.begin(), names.end(), b.observable) == names.end())
-      throw core::InputError("bound",
-                             fmt::format("'{}' is not an observable of {} (its "
-                                         "observables: {})",
-                                         b.observable, problem.name(), fmt::join(names, ", ")));
+  for (const auto& [name, value] : observables) names.push_back(name);
+  for (const continuation::Bound& b : options.bounds) {
+    const auto it = std::find(names.begin(), names.end(), b.observable);
+    if (it == names.end())
+      throw core::InputError("bound", fmt::format("'{}' is not an observable of {} (its "
+                                                  "observables: {})",
+                                                  b.observable, problem.name(),
+                                                  fmt::join(names, ", ")));
+    if (b.min > b.max)
+      throw core::InputError(bound_key(scene, b.observable, "_max"),
+                             fmt::format("the {} window [{:g}, {:g}] is empty", b.observable,
+                                         b.min, b.max));
+    const double start = observables[static_cast<std::size_t>(it - names.begin())].second;
+    if (restarting || !std::isfinite(start)) continue;
+    if (start < b.min || start > b.max) {
+      const bool below = start < b.min;
+      throw core::InputError(
+          bound_key(scene, b.observable, below ? "_min" : "_max"),
+          fmt::format("the starting orbit's {} {:.6g} lies {} {:g}: the branch would end at its "
+                      "first point",
+                      b.observable, start, below ? "below" : "above", below ? b.min : b.max));
+    }
+  }
 }
 
 }  // namespace
@@ -100,7 +129,7 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
                                                  "residual has {} equations for {} unknowns "
                                                  "(use newton = eigen, least squares)",
                                                  entry.name, m, n));
-  check_bounds(problem, t.setup.guess, options);
+  check_bounds(scene, problem, t.setup.guess, options, t.restart.has_value());
   // A consistent overdetermined system (m > n - 1) still has curves of solutions.
   t.expected_dimension = n - std::min(m, n - 1);
   return t;

@@ -10,7 +10,8 @@
 // linear mode: at grazing every initial condition is 4L/c-periodic and a nodal Newton from the
 // sine lands on such a non-contact orbit, of period 4L/c. Mode 2 moves one knot
 // with the physics (free_knots = 1, the crest of the tent) because its kink travels with T and
-// a uniform grid holds it only to O(dx) (problems/contact_bar/orbits/README.md, section "Shooting on the bar").
+// a uniform grid holds it only to O(dx) (problems/contact_bar/orbits/README.md, section "Shooting
+// on the bar").
 //
 //   backbone trace problems/contact_bar/scenes/paper.ini --branch mode1 --out out/m1
 //   backbone trace problems/contact_bar/scenes/paper.ini --branch mode2 --free_knots 0
@@ -108,7 +109,8 @@ po::options_description trace_keys() {
       ("amplitude_units", po::value<bool>()->default_value(true),
        "mode1, mode2: above the gap, steps and rank reports in units of the orbit's amplitude "
        "(the L2 norm of u0) instead of the gap, so that ds is relative and a branch covers "
-       "decades of energy (problems/contact_bar/orbits/README.md, section 'Amplitude units'); false: the gap throughout")  //
+       "decades of energy (problems/contact_bar/orbits/README.md, section 'Amplitude units'); "
+       "false: the gap throughout")  //
       ("max_residual_work", po::value<double>()->default_value(1e7),
        "refuse a trace whose residual costs more than this many element-steps "
        "(shooting_elements x steps_per_period; a point evaluates the residual about 2 x "
@@ -141,11 +143,49 @@ void check_residual_work(const core::Scene& scene, const OrbitOptions& options) 
                   steps ? "steps_per_period" : "shooting_elements"));
 }
 
+// The ends a contact-bar orbit needs, named by their scene keys: left_end fixed, right_end
+// contact with gap > 0.
+void check_orbit_ends(const bar::BarSetup& setup, const std::string& what) {
+  if (setup.left.type != bar::EndType::fixed)
+    throw core::InputError("left_end", fmt::format("{} need a fixed left end (got {})", what,
+                                                   bar::to_string(setup.left.type)));
+  if (setup.right.type != bar::EndType::contact)
+    throw core::InputError("right_end", fmt::format("{} need right_end = contact (got {})", what,
+                                                    bar::to_string(setup.right.type)));
+  if (!(setup.right.gap > 0))
+    throw core::InputError("gap",
+                           fmt::format("{} need a gap > 0 (got {:g})", what, setup.right.gap));
+}
+
+// The scene's simulation keys (u0, v0, period, dt, probes) fit the bar, so that the scene.ini a
+// trace writes reruns as `backbone simulate` too.
+void check_simulation_keys(const core::Scene& scene) {
+  setup_from_scene(scene);
+  simulation_from_scene(scene, 1.0);
+}
+
+// dt = T / steps_per_period must not exceed the bar's travel time L / c, the largest step of
+// the TD-BEM march; checked at the starting orbit's period.
+void check_time_step(const bar::Material& material, double period, int steps_per_period) {
+  const double dt = period / steps_per_period, transit = material.travel_time();
+  if (dt <= transit * (1 + 1e-12)) return;
+  throw core::InputError(
+      "steps_per_period",
+      fmt::format("{} steps over the starting period {:.6g} s give dt = {:.4g} s > L/c = "
+                  "{:.4g} s, the largest step of the TD-BEM march; use at least {} (even)",
+                  steps_per_period, period, dt, transit,
+                  2 * static_cast<long>(std::ceil(period / transit / 2))));
+}
+
 // The shooting grid of the scene: shooting_elements (0: the scene's elements) and
 // steps_per_period, checked against max_residual_work.
 OrbitOptions shooting_grid(const core::Scene& scene) {
   OrbitOptions options;
   const long shooting_elements = scene.integer("shooting_elements", 0);
+  if (shooting_elements != 0 && shooting_elements < 2)
+    throw core::InputError(
+        "shooting_elements",
+        fmt::format("must be >= 2, or 0 for the scene's elements (got {})", shooting_elements));
   options.elements =
       static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
   options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
@@ -179,9 +219,9 @@ std::function<std::string(const core::Vector&)> return_check(const core::Scene& 
 }
 
 // mode1 and mode2 in units of the amplitude: a step ds is a relative change of the orbit and
-// F's round-off is relative too (problems/contact_bar/orbits/README.md, section 'Amplitude units'), so the defaults become 10 % steps,
-// which give a branch enough points for the figures, and a tolerance of 1e-10 of the amplitude,
-// above that round-off. Keys the scene gives are kept.
+// F's round-off is relative too (problems/contact_bar/orbits/README.md, section 'Amplitude units'),
+// so the defaults become 10 % steps, which give a branch enough points for the figures, and a
+// tolerance of 1e-10 of the amplitude, above that round-off. Keys the scene gives are kept.
 std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)>
 amplitude_unit_options(const core::Scene& scene) {
   const bool ds_given = !scene.values()["ds"].defaulted();
@@ -234,9 +274,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   if (branch.rfind("subharmonic", 0) == 0) return setup_subharmonic(scene, branch);
   const int mode = branch == "mode2" ? 2 : 1;
   bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
-  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
-    throw core::InputError("right_end",
-                           "the contact-bar modes need right_end = contact and gap > 0");
+  check_orbit_ends(setup, "the contact-bar modes");
+  check_simulation_keys(scene);
   const ContactFamily family(setup.material, setup.right.gap, mode);
   const std::shared_ptr<const bar::BarSolver> solver = shooting_solver(scene);
 
@@ -259,6 +298,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   if (options.amplitude_units) s.branch_options = amplitude_unit_options(scene);
   s.guess = guess == "linear_mode" ? problem->linear_mode_guess(mode, ratio)
                                    : problem->contact_family_guess(mode, ratio);
+  check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
   // Energy grows along the family: the direction of the contact family's own tangent.
   s.direction = problem->contact_family_guess(mode, ratio * 1.01) -
                 problem->contact_family_guess(mode, ratio);
@@ -270,7 +310,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   return s;
 }
 
-// The continuum's own continuation settings (problems/contact_bar/orbits/README.md, section 'Subharmonic continuum'):
+// The continuum's own continuation settings (problems/contact_bar/orbits/README.md, section
+// 'Subharmonic continuum'):
 //  - the first step along the closed-form direction (start_along_direction);
 //  - ds = ds_max = 1/40 of the closed-form path length in the scaled step norm, so every
 //    energy has about 40 members (the path grows like sqrt(E) / g0 in that norm), unless the
@@ -411,16 +452,16 @@ std::function<void(const std::filesystem::path&, const continuation::Branch&)> s
   };
 }
 
-// The subharmonic branches (problems/contact_bar/orbits/README.md, section 'Subharmonic continuum'): mode 2 taken over two
-// periods, T = 2 T2, started at rest at the centre of a contact phase (start_on_wall), two free
-// knots at its two kinks. The periodic orbits form a 2D manifold (energy x shape); a path on it
-// is picked by one path row: the shape (subharmonic: the backbone at constant shape) or the
-// energy (subharmonic_continuum: the members at one energy, from a grazing limit on).
+// The subharmonic branches (problems/contact_bar/orbits/README.md, section 'Subharmonic
+// continuum'): mode 2 taken over two periods, T = 2 T2, started at rest at the centre of a contact
+// phase (start_on_wall), two free knots at its two kinks. The periodic orbits form a 2D manifold
+// (energy x shape); a path on it is picked by one path row: the shape (subharmonic: the backbone at
+// constant shape) or the energy (subharmonic_continuum: the members at one energy, from a grazing
+// limit on).
 cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch) {
   bar::BarSetup setup = bar_from_scene(scene);
-  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
-    throw core::InputError("right_end",
-                           "the subharmonic branches need right_end = contact and gap > 0");
+  check_orbit_ends(setup, "the subharmonic branches");
+  check_simulation_keys(scene);
   const bar::Material& material = setup.material;
   const ContactFamily mode2(material, setup.right.gap, 2);
   const SubharmonicStart st = subharmonic_start(scene, branch, material, setup.right.gap);
@@ -429,6 +470,7 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
   auto problem = std::make_unique<ContactBarOrbitProblem>(setup, shooting_solver(scene), options);
   cli::TraceSetup s;
   s.guess = problem->subharmonic_guess(st.start_energy, st.shape);
+  check_time_step(material, s.guess[problem->period_index()], options.steps_per_period);
   if (st.continuum) {
     // Towards the other grazing limit: the shape decreases from 1 (increases from below 1/2).
     // The closed-form direction of the family: the first step follows it, since the start at
