@@ -20,8 +20,7 @@ namespace {
 
 // The scene key a bound came from: OBSERVABLE_min / _max when the scene gives that key, else
 // `bound` (the NAME:MIN:MAX key).
-std::string bound_key(const core::Scene& scene, const std::string& observable,
-                      const char* side) {
+std::string bound_key(const core::Scene& scene, const std::string& observable, const char* side) {
   const std::string key = observable + side;
   const auto& values = scene.values();
   return values.count(key) && !values[key].defaulted() ? key : "bound";
@@ -29,9 +28,8 @@ std::string bound_key(const core::Scene& scene, const std::string& observable,
 
 // Every bound names an observable of the problem (its observables at the guess), and a fresh
 // start lies inside every bound: a start outside would end the branch at its first point.
-void check_bounds(const core::Scene& scene, const core::Problem& problem,
-                  const core::Vector& guess, const continuation::ContinuationOptions& options,
-                  bool restarting) {
+void check_bounds(const core::Scene& scene, const core::Problem& problem, const core::Vector& guess,
+                  const continuation::ContinuationOptions& options, bool restarting) {
   if (options.bounds.empty()) return;
   const core::Observables observables = problem.observables(guess);
   std::vector<std::string> names;
@@ -39,18 +37,23 @@ void check_bounds(const core::Scene& scene, const core::Problem& problem,
   for (const continuation::Bound& b : options.bounds) {
     const auto it = std::find(names.begin(), names.end(), b.observable);
     if (it == names.end())
-      throw core::InputError("bound", fmt::format("'{}' is not an observable of {} (its "
-                                                  "observables: {})",
-                                                  b.observable, problem.name(),
-                                                  fmt::join(names, ", ")));
+      throw core::InputError("bound",
+                             fmt::format("'{}' is not an observable of {} (its "
+                                         "observables: {})",
+                                         b.observable, problem.name(), fmt::join(names, ", ")));
     if (b.min > b.max)
-      throw core::InputError(bound_key(scene, b.observable, "_max"),
-                             fmt::format("the {} window [{:g}, {:g}] is empty", b.observable,
-                                         b.min, b.max));
+      throw core::InputError(
+          bound_key(scene, b.observable, "_max"),
+          fmt::format("the {} window [{:g}, {:g}] is empty", b.observable, b.min, b.max));
     const double start = observables[static_cast<std::size_t>(it - names.begin())].second;
     if (restarting || !std::isfinite(start)) continue;
-    if (start < b.min || start > b.max) {
-      const bool below = start < b.min;
+    // A start on a bound (within rounding of the guess) is a branch's own end, as at a grazing
+    // limit; one beyond it by more is outside the window.
+    const auto beyond = [start](double bound, double sign) {
+      return sign * (start - bound) > 1e-6 * std::max(std::abs(start), std::abs(bound));
+    };
+    if (beyond(b.min, -1) || beyond(b.max, 1)) {
+      const bool below = beyond(b.min, -1);
       throw core::InputError(
           bound_key(scene, b.observable, below ? "_min" : "_max"),
           fmt::format("the starting orbit's {} {:.6g} lies {} {:g}: the branch would end at its "

@@ -1,7 +1,8 @@
 // `backbone trace` end to end on the contact bar: bad input names its key (exit 2, nothing
 // written); another scene than the paper's (other L, E, rho, g0 on the command line, nothing
-// else changed) traces mode 1 onto the closed form of problems/contact_bar/orbits/README.md, 'Mode 1',
-// because the continuation works in units of the scene (u0 / g0, T c / L) and checks each point.
+// else changed) traces mode 1 onto the closed form of problems/contact_bar/orbits/README.md, 'Mode
+// 1', because the continuation works in units of the scene (u0 / g0, T c / L) and checks each
+// point.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -66,14 +67,17 @@ TEST(TraceCli, BadInputExitsTwoAndWritesNothing) {
   expect_bad_input(paper + " --newton kinsol", "newton");
 }
 
-// A short stiff aluminium bar with a 10 um gap: u0 ~ 1e-5 m, T ~ 2e-4 s. The scene's u0 knots
-// (written for L = 1) are not needed; the default dimensionless steps fit. Every point must
-// match the closed form at its own energy and return under the exact oracle (the per-point
-// check of trace, 1e-6).
+// A short soft bar (L = 0.3 m, E = 7e4 Pa, rho = 2.7 kg/m^3: c = 161 m/s) with a 10 um gap:
+// u0 ~ 1e-5 m, T ~ 3 L/c = 5.6e-3 s. u0, period and dt are given for this bar (the scene's are
+// for L = 1 and are refused); the default dimensionless steps fit. Every point must match the
+// closed form at its own energy and return under the exact oracle (the per-point check of
+// trace, 1e-6).
 TEST(TraceCli, OtherSceneModeOneMatchesTheClosedForm) {
   fs::path out;
   const auto check = trace_mode1_on_the_closed_form(
-      "short_bar", "--length 0.3 --youngs_modulus 7e4 --density 2.7 --gap 1e-5 --energy_max 1e-3",
+      "short_bar",
+      "--length 0.3 --youngs_modulus 7e4 --density 2.7 --gap 1e-5 --energy_max 1e-3 "
+      "--u0 '0:0 0.3:-3e-5' --period 0.0055 --dt 1e-5",
       out);
   const auto energy = check.column("energy");
   ASSERT_FALSE(energy.empty());
@@ -237,8 +241,8 @@ TEST(TraceCli, FinishedBranchFarAboveTheGapExtends) {
 
 // A resumed run reads the resolved scene.ini, where keys left at their defaults are comments: in
 // the amplitude units (mode 1's default) newton_tolerance is then still "not given" and the
-// branch keeps its own 1e-10 (problems/contact_bar/orbits/README.md, 'Amplitude units'), so the resumed branch
-// is the uninterrupted one's point for point.
+// branch keeps its own 1e-10 (problems/contact_bar/orbits/README.md, 'Amplitude units'), so the
+// resumed branch is the uninterrupted one's point for point.
 TEST(TraceCli, ResumeInTheAmplitudeUnitsKeepsTheBranchsOwnSettings) {
   const fs::path full = cli::scratch("trace_cli", "full_amp"),
                  part = cli::scratch("trace_cli", "part_amp");
