@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <sstream>
 
 #include "core/output_folder.hpp"
 #include "core/table.hpp"
@@ -34,6 +35,13 @@ std::string stdout_of(const std::string& arguments, int& code) {
   const int status = pclose(pipe.release());
   code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return text;
+}
+
+// Writes `bytes` as a scene file in the test's scratch folder.
+fs::path scene_file(const std::string& name, const std::string& bytes) {
+  const fs::path path = cli::scratch("cli_input", name);
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
 }
 
 TEST(TraceInput, BoundOnAnObservableTheProblemDoesNotHaveIsBadInput) {
@@ -139,6 +147,29 @@ TEST(TraceInput, TheWrittenSceneRerunsAsASimulation) {
   EXPECT_EQ(simulated.code, 0) << simulated.err;
 }
 
+TEST(TraceInput, AGridWhoseJacobianDoesNotFitIsRefusedUpFront) {
+  // 20000 intervals: a 40000 x 20001 dense Jacobian, 6.4 GB a copy, nine copies.
+  cli::expect_bad_input("trace", scene + " --branch mode1 --shooting_elements 20000",
+                        "shooting_elements", "trace_input_memory");
+  // The bound is the key max_memory when given: 800 intervals need about 0.09 GB.
+  cli::expect_bad_input("trace",
+                        scene + " --branch mode1 --shooting_elements 800 --max_memory 0.01",
+                        "max_memory 0.01", "trace_input_memory");
+  cli::expect_bad_input("trace", small + " --max_memory -1", "max_memory", "trace_input_memory");
+}
+
+TEST(SimulateInput, AHistoryTooLargeToHoldIsRefusedUpFront) {
+  // 50000 probes x 311 rows (3.1 s at dt = 0.01) x 100005 columns: 3e7 values, above a tenth of
+  // max_steps (1e8).
+  std::string probes = "probes =";
+  for (int i = 0; i < 50000; ++i) probes += " " + std::to_string(i / 50000.0);
+  std::ifstream paper(scene);
+  std::stringstream text;
+  text << paper.rdbuf() << "\n" << probes << "\n";
+  const fs::path many = scene_file("many_probes.ini", text.str());
+  cli::expect_bad_input("simulate", many.string(), "probes", "simulate_input_history");
+}
+
 TEST(OutputFolderInput, AFolderThatCannotBeCreatedIsBadInputForEveryCommand) {
   // /proc takes no new folders; bench and reproduce checked nothing before their first case.
   const fs::path proc = "/proc/backbone_test";
@@ -170,13 +201,6 @@ TEST(FiguresInput, AFolderWithoutTracedBranchesIsBadInput) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("out:"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(missing));
-}
-
-// Writes `bytes` as a scene file in the test's scratch folder.
-fs::path scene_file(const std::string& name, const std::string& bytes) {
-  const fs::path path = cli::scratch("cli_input", name);
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path;
 }
 
 TEST(SceneFileInput, WhatIsNotASceneIsRefusedBeforeItIsRead) {

@@ -105,6 +105,16 @@ void check_run_size(const core::Scene& scene, const bar::BarSetup& setup,
                                          "larger dt or fewer history_samples, {}",
                                          window, rows, window, raise));
   }
+  // The history every solver writes: rows x (time, the ends' and every probe's u and v), held in
+  // memory and written as history.csv; a tenth of max_steps values at most (8 bytes each).
+  const double columns = 1 + 2 * (2 + static_cast<double>(o.probes.size()));
+  const double values = rows * columns * static_cast<double>(methods.size());
+  if (values > limit / 10)
+    throw InputError(o.probes.size() > 2 ? "probes" : "history_samples",
+                     fmt::format("the history holds {:.0f} rows x {:.0f} columns x {} solvers = "
+                                 "{:.4g} values (> max_steps / 10); use fewer probes or "
+                                 "history_samples, {}",
+                                 rows, columns, methods.size(), values, raise));
   if (uses("fem") && steps * (o.elements + 1.0) > 100 * limit)
     throw InputError("elements", fmt::format("the FEM does {:.4g} steps on {} nodes (node-steps / "
                                              "100 > max_steps); use fewer elements or periods, {}",

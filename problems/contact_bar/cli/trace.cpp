@@ -18,6 +18,7 @@
 #include "problems/contact_bar/cli/trace.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <functional>
@@ -115,6 +116,9 @@ po::options_description trace_keys() {
        "refuse a trace whose residual costs more than this many element-steps "
        "(shooting_elements x steps_per_period; a point evaluates the residual about 2 x "
        "shooting_elements times): raise it to run larger traces")  //
+      ("max_memory", po::value<double>()->default_value(0),
+       "refuse a trace whose dense Jacobian and its factorizations would need more than this "
+       "many GB (>= 0; 0: half of this machine's memory)")  //
       ("return_tolerance", po::value<double>()->default_value(1e-6),
        "reject a converged point whose orbit, re-simulated over T by the exact oracle, misses "
        "u0 or v0 = 0 by more than this, relative to max|u0| (0: no check). Catches spurious "
@@ -175,6 +179,27 @@ void check_time_step(const bar::Material& material, double period, int steps_per
                   "{:.4g} s, the largest step of the TD-BEM march; use at least {} (even)",
                   steps_per_period, period, dt, transit,
                   2 * static_cast<long>(std::ceil(period / transit / 2))));
+}
+
+// The memory a trace needs before it starts: the corrector and the rank report hold about nine
+// copies of the dense m x n Jacobian (J, its QR or COD, the bordered system, the SVD's
+// workspace), so a grid whose copies do not fit is refused up front (key max_memory).
+void check_memory(const core::Scene& scene, const OrbitOptions& options) {
+  const double given = scene.non_negative("max_memory");
+  const double physical =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  const double limit_gb = given > 0 ? given : physical / 2 / 1e9;
+  const double equations = options.test_elements > 0 ? options.test_elements : options.state_size();
+  const double unknowns = options.state_size() + 1.0;
+  const double need_gb = 9 * equations * unknowns * sizeof(double) / 1e9;
+  if (need_gb <= limit_gb) return;
+  throw core::InputError(
+      "shooting_elements",
+      fmt::format("{} intervals make a {:.0f} x {:.0f} Jacobian; the corrector and the rank "
+                  "reports need about {:.3g} GB, above max_memory {:.3g} GB{}: lower "
+                  "shooting_elements (or test_elements), or raise max_memory",
+                  options.elements, equations, unknowns, need_gb, limit_gb,
+                  given > 0 ? "" : " (half of this machine's memory)"));
 }
 
 // The shooting grid of the scene: shooting_elements (0: the scene's elements) and
@@ -285,6 +310,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements = static_cast<int>(
       test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);
+  check_memory(scene, options);
   // A followed family's probes and paths are measured in units of the gap: with follow the gap
   // stays the unit. (Branch-point detection works in either: its samples are kept in the unit
   // scale, continuation/README.md, section 'Branch points'.)
@@ -415,6 +441,7 @@ OrbitOptions subharmonic_chart(const core::Scene& scene, const bar::Material& ma
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements =
       static_cast<int>(test_elements < 0 ? 2 * options.state_size() : test_elements);
+  check_memory(scene, options);
   if (st.continuum)
     options.fixed_energy = st.energy;
   else
