@@ -55,7 +55,8 @@ int run_reproduce(const std::vector<std::string>& args) {
   if (vm.count("help")) {
     std::string names;
     for (const ReproduceStep& s : plan("OUT", false)) names += " " + s.name;
-    fmt::print("{}\nsteps:{}\n", fmt::streamed(keys), names);
+    fmt::print("usage: backbone reproduce [--out DIR] [--quick] [--only STEP]\n{}\nsteps:{}\n",
+               fmt::streamed(keys), names);
     return 0;
   }
   const std::string out = vm["out"].as<std::string>();

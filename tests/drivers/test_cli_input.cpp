@@ -224,6 +224,18 @@ TEST(SceneFileInput, TheSceneFileComesFirst) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST(EveryCommand, AnswersHelpWithItsUsage) {
+  for (const char* command :
+       {"trace", "simulate", "inspect", "bench", "figures", "reproduce", "version"}) {
+    int code = -1;
+    const std::string text = stdout_of(std::string(command) + " --help", code);
+    EXPECT_EQ(code, 0) << command;
+    EXPECT_NE(text.find("usage: backbone " + std::string(command)), std::string::npos)
+        << command << ":\n"
+        << text;
+  }
+}
+
 TEST(InspectInput, HelpIsAnswered) {
   int code = -1;
   EXPECT_NE(stdout_of("inspect --help", code).find("usage: backbone inspect"), std::string::npos);
