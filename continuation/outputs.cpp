@@ -324,10 +324,26 @@ void write_after_run(
   core::Table rows = branch_point_table(branch, branch.points.front().observables);
   const std::filesystem::path saved = out / "branch_points.csv";
   if (resumed && std::filesystem::exists(saved))
-    rows = merge_saved_rows(core::Table::read_csv(saved), rows, "after_point",
-                            branch.branch_points_from >= 0 ? branch.branch_points_from
-                                                           : branch.points.front().index);
+    rows = merge_saved_rows(
+        core::Table::read_csv(saved), rows, "after_point",
+        branch.branch_points_from >= 0 ? branch.branch_points_from : branch.points.front().index);
   rows.write_csv(saved);
+}
+
+void forget_saved_states(const std::filesystem::path& out) {
+  const std::filesystem::path path = out / "state.txt";
+  std::ifstream in(path);
+  if (!in) return;
+  std::string text, line;
+  for (bool header = true; std::getline(in, line); header = false) {
+    if (header) {
+      text += line + "\n";
+      continue;
+    }
+    const auto space = line.find(' ');
+    text += (space == std::string::npos ? line : line.substr(0, space)) + " -\n";
+  }
+  core::write_text_atomically(path, text);
 }
 
 }  // namespace backbone::continuation

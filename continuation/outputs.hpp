@@ -78,6 +78,11 @@ class BranchWriter {
 // is none.
 int repair_branch_files(const std::filesystem::path& out, const std::string& key);
 
+// Replaces the saved loop state of every point of out/state.txt by `-` (none), atomically: what
+// a resume does when the saved states do not fit its settings (restart.hpp, state_mismatch), so
+// that the folder holds no states of another run's loop. Nothing when there is no state.txt.
+void forget_saved_states(const std::filesystem::path& out);
+
 // The unknowns of point `point` (-1: the last one) of an unknowns.csv. InputError naming `key`
 // when the file cannot be read or has no such point.
 core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key);

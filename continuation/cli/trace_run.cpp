@@ -125,6 +125,14 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
   if (t.restart)
     continuation::take_up(*t.restart, restart_key, static_cast<int>(start_direction), problem,
                           options, t.setup.guess, t.direction);
+  if (t.restart && !t.resume.empty() && !t.restart->note.empty()) {
+    // The saved states belong to another run's loop: the folder keeps none of them.
+    continuation::forget_saved_states(t.resume);
+    fmt::print(stderr,
+               "backbone trace: the saved loop states do not fit this run ({}); "
+               "the last point is corrected again and state.txt keeps no other run's states\n",
+               t.restart->note);
+  }
 
   const int n = problem.num_unknowns(), m = problem.num_equations();
   if (m != n - 1 && t.corrector->name() == "kinsol")

@@ -8,6 +8,7 @@
 #include <climits>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <sstream>
 
@@ -168,6 +169,35 @@ TEST(SimulateInput, AHistoryTooLargeToHoldIsRefusedUpFront) {
   text << paper.rdbuf() << "\n" << probes << "\n";
   const fs::path many = scene_file("many_probes.ini", text.str());
   cli::expect_bad_input("simulate", many.string(), "probes", "simulate_input_history");
+}
+
+TEST(TraceInput, ResumeWithAnotherRunsStatesKeepsNoneOfThem) {
+  // The same five points traced twice, by the arclength and by the natural loop; the folder of
+  // the first then holds the second's state.txt, whose states do not fit an arclength resume.
+  const fs::path mine = cli::scratch("trace_input", "mine");
+  const fs::path other = cli::scratch("trace_input", "other");
+  ASSERT_EQ(cli::run("trace", small + " --max_points 5", mine).code, 0);
+  ASSERT_EQ(cli::run("trace", small + " --max_points 5 --method natural", other).code, 0);
+  fs::copy_file(other / "state.txt", mine / "state.txt", fs::copy_options::overwrite_existing);
+  const fs::path err = mine.string() + ".resume.stderr";
+  const std::string command = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume " +
+                              mine.string() + " --max_points 8 > /dev/null 2> " + err.string();
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  std::ifstream log(err);
+  const std::string message((std::istreambuf_iterator<char>(log)), {});
+  EXPECT_NE(message.find("do not fit this run"), std::string::npos) << message;
+  std::ifstream states(mine / "state.txt");
+  std::string line;
+  std::getline(states, line);  // header
+  int saved = 0, own = 0;
+  while (std::getline(states, line)) {
+    const bool none = line.substr(line.find(' ') + 1) == "-";
+    const int point = std::stoi(line.substr(0, line.find(' ')));
+    if (point <= 4) saved += none ? 1 : 0;
+    if (point > 4) own += line.find("method=arclength") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(saved, 5);  // the five saved points keep no state of the natural run
+  EXPECT_EQ(own, 3);    // the resumed points carry this run's arclength states
 }
 
 TEST(OutputFolderInput, AFolderThatCannotBeCreatedIsBadInputForEveryCommand) {
