@@ -18,6 +18,7 @@
 #include "continuation/pseudo_arclength.hpp"
 #include "core/bordered_system.hpp"
 #include "core/eigen_newton.hpp"
+#include "core/job_queue.hpp"
 
 namespace backbone::continuation {
 
@@ -47,8 +48,8 @@ bool smallest_singular_triplet(const core::Matrix& A, const core::Vector& start,
   const double floor = 1e-12 * A.norm();
   const Eigen::Index max_vectors = std::min<Eigen::Index>(n, 40);
   core::Matrix K(n, max_vectors), RK(n, max_vectors);
-  core::Vector v = start.size() == n && start.norm() > 0 ? core::Vector(start)
-                                                         : core::Vector::Ones(n);
+  core::Vector v =
+      start.size() == n && start.norm() > 0 ? core::Vector(start) : core::Vector::Ones(n);
   Eigen::Index next_check = 1;
   for (Eigen::Index j = 0; j < max_vectors; ++j) {
     if (j > 0) {
@@ -102,7 +103,8 @@ void leading_right_singular(const core::Matrix& A, Eigen::Index count, core::Vec
   core::Matrix X(n, block);
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < block; ++j)
-      X(i, j) = std::cos(0.7 * static_cast<double>((i + 1) * (j + 1)) + 0.3 * static_cast<double>(j));
+      X(i, j) =
+          std::cos(0.7 * static_cast<double>((i + 1) * (j + 1)) + 0.3 * static_cast<double>(j));
   for (int step = 0; step < 3; ++step) {
     const core::Matrix Y = A.transpose() * (A * X);
     const Eigen::HouseholderQR<core::Matrix> qr(Y);
@@ -264,17 +266,18 @@ class BranchPointDetector::Locator {
   core::Matrix last_jacobian_;
   long jacobian_residuals_ = 0;  // residuals the last Jacobian evaluate() computed took (0: none)
   std::unique_ptr<core::Corrector> finisher_, probe_finisher_;  // after chord steps stall
-  std::vector<BranchPointReport>* found_ = nullptr;              // run()'s
+  std::vector<BranchPointReport>* found_ = nullptr;             // run()'s
 };
 
-const BranchPointDetector::Chord& BranchPointDetector::Locator::chord_of(const Evaluation& e) const {
+const BranchPointDetector::Chord& BranchPointDetector::Locator::chord_of(
+    const Evaluation& e) const {
   if (!e.chord) e.chord = std::make_shared<const Chord>(e.jacobian, null_cutoff());
   return *e.chord;
 }
 
 bool BranchPointDetector::Locator::chord_correct(const Chord& chord, const core::Vector& normal,
-                                        const core::Vector& anchor, core::Vector& y,
-                                        const core::Matrix* kinks) const {
+                                                 const core::Vector& anchor, core::Vector& y,
+                                                 const core::Matrix* kinks) const {
   const core::Matrix& J = chord.jacobian;
   const core::Matrix& N = chord.null_space;
   const core::Vector w = N.transpose() * normal;
@@ -411,73 +414,6 @@ double BranchPointDetector::Locator::null_cutoff() const {
   return options_.rank.relative_threshold * jacobian_scale_;
 }
 
-// A thread that runs tasks in the order they were pushed. wait() returns when every task pushed
-// has run, and rethrows the first exception a task threw (the later tasks still run: the branch
-// goes on and reports it when it asks). The destructor drops the tasks not begun.
-class BranchPointDetector::SerialQueue {
- public:
-  SerialQueue() : thread_([this] { run(); }) {}
-  ~SerialQueue() {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-  }
-  void push(std::function<void()> task) {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      tasks_.push_back(std::move(task));
-    }
-    wake_.notify_one();
-  }
-  void wait() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    idle_.wait(lock, [&] { return tasks_.empty() && !busy_; });
-    if (error_) std::rethrow_exception(error_);
-  }
-  void rethrow() {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (error_) std::rethrow_exception(error_);
-  }
-
- private:
-  void run() {
-    for (;;) {
-      std::function<void()> task;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        wake_.wait(lock, [&] { return stop_ || !tasks_.empty(); });
-        if (stop_) return;
-        task = std::move(tasks_.front());
-        tasks_.pop_front();
-        busy_ = true;
-      }
-      std::exception_ptr thrown;
-      try {
-        task();
-      } catch (...) {
-        thrown = std::current_exception();
-      }
-      {
-        const std::lock_guard<std::mutex> lock(mutex_);
-        if (thrown && !error_) error_ = thrown;
-        busy_ = false;
-      }
-      idle_.notify_all();
-    }
-  }
-
-  std::mutex mutex_;
-  std::condition_variable wake_;  // a task came, or stop
-  std::condition_variable idle_;  // a task ended
-  std::deque<std::function<void()>> tasks_;
-  bool busy_ = false, stop_ = false;
-  std::exception_ptr error_;
-  std::thread thread_;  // last: started once the rest exists
-};
-
 // What add() hands over: the point and its Jacobian in the loop's units of that moment.
 struct BranchPointDetector::Point {
   int index = 0;
@@ -500,8 +436,8 @@ BranchPointDetector::BranchPointDetector(const ScaledProblem& problem,
   worker_base_ = std::move(copy);
   worker_problem_ = std::make_unique<ScaledProblem>(*worker_base_, problem);
   locator_ = std::make_unique<Locator>(*worker_problem_, worker_problem_.get(), options, hooks);
-  locating_ = std::make_unique<SerialQueue>();
-  sampling_ = std::make_unique<SerialQueue>();
+  locating_ = std::make_unique<core::SerialQueue>();
+  sampling_ = std::make_unique<core::SerialQueue>();
 }
 
 BranchPointDetector::~BranchPointDetector() {
@@ -632,8 +568,8 @@ void BranchPointDetector::sample(Point p) {
 }
 
 bool BranchPointDetector::Locator::subspace_correct(const Chord& chord, const core::Vector& normal,
-                                           const core::Vector& anchor, core::Vector& y_io,
-                                           int max_differences) const {
+                                                    const core::Vector& anchor, core::Vector& y_io,
+                                                    int max_differences) const {
   // On failure y_io is left as it was.
   core::Vector y = y_io;
   const core::Matrix& N = chord.null_space;
@@ -902,8 +838,8 @@ void BranchPointDetector::Locator::locate(const std::vector<Sample>& polyline, b
     double smallest = std::min(std::abs(f_prev), std::abs(f_last));
     int stale = 0;
     bool left_range = false;
-    while (steps < o.max_location_steps && std::abs(s_last - s_prev) > o.location_tolerance && stale < 3 &&
-           !(std::abs(best_value) <= located_value)) {
+    while (steps < o.max_location_steps && std::abs(s_last - s_prev) > o.location_tolerance &&
+           stale < 3 && !(std::abs(best_value) <= located_value)) {
       double s = (s_prev * f_last - s_last * f_prev) / (f_last - f_prev);
       if (bracketed) {
         const double lo = std::min(s_prev, s_last), hi = std::max(s_prev, s_last);
@@ -1036,8 +972,8 @@ void BranchPointDetector::Locator::locate(const std::vector<Sample>& polyline, b
 }
 
 void BranchPointDetector::Locator::verify(BranchPointReport& report, const core::Vector& z,
-                                 const core::Vector& tangent, core::Matrix J,
-                                 const Chord* chord_of_j) {
+                                          const core::Vector& tangent, core::Matrix J,
+                                          const Chord* chord_of_j) {
   // z, tangent and J in the unit scale; the loop's problem in its current units.
   const core::Vector f = factor();
   report.x = z.cwiseProduct(problem_.unit_scale());
@@ -1121,9 +1057,10 @@ void BranchPointDetector::Locator::verify(BranchPointReport& report, const core:
     if (!okc && learned < 3) {
       // The probe needed fresh Jacobians: J(y) differs from J where the step crossed a kink of
       // F. Its leading right singular vectors (singular values above 1e-2 of the largest, at
-      // most three, of D = J(y) - J) are differenced at the next probes' starts. On the contact bar at 100 intervals D has one such direction, the same
-      // at every probe of a point (the period's column: its second singular value is 1e-5..
-      // 1e-2 of its first, 200..300 against |J| = 1.1e4).
+      // most three, of D = J(y) - J) are differenced at the next probes' starts. On the contact bar
+      // at 100 intervals D has one such direction, the same at every probe of a point (the period's
+      // column: its second singular value is 1e-5.. 1e-2 of its first, 200..300 against |J|
+      // = 1.1e4).
       ++learned;
       core::Matrix Jy;
       if (problem_.jacobian(y.cwiseQuotient(f), Jy) == core::EvalStatus::ok) {
