@@ -18,102 +18,17 @@
 #include "continuation/pseudo_arclength.hpp"
 #include "core/bordered_system.hpp"
 #include "core/eigen_newton.hpp"
+#include "core/few_singular_values.hpp"
 #include "core/job_queue.hpp"
 
 namespace backbone::continuation {
 
 namespace {
 
-// The smallest singular triplet of the tall matrix A (rows >= cols) from the triangular factor R
-// of A's Householder QR (sigma(R) = sigma(A)): a Krylov basis of inverse iteration on R^T R from
-// `start` (the reference's right vector: the triplet moves little between points), and the
-// Rayleigh-Ritz triplet of R on it (the smallest singular triplet of R K, K orthonormal).
-// Plain inverse iteration converges as (sigma_1 / sigma_2)^2 per step, which near a branch point
-// of the contact bar, where some twenty singular values vanish together, took the 200 steps
-// allowed and then the SVD; the Ritz triplet of the Krylov space resolves the smallest of the
-// cluster in a few tens of vectors. Measured on the 201 x 101 bordered matrix of the contact bar
-// at 100 intervals: the QR takes 0.34 ms where the thin SVD took 6 ms, and each vector two
-// triangular solves (~10 us). Converged when the triplet's residual |R^T u - sigma v| (a singular
-// value of A lies within it of sigma) is below 1e-4 sigma plus 1e-12 |A|_F: the location needs
-// the value to a few digits, and near a root the residual stalls at 1e-13..1e-12 |A|_F (the
-// round-off of the basis); false when it is not within 40 vectors (at the contact bar's located
-// points, sigma ~ 1e-9 inside a cluster: 6 of 83 calls): the caller falls back to the SVD.
-bool smallest_singular_triplet(const core::Matrix& A, const core::Vector& start, core::Vector& left,
-                               core::Vector& right, double& sigma) {
-  const Eigen::Index n = A.cols();
-  if (A.rows() < n || n == 0) return false;
-  const Eigen::HouseholderQR<core::Matrix> qr(A);
-  const core::Matrix R = qr.matrixQR().topRows(n).triangularView<Eigen::Upper>();
-  if (!(R.diagonal().cwiseAbs().minCoeff() > 0)) return false;
-  const double floor = 1e-12 * A.norm();
-  const Eigen::Index max_vectors = std::min<Eigen::Index>(n, 40);
-  core::Matrix K(n, max_vectors), RK(n, max_vectors);
-  core::Vector v =
-      start.size() == n && start.norm() > 0 ? core::Vector(start) : core::Vector::Ones(n);
-  Eigen::Index next_check = 1;
-  for (Eigen::Index j = 0; j < max_vectors; ++j) {
-    if (j > 0) {
-      // One step of inverse iteration on R^T R from the last basis vector.
-      v = R.transpose().triangularView<Eigen::Lower>().solve(K.col(j - 1));
-      v = R.triangularView<Eigen::Upper>().solve(v);
-    }
-    if (!v.allFinite()) return false;
-    const double before = v.norm();
-    for (int pass = 0; pass < 2; ++pass)  // classical Gram-Schmidt, twice
-      v -= K.leftCols(j) * (K.leftCols(j).transpose() * v);
-    const double norm = v.norm();
-    if (!(norm > 1e-12 * before)) return false;  // the space stopped growing: not expected
-    K.col(j) = v / norm;
-    RK.col(j) = R * K.col(j);
-    if (j + 1 != next_check && j + 1 != max_vectors) continue;
-    next_check = std::max<Eigen::Index>(next_check + 1, next_check * 3 / 2);
-    const Eigen::JacobiSVD<core::Matrix> small(RK.leftCols(j + 1),
-                                               Eigen::ComputeThinU | Eigen::ComputeThinV);
-    const Eigen::Index last = j;
-    sigma = small.singularValues()(last);
-    if (!(sigma > 0)) return false;
-    core::Vector candidate = K.leftCols(j + 1) * small.matrixV().col(last);
-    candidate.normalize();
-    const core::Vector Rv = R * candidate;
-    const double residual = (R.transpose() * (Rv / sigma) - sigma * candidate).norm();
-    if (residual <= 1e-4 * sigma + floor) {
-      right = candidate;
-      left = A * candidate / sigma;
-      return true;
-    }
-  }
-  return false;
-}
-
 // Forward-difference step for J's columns along unit directions at y (scaled unknowns): the
 // square root of the machine epsilon, relative to y's largest entry once that exceeds 1.
 double difference_step(const core::Vector& y) {
   return 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
-}
-
-// The `count` leading singular values (descending) and right singular vectors of A by subspace
-// iteration on A^T A with a block of count + 3 vectors (three steps from a fixed, deterministic
-// start, then the Ritz values of A on the block): O(m n) per step where an SVD or eigensolver
-// of A^T A is O(n^3) (1001 unknowns at 1000 intervals). The leading values wanted here stand
-// 1e2..1e5 above the rest (a kink's rank-one jump), so three steps resolve them to far more
-// than the 1e-2 they are compared at.
-void leading_right_singular(const core::Matrix& A, Eigen::Index count, core::Vector& sigma,
-                            core::Matrix& right) {
-  const Eigen::Index n = A.cols(), block = std::min<Eigen::Index>(n, count + 3);
-  core::Matrix X(n, block);
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (Eigen::Index j = 0; j < block; ++j)
-      X(i, j) =
-          std::cos(0.7 * static_cast<double>((i + 1) * (j + 1)) + 0.3 * static_cast<double>(j));
-  for (int step = 0; step < 3; ++step) {
-    const core::Matrix Y = A.transpose() * (A * X);
-    const Eigen::HouseholderQR<core::Matrix> qr(Y);
-    X = qr.householderQ() * core::Matrix::Identity(n, block);
-  }
-  const Eigen::JacobiSVD<core::Matrix> ritz(A * X, Eigen::ComputeThinV);
-  const Eigen::Index kept = std::min<Eigen::Index>(count, ritz.singularValues().size());
-  sigma = ritz.singularValues().head(kept);
-  right = X * ritz.matrixV().leftCols(kept);
 }
 
 }  // namespace
@@ -128,7 +43,7 @@ TestFunctionValue bordered_test_function(const core::Matrix& J, const core::Vect
   bordered.row(m) = tangent.normalized().transpose();
   const core::Vector start = reference ? reference->right : core::Vector();
   if (!iterate ||
-      !smallest_singular_triplet(bordered, start, result.left, result.right, result.value)) {
+      !core::smallest_singular_triplet(bordered, start, result.left, result.right, result.value)) {
     Eigen::BDCSVD<core::Matrix> svd(bordered, Eigen::ComputeThinU | Eigen::ComputeThinV);
     const Eigen::Index last = svd.singularValues().size() - 1;
     result.left = svd.matrixU().col(last);
@@ -1067,7 +982,7 @@ void BranchPointDetector::Locator::verify(BranchPointReport& report, const core:
         const core::Matrix D = in_unit_scale(Jy) - J;
         core::Vector sigma;
         core::Matrix directions;
-        leading_right_singular(D, 3, sigma, directions);
+        core::leading_right_singular(D, 3, sigma, directions);
         for (Eigen::Index j = 0; j < sigma.size(); ++j) {
           if (!(sigma(j) > 1e-2 * sigma(0) && sigma(j) > 1e-6 * J.norm())) break;
           if (kinks.cols() >= max_kinks) break;

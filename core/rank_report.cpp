@@ -12,6 +12,7 @@
 
 #include "core/bordered_system.hpp"
 #include "core/errors.hpp"
+#include "core/few_singular_values.hpp"
 #include "core/finite_difference.hpp"
 #include "core/sparse_least_squares.hpp"
 
@@ -81,177 +82,6 @@ void count_rank(RankReport& report, const RankOptions& options, Eigen::Index n) 
   }
 }
 
-// A fixed, well-spread start block (n x k): entries +-(1..2) (fixed_weight), orthonormalised.
-Matrix start_block(Eigen::Index n, Eigen::Index k) {
-  Matrix X(n, k);
-  for (Eigen::Index j = 0; j < k; ++j)
-    for (Eigen::Index i = 0; i < n; ++i)
-      X(i, j) = fixed_weight(static_cast<std::uint64_t>(j * n + i + 1));
-  const Eigen::HouseholderQR<Matrix> qr(X);
-  return qr.householderQ() * Matrix::Identity(n, k);
-}
-
-// A with A^T A = J^T J, the operator the iteration below works with: R of a Householder QR of J
-// (n x n), or, for a sparse J (sparse_least_squares.hpp), J itself with a sparse Cholesky
-// factor of J^T J + mu I for the inverse iteration (mu = 1e-10 of its largest diagonal entry:
-// the same eigenvectors, J^T J itself being singular wherever there is a null direction).
-struct TriangularGram {
-  Matrix r;
-  Eigen::Index rows() const { return r.rows(); }
-  Vector times(const Vector& v) const { return r.triangularView<Eigen::Upper>() * v; }
-  Matrix times(const Matrix& x) const { return r.triangularView<Eigen::Upper>() * x; }
-  Vector times_transpose(const Vector& u) const {
-    return r.triangularView<Eigen::Upper>().transpose() * u;
-  }
-  Matrix inverse_gram(const Matrix& x) const {
-    const auto upper = r.triangularView<Eigen::Upper>();
-    return upper.solve(Matrix(upper.transpose().solve(x)));
-  }
-};
-
-struct SparseGram {
-  Eigen::SparseMatrix<double> a;
-  NormalFactor factor;
-  Eigen::Index rows() const { return a.rows(); }
-  Vector times(const Vector& v) const { return a * v; }
-  Matrix times(const Matrix& x) const { return a * x; }
-  Vector times_transpose(const Vector& u) const { return a.transpose() * u; }
-  Matrix inverse_gram(const Matrix& x) const { return factor.solve(x); }
-};
-
-template <class Gram>
-bool smallest_singular_values(const Gram& gram, Eigen::Index n, const RankOptions& options,
-                              RankReport& report);
-
-// The smallest singular values of J (m >= n) and their right vectors, without a full SVD:
-// R from a Householder QR of J (J = QR, same singular values and right vectors), sigma_max by
-// Lanczos bidiagonalisation of R, the k smallest by block inverse iteration on R^T R (two
-// triangular solves per step, the block re-orthonormalised) with a Rayleigh-Ritz step (SVD of
-// the n x k R X) each time, converged when the span of the values at or below the threshold
-// and the smallest value above it stop moving (below). The block holds k = 8 to start and
-// doubles while the values at or below the threshold fill all but one of it, so that it always
-// holds one value above the threshold (sigma_kept and the gap). False (the caller takes the
-// full SVD) when R is singular to working precision, the block would exceed n / 2, or 60 steps
-// do not converge. Measured on the contact bar's mode 1 at N = 160 (321 x 161): 4-7 steps,
-// sigma_zero and sigma_kept within 3.4e-6 of the full SVD's (sigma_max's Lanczos estimate),
-// the same branch and dimensions; core/README.md, 'Rank reports'. A sparse J without dense
-// rows skips the QR: the products are J's, the inverse iteration a sparse Cholesky solve
-// (SparseGram); should that not converge, the QR is taken after all.
-bool smallest_singular_values(const Matrix& J, const RankOptions& options, RankReport& report) {
-  const Eigen::Index n = J.cols();
-  if (J.rows() < n || n < 4) return false;
-  {
-    // Sparse without dense rows (those would make J^T J dense): no QR at all.
-    SparseGram sparse;
-    std::vector<char> dense_row;
-    if (sparse_view(J, sparse.a, dense_row) &&
-        std::find(dense_row.begin(), dense_row.end(), 1) == dense_row.end() &&
-        factor_shifted_normal(sparse.a, sparse.factor) &&
-        smallest_singular_values(sparse, n, options, report))
-      return true;
-  }
-  const Eigen::HouseholderQR<Matrix> qr(J);
-  TriangularGram triangular{qr.matrixQR().topRows(n).triangularView<Eigen::Upper>()};
-  const double largest_pivot = triangular.r.diagonal().cwiseAbs().maxCoeff();
-  if (!(largest_pivot > 0) || !std::isfinite(largest_pivot) ||
-      !(triangular.r.diagonal().cwiseAbs().minCoeff() > 1e-15 * largest_pivot))
-    return false;
-  return smallest_singular_values(triangular, n, options, report);
-}
-
-template <class Gram>
-bool smallest_singular_values(const Gram& gram, Eigen::Index n, const RankOptions& options,
-                              RankReport& report) {
-  // sigma_max: Golub-Kahan-Lanczos bidiagonalisation of R (fully reorthogonalised), the largest
-  // singular value of its bidiagonal, until that moves by less than 1e-10 of itself (at most
-  // 60 steps; Lanczos finds the extreme values in a few tens of steps where power iteration on
-  // a clustered top of the spectrum took hundreds, and left 0.3 % on the contact bar).
-  double sigma_max = 0;
-  {
-    const int steps = static_cast<int>(std::min<Eigen::Index>(60, n));
-    Matrix V(n, steps + 1), U(gram.rows(), steps);
-    Vector alpha = Vector::Zero(steps), beta = Vector::Zero(steps);
-    V.col(0) = start_block(n, 1).col(0);
-    for (int j = 0; j < steps; ++j) {
-      Vector u = gram.times(Vector(V.col(j)));
-      if (j > 0) u -= beta[j - 1] * U.col(j - 1);
-      u -= U.leftCols(j) * (U.leftCols(j).transpose() * u);
-      alpha[j] = u.norm();
-      if (!(alpha[j] > 0) || !std::isfinite(alpha[j])) break;
-      U.col(j) = u / alpha[j];
-      Vector w = gram.times_transpose(Vector(U.col(j))) - alpha[j] * V.col(j);
-      w -= V.leftCols(j + 1) * (V.leftCols(j + 1).transpose() * w);
-      beta[j] = w.norm();
-      // The largest eigenvalue of the tridiagonal B^T B (B: alpha on the diagonal, beta above).
-      Vector diagonal(j + 1), off(j);
-      for (int i = 0; i <= j; ++i) {
-        diagonal[i] = alpha[i] * alpha[i] + (i > 0 ? beta[i - 1] * beta[i - 1] : 0.0);
-        if (i < j) off[i] = alpha[i] * beta[i];
-      }
-      Eigen::SelfAdjointEigenSolver<Matrix> tridiagonal;
-      tridiagonal.computeFromTridiagonal(diagonal, off, Eigen::EigenvaluesOnly);
-      const double estimate = std::sqrt(tridiagonal.eigenvalues()[j]);
-      const bool settled = std::abs(estimate - sigma_max) <= 1e-10 * estimate;
-      sigma_max = estimate;
-      if (settled || !(beta[j] > 1e-15 * estimate)) break;
-      V.col(j + 1) = w / beta[j];
-    }
-  }
-  if (!(sigma_max > 0) || !std::isfinite(sigma_max)) return false;
-  const double threshold =
-      std::max(options.relative_threshold * sigma_max, options.absolute_threshold);
-
-  for (Eigen::Index k = std::min<Eigen::Index>(8, n); 2 * k <= n; k *= 2) {
-    Matrix X = start_block(n, k);
-    bool converged = false, too_small = false;
-    Vector s;
-    Matrix W, previous_span;
-    int previous_below = -1;
-    double previous_kept = 0;
-    for (int step = 0; step < 60 && !converged; ++step) {
-      Matrix Y = gram.inverse_gram(X);
-      if (!Y.allFinite()) return false;
-      const Eigen::HouseholderQR<Matrix> block(Y);
-      X = block.householderQ() * Matrix::Identity(n, k);
-      const Eigen::JacobiSVD<Matrix> ritz(gram.times(X), Eigen::ComputeThinU | Eigen::ComputeThinV);
-      s = ritz.singularValues();
-      W = X * ritz.matrixV();
-      int below = 0;
-      for (Eigen::Index i = 0; i < k; ++i) below += s[i] <= threshold ? 1 : 0;
-      too_small = below >= k - 1;
-      if (too_small) break;
-      // The pairs that matter: those at or below the threshold (their span) and the smallest
-      // above it (its value). Converged when the span moves by a sine below 1e-10 between two
-      // steps and that value by 1e-10 of itself: each step shrinks the error of both by
-      // (s / sigma_{k+1})^2, so what is left is below that last move once the ratio is below
-      // 1/2 (the block is eight or more wide). (A residual test |R^T u - s w| does not work
-      // for the values at the finite-difference noise: u = R w / s divides R w's round-off,
-      // eps sigma_max, by s.)
-      const Eigen::Index kept = k - 1 - below;
-      const Matrix null_span = W.rightCols(below);
-      converged =
-          below == previous_below && previous_kept > 0 &&
-          std::abs(s[kept] - previous_kept) <= 1e-10 * s[kept] &&
-          (below == 0 || (previous_span - null_span * (null_span.transpose() * previous_span))
-                                 .colwise()
-                                 .norm()
-                                 .maxCoeff() <= 1e-10);
-      previous_below = below;
-      previous_kept = s[kept];
-      previous_span = null_span;
-    }
-    if (too_small) continue;
-    if (!converged) return false;
-    report.singular_values = Vector::Constant(n, std::numeric_limits<double>::quiet_NaN());
-    report.singular_values[0] = sigma_max;
-    report.singular_values.tail(k) = s;
-    count_rank(report, options, n);
-    report.null_directions = W.rightCols(report.nullity);
-    return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 RankReport rank_report(const Matrix& J, const RankOptions& options) {
@@ -259,7 +89,16 @@ RankReport rank_report(const Matrix& J, const RankOptions& options) {
   const Eigen::Index n = J.cols();
   RankReport report;
   report.relative_threshold = options.relative_threshold;
-  if (!options.full_spectrum && smallest_singular_values(J, options, report)) return report;
+  SmallestSingularValues few;
+  if (!options.full_spectrum &&
+      smallest_singular_values(J, options.relative_threshold, options.absolute_threshold, few)) {
+    report.singular_values = Vector::Constant(n, std::numeric_limits<double>::quiet_NaN());
+    report.singular_values[0] = few.largest;
+    report.singular_values.tail(few.values.size()) = few.values;
+    count_rank(report, options, n);
+    report.null_directions = few.right.rightCols(report.nullity);
+    return report;
+  }
   // Full V: for m < n the null space includes the n - m directions without a singular value.
   Eigen::BDCSVD<Matrix> svd(J, Eigen::ComputeFullV);
   report.singular_values = svd.singularValues();
@@ -345,8 +184,7 @@ Probe probe(const Problem& problem, const Vector& x, const Vector& d, double h,
   Vector y = stepped;
   Matrix nearby;
   const Matrix* base = start.jacobian();
-  const bool chord =
-      base && bordered.jacobian_with_base(stepped, *base, nearby) == EvalStatus::ok;
+  const bool chord = base && bordered.jacobian_with_base(stepped, *base, nearby) == EvalStatus::ok;
   const NewtonSummary s =
       chord ? corrector.solve(constrained, y, nearby) : corrector.solve(constrained, y);
   if (chord) start.record(s);
@@ -384,8 +222,7 @@ Probe known_neighbour(const Vector& x, const Vector& d, const Vector& z) {
 // Probes along +d, and along -d when +d finds no neighbour: at a point on the boundary of a
 // manifold (a grazing limit of a continuum) only one side holds solutions.
 Probe probe_either_side(const Problem& problem, const Vector& x, const Vector& d, double h,
-                        Corrector& corrector, const VerifyOptions& options,
-                        ChordStart& start) {
+                        Corrector& corrector, const VerifyOptions& options, ChordStart& start) {
   Probe forward = probe(problem, x, d, h, corrector, options, start);
   if (found_neighbour(forward, options)) return forward;
   Probe backward = probe(problem, x, d, -h, corrector, options, start);
