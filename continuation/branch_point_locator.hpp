@@ -127,7 +127,23 @@ class Locator {
                       const Chord* initial, const Evaluation* last, const Evaluation* near);
   // The chord of e's Jacobian, made on first use.
   const Chord& chord_of(const Evaluation& e) const;
+  // Locates the candidate bracketed by polyline's samples, verifies it, appends its report to
+  // found_. Its steps, on one Location: start_secant, secant_steps (when the start is a root
+  // finding one), minimise_modulus, verify_best.
+  struct Location;
+  struct Secant;
   void locate(const std::vector<Sample>& polyline, bool sign_change);
+  // evaluate() at s from what the location has (its chord, last and nearest evaluations).
+  Evaluation evaluate_at(Location& at, double s, const TestFunctionValue& reference);
+  // The secant iteration's start: a sign change's two samples, or a dip's smallest sample and
+  // an evaluation 1 % of the way to its smaller neighbour.
+  Secant start_secant(Location& at, bool sign_change);
+  // Secant steps, regula falsi once bracketed, until located or stalled.
+  void secant_steps(Location& at, Secant& secant, double located_value);
+  // V-fit and golden-section minimisation of |tau| around the smallest value seen.
+  void minimise_modulus(Location& at, double located_value);
+  // The report's location fields, then verify() at the best point.
+  void verify_best(Location& at, BranchPointReport& report);
   // chord_of_j: J's Chord when the location made it (nullptr: made here).
   void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,
               core::Matrix J, const Chord* chord_of_j = nullptr);
