@@ -16,6 +16,78 @@ double difference_step(const core::Vector& y) {
   return 1.5e-8 * std::max(1.0, y.lpNorm<Eigen::Infinity>());
 }
 
+// Secant updates of a chord matrix, B = J + A C^T (good Broyden, unit columns of C): the
+// contact bar's residual is piecewise affine in u0, and where a step crosses into another piece
+// its Jacobian differs from J by rank one (measured at the branch points of the contact bar at
+// 100 intervals: the difference's second singular value is 1e-3..1e-5 of its first), so one
+// update turns the chord into the piece's own matrix. PA = P A and RA = (I - J P) A, the part of
+// A outside J's range, are kept with them (P: J's pseudo-inverse, Chord::solve).
+struct SecantUpdates {
+  static constexpr int max_updates = 6;
+  SecantUpdates(Eigen::Index m, Eigen::Index n) : A(m, 0), C(n, 0), PA(n, 0), RA(m, 0) {}
+  // The update that makes B map the step dx onto the change of the residual r_previous -> r,
+  // unless B already does (to 1e-12 of that change).
+  void add(const Chord& chord, const core::Vector& dx, const core::Vector& r,
+           const core::Vector& r_previous);
+  // The step dx = -P (r + A theta) + N c with theta = C^T dx and normal . dx = -plane (w =
+  // N^T normal).
+  core::Vector step(const Chord& chord, const core::Vector& w, const core::Vector& normal,
+                    const core::Vector& r, double plane, double row_scale) const;
+  core::Matrix A, C, PA, RA;
+};
+
+void SecantUpdates::add(const Chord& chord, const core::Vector& dx, const core::Vector& r,
+                        const core::Vector& r_previous) {
+  const core::Matrix& J = chord.jacobian;
+  const double length = dx.norm();
+  if (!(length > 0)) return;
+  const core::Vector c = dx / length;
+  const core::Vector Bc = J * c + A * (C.transpose() * c);
+  const core::Vector a = (r - r_previous) / length - Bc;
+  if (!(a.norm() > 1e-12 * (r - r_previous).norm() / length)) return;
+  const Eigen::Index q = A.cols();
+  A.conservativeResize(Eigen::NoChange, q + 1);
+  C.conservativeResize(Eigen::NoChange, q + 1);
+  PA.conservativeResize(Eigen::NoChange, q + 1);
+  RA.conservativeResize(Eigen::NoChange, q + 1);
+  A.col(q) = a;
+  C.col(q) = c;
+  PA.col(q) = chord.solve(a);
+  RA.col(q) = a - J * PA.col(q);
+}
+
+core::Vector SecantUpdates::step(const Chord& chord, const core::Vector& w,
+                                 const core::Vector& normal, const core::Vector& r, double plane,
+                                 double row_scale) const {
+  const core::Matrix& J = chord.jacobian;
+  const core::Matrix& N = chord.null_space;
+  const Eigen::Index m = J.rows(), k = N.cols();
+  // The part of r + A theta outside J's range is made as small as it can be (rows scaled by
+  // 1/|J| to the others' units), and (theta, c) is the least-squares solution of least norm.
+  const core::Vector Pr = chord.solve(r);
+  const Eigen::Index q = A.cols();
+  core::Vector dx;
+  if (q == 0) {
+    dx = -Pr;
+    dx += N * (w * ((-plane - normal.dot(dx)) / w.squaredNorm()));
+    return dx;
+  }
+  core::Matrix S = core::Matrix::Zero(m + q + 1, q + k);
+  core::Vector rhs(m + q + 1);
+  S.topLeftCorner(m, q) = RA * row_scale;
+  rhs.head(m) = -(r - J * Pr) * row_scale;
+  S.block(m, 0, q, q) = core::Matrix::Identity(q, q) + C.transpose() * PA;
+  S.block(m, q, q, k) = -C.transpose() * N;
+  rhs.segment(m, q) = -C.transpose() * Pr;
+  S.block(m + q, 0, 1, q) = normal.transpose() * PA;
+  S.block(m + q, q, 1, k) = -w.transpose();
+  rhs(m + q) = plane - normal.dot(Pr);
+  const Eigen::CompleteOrthogonalDecomposition<core::Matrix> cod(S);
+  const core::Vector u = cod.solve(rhs);
+  dx = -Pr - PA * u.head(q) + N * u.tail(k);
+  return dx;
+}
+
 }  // namespace
 
 bool Locator::chord_correct(const Chord& chord, const core::Vector& normal,
@@ -28,15 +100,7 @@ bool Locator::chord_correct(const Chord& chord, const core::Vector& normal,
   const core::Vector f = factor();
   const core::Vector& rf = problem_.residual_factor();
   const double tolerance = options_.verification.corrector_options().residual_tolerance;
-  const Eigen::Index m = J.rows(), n = J.cols(), k = N.cols();
-  // Secant updates of the chord matrix, B = J + A C^T (good Broyden, unit columns of C): the
-  // contact bar's residual is piecewise affine in u0, and where a step crosses into another
-  // piece its Jacobian differs from J by rank one (measured at the branch points of the contact
-  // bar at 100 intervals: the difference's second singular value is 1e-3..1e-5 of its first),
-  // so one update turns the chord into the piece's own matrix. PA = P A and RA = (I - J P) A,
-  // the part of A outside J's range, are kept with them.
-  constexpr int max_updates = 6;
-  core::Matrix A(m, 0), C(n, 0), PA(n, 0), RA(m, 0);
+  SecantUpdates updates(J.rows(), J.cols());
   const double row_scale = 1.0 / std::max(J.norm(), std::numeric_limits<double>::min());
   // On failure y is left at the iterate with the smallest residual (a start for a corrector).
   core::Vector best = y;
@@ -62,68 +126,39 @@ bool Locator::chord_correct(const Chord& chord, const core::Vector& normal,
       best_norm = norm;
     }
     if (iteration == 0 && kinks && kinks->cols() > 0) {
-      // J's columns along the kink directions, differenced at the start (one residual each).
-      const double h = difference_step(y);
-      const Eigen::Index q = kinks->cols();
-      A.resize(m, q);
-      for (Eigen::Index i = 0; i < q; ++i) {
-        core::Vector ri;
-        if (problem_.residual((y + h * kinks->col(i)).cwiseQuotient(f), ri) != core::EvalStatus::ok)
-          return false;
-        if (rf.size() > 0) ri = ri.cwiseProduct(rf);
-        A.col(i) = (ri - r) / h - J * kinks->col(i);
-      }
-      C = *kinks;
-      PA = chord.solve(A);
-      RA = A - J * PA;
-    } else if (iteration > 0 && A.cols() < max_updates) {
-      const double length = dx.norm();
-      if (length > 0) {
-        const core::Vector c = dx / length;
-        const core::Vector Bc = J * c + A * (C.transpose() * c);
-        const core::Vector a = (r - r_previous) / length - Bc;
-        if (a.norm() > 1e-12 * (r - r_previous).norm() / length) {
-          const Eigen::Index q = A.cols();
-          A.conservativeResize(Eigen::NoChange, q + 1);
-          C.conservativeResize(Eigen::NoChange, q + 1);
-          PA.conservativeResize(Eigen::NoChange, q + 1);
-          RA.conservativeResize(Eigen::NoChange, q + 1);
-          A.col(q) = a;
-          C.col(q) = c;
-          PA.col(q) = chord.solve(a);
-          RA.col(q) = a - J * PA.col(q);
-        }
-      }
+      if (!difference_kinks(chord, *kinks, y, r, updates.A)) return false;
+      updates.C = *kinks;
+      updates.PA = chord.solve(updates.A);
+      updates.RA = updates.A - J * updates.PA;
+    } else if (iteration > 0 && updates.A.cols() < SecantUpdates::max_updates) {
+      updates.add(chord, dx, r, r_previous);
     }
-    // The step dx = -P (r + A theta) + N c with theta = C^T dx and normal . dx = -plane; the
-    // part of r + A theta outside J's range is made as small as it can be (rows scaled by 1/|J|
-    // to the others' units), and (theta, c) is the least-squares solution of least norm.
-    const core::Vector Pr = chord.solve(r);
-    const Eigen::Index q = A.cols();
-    if (q == 0) {
-      dx = -Pr;
-      dx += N * (w * ((-plane - normal.dot(dx)) / w.squaredNorm()));
-    } else {
-      core::Matrix S = core::Matrix::Zero(m + q + 1, q + k);
-      core::Vector rhs(m + q + 1);
-      S.topLeftCorner(m, q) = RA * row_scale;
-      rhs.head(m) = -(r - J * Pr) * row_scale;
-      S.block(m, 0, q, q) = core::Matrix::Identity(q, q) + C.transpose() * PA;
-      S.block(m, q, q, k) = -C.transpose() * N;
-      rhs.segment(m, q) = -C.transpose() * Pr;
-      S.block(m + q, 0, 1, q) = normal.transpose() * PA;
-      S.block(m + q, q, 1, k) = -w.transpose();
-      rhs(m + q) = plane - normal.dot(Pr);
-      const Eigen::CompleteOrthogonalDecomposition<core::Matrix> cod(S);
-      const core::Vector u = cod.solve(rhs);
-      dx = -Pr - PA * u.head(q) + N * u.tail(k);
-    }
+    dx = updates.step(chord, w, normal, r, plane, row_scale);
     r_previous = r;
     y += dx;
     if (!y.allFinite()) break;
   }
   y = best;
   return false;
+}
+
+bool Locator::difference_kinks(const Chord& chord, const core::Matrix& kinks, const core::Vector& y,
+                               const core::Vector& r, core::Matrix& A) const {
+  // J's columns along the kink directions, differenced at y (one residual each), less J's own.
+  const core::Matrix& J = chord.jacobian;
+  const core::Vector f = factor();
+  const core::Vector& rf = problem_.residual_factor();
+  const double h = difference_step(y);
+  const Eigen::Index q = kinks.cols();
+  A.resize(J.rows(), q);
+  for (Eigen::Index i = 0; i < q; ++i) {
+    core::Vector ri;
+    if (problem_.residual((y + h * kinks.col(i)).cwiseQuotient(f), ri) != core::EvalStatus::ok)
+      return false;
+    if (rf.size() > 0) ri = ri.cwiseProduct(rf);
+    A.col(i) = (ri - r) / h - J * kinks.col(i);
+  }
+  return true;
 }
 
 bool Locator::subspace_correct(const Chord& chord, const core::Vector& normal,

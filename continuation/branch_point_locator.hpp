@@ -112,6 +112,10 @@ class Locator {
   // verifier's corrector tolerance.
   bool chord_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
                      core::Vector& y, const core::Matrix* kinks = nullptr) const;
+  // A = J's columns along the kinks, differenced at y (F(y) = r in the unit scale), less J's
+  // own: the start of chord_correct's secant updates. False when a residual fails.
+  bool difference_kinks(const Chord& chord, const core::Matrix& kinks, const core::Vector& y,
+                        const core::Vector& r, core::Matrix& A) const;
   // Gauss-Newton on J with its columns along J's null space N re-differenced at an iterate
   // (N.cols() residuals instead of a Jacobian's n), kept while its steps halve |F| (one residual
   // each), onto the same constraints; at most max_differences differencings.
@@ -144,9 +148,22 @@ class Locator {
   void minimise_modulus(Location& at, double located_value);
   // The report's location fields, then verify() at the best point.
   void verify_best(Location& at, BranchPointReport& report);
-  // chord_of_j: J's Chord when the location made it (nullptr: made here).
+  // Verifies the located point z (its tangent and J, empty: evaluated here) and fills report's
+  // verification fields (branch_point_verify.cpp). chord_of_j: J's Chord when the location made
+  // it (nullptr: made here).
   void verify(BranchPointReport& report, const core::Vector& z, const core::Vector& tangent,
               core::Matrix J, const Chord* chord_of_j = nullptr);
+  // Its steps. The rank report of J (report.nullity) and the orthonormal directions of its
+  // candidate null space beyond the tangent t, the first `candidates` of which are probed.
+  core::Matrix directions_beyond(const core::Matrix& J, const core::Vector& t,
+                                 BranchPointReport& report, int& candidates) const;
+  struct Probing;
+  // One probe from stepped (z + h d) onto the hyperplane through it orthogonal to d: y, and
+  // whether the chord steps alone finished it. False when no corrector converged.
+  bool probe(const Chord& chord, const core::Vector& d, const core::Vector& stepped,
+             Probing& probing, core::Vector& y, bool& by_chord) const;
+  // Adds to kinks the directions along which J(y) differs from J.
+  void learn_kinks(const core::Vector& y, const core::Matrix& J, core::Matrix& kinks) const;
 
   const ScaledProblem& problem_;
   ScaledProblem* own_;
