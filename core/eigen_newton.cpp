@@ -128,6 +128,64 @@ bool chord_step_pays(double norm2, const Vector& trial_r, const NewtonOptions& o
   return rate <= 0.5 &&
          trial_r.lpNorm<Eigen::Infinity>() * std::pow(rate, 6) <= options.residual_tolerance;
 }
+
+// Scaled length of the step alpha dx from x: max_j |alpha dx_j| / max(|x_j|, typical scale_j).
+double scaled_step_length(const Vector& dx, double alpha, const Vector& x, const Vector& scale) {
+  double scaled_step = 0;
+  for (Eigen::Index j = 0; j < x.size(); ++j)
+    scaled_step = std::max(scaled_step,
+                           std::abs(alpha * dx[j]) / std::max({std::abs(x[j]), scale[j], 1e-300}));
+  return scaled_step;
+}
+
+// A chord step from x on the kept factorization: taken (x and r moved, its scaled length in
+// scaled_step) when it can be evaluated and pays (chord_step_pays); else x and r stay.
+bool chord_step(const Problem& problem, LeastSquares& factorization, const NewtonOptions& options,
+                const Vector& scale, double norm2, Vector& x, Vector& r, Vector& dx,
+                Vector& trial_x, Vector& trial_r, double& scaled_step) {
+  const int rank = factorization.solve(-r, dx);
+  trial_x = x + dx;
+  if (!(rank > 0 && dx.allFinite() && problem.residual(trial_x, trial_r) == EvalStatus::ok &&
+        chord_step_pays(norm2, trial_r, options)))
+    return false;
+  scaled_step = scaled_step_length(dx, 1.0, x, scale);
+  x.swap(trial_x);
+  r.swap(trial_r);
+  return true;
+}
+
+// The backtracking line search along dx from x (|F(x)|_2 = norm2): alpha halves until the
+// Armijo condition holds (at most 30 times); without options.line_search, the full step only.
+struct LineSearch {
+  double alpha = 1.0;
+  bool accepted = false;                     // trial_x = x + alpha dx, trial_r = F(trial_x)
+  EvalStatus last_failure = EvalStatus::ok;  // of the last residual that failed
+  bool failed_full_step = false;             // without line search: F(x + dx) failed (last_failure)
+};
+
+LineSearch line_search(const Problem& problem, const NewtonOptions& options, const Vector& x,
+                       const Vector& dx, double norm2, Vector& trial_x, Vector& trial_r) {
+  constexpr double armijo = 1e-4;
+  constexpr int max_halvings = 30;
+  LineSearch out;
+  for (int halving = 0; halving <= (options.line_search ? max_halvings : 0); ++halving) {
+    trial_x = x + out.alpha * dx;
+    const EvalStatus s = problem.residual(trial_x, trial_r);
+    if (s == EvalStatus::ok &&
+        (!options.line_search || trial_r.norm() <= (1.0 - armijo * out.alpha) * norm2)) {
+      out.accepted = true;
+      break;
+    }
+    if (s != EvalStatus::ok) out.last_failure = s;
+    if (!options.line_search && s != EvalStatus::ok) {
+      out.failed_full_step = true;
+      return out;
+    }
+    out.alpha *= 0.5;
+  }
+  return out;
+}
+
 }  // namespace
 
 int minimum_norm_solve(const Matrix& J, const Vector& rhs, double rank_cutoff, Vector& dx) {
@@ -187,40 +245,29 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     chord = true;
   }
   Vector dx, trial_x, trial_r;
-  constexpr double armijo = 1e-4;
-  constexpr int max_halvings = 30;
 
   for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
     summary.iterations = iteration;
     const double norm2 = r.norm();
-    // Chord step: the factorization of an earlier Jacobian, kept while it contracts.
-    if (have_factorization && chord) {
-      const int rank = factorization.solve(-r, dx);
-      trial_x = x + dx;
-      if (rank > 0 && dx.allFinite() && problem.residual(trial_x, trial_r) == EvalStatus::ok &&
-          chord_step_pays(norm2, trial_r, options_)) {
-        double scaled_step = 0;
-        for (Eigen::Index j = 0; j < x.size(); ++j)
-          scaled_step =
-              std::max(scaled_step, std::abs(dx[j]) / std::max({std::abs(x[j]), scale[j], 1e-300}));
-        x.swap(trial_x);
-        r.swap(trial_r);
-        ++summary.chord_steps;
-        summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
-        if (summary.residual_history.back() <= options_.residual_tolerance)
-          return finish(
-              NewtonStatus::converged,
-              fmt::format("eigen: converged in {} iterations ({} chord), ||F||_inf "
-                          "= {:.3e}",
-                          iteration, summary.chord_steps, summary.residual_history.back()));
-        if (scaled_step <= options_.step_tolerance)
-          return finish(NewtonStatus::stalled,
-                        fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
-                                    "{}, ||F||_inf = {:.3e}",
-                                    scaled_step, iteration, summary.residual_history.back()));
-        continue;
-      }
-      // Too slow (or not evaluable): a fresh Jacobian at x, in this same iteration.
+    // Chord step: the factorization of an earlier Jacobian, kept while it contracts. Too slow
+    // (or not evaluable): a fresh Jacobian at x, in this same iteration.
+    double scaled_step = 0;
+    if (have_factorization && chord &&
+        chord_step(problem, factorization, options_, scale, norm2, x, r, dx, trial_x, trial_r,
+                   scaled_step)) {
+      ++summary.chord_steps;
+      summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
+      if (summary.residual_history.back() <= options_.residual_tolerance)
+        return finish(NewtonStatus::converged,
+                      fmt::format("eigen: converged in {} iterations ({} chord), ||F||_inf "
+                                  "= {:.3e}",
+                                  iteration, summary.chord_steps, summary.residual_history.back()));
+      if (scaled_step <= options_.step_tolerance)
+        return finish(NewtonStatus::stalled,
+                      fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
+                                  "{}, ||F||_inf = {:.3e}",
+                                  scaled_step, iteration, summary.residual_history.back()));
+      continue;
     }
     {
       const CorrectorJacobians loose(options_.jacobian_check_tolerance);
@@ -237,38 +284,23 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
       return finish(NewtonStatus::linear_solver_failed,
                     fmt::format("eigen: non-finite Newton step at iteration {}", iteration));
 
-    double alpha = 1.0;
-    bool accepted = false;
-    EvalStatus last_failure = EvalStatus::ok;
-    for (int halving = 0; halving <= (options_.line_search ? max_halvings : 0); ++halving) {
-      trial_x = x + alpha * dx;
-      const EvalStatus s = problem.residual(trial_x, trial_r);
-      if (s == EvalStatus::ok &&
-          (!options_.line_search || trial_r.norm() <= (1.0 - armijo * alpha) * norm2)) {
-        accepted = true;
-        break;
-      }
-      if (s != EvalStatus::ok) last_failure = s;
-      if (!options_.line_search && s != EvalStatus::ok)
-        return finish(NewtonStatus::evaluation_failed,
-                      fmt::format("eigen: residual at iteration {}: {}", iteration, to_string(s)));
-      alpha *= 0.5;
-    }
+    const LineSearch search = line_search(problem, options_, x, dx, norm2, trial_x, trial_r);
+    if (search.failed_full_step)
+      return finish(NewtonStatus::evaluation_failed,
+                    fmt::format("eigen: residual at iteration {}: {}", iteration,
+                                to_string(search.last_failure)));
     // Scaled step length: relative to max(|x_j|, typical scale_j).
-    double scaled_step = 0;
-    for (Eigen::Index j = 0; j < x.size(); ++j)
-      scaled_step = std::max(
-          scaled_step, std::abs(alpha * dx[j]) / std::max({std::abs(x[j]), scale[j], 1e-300}));
-    if (!accepted) {
+    scaled_step = scaled_step_length(dx, search.alpha, x, scale);
+    if (!search.accepted) {
       if (scaled_step <= options_.step_tolerance || rank == 0)
         return finish(NewtonStatus::stalled,
                       fmt::format("eigen: stalled at iteration {} (rank {}), ||F||_inf = {:.3e}",
                                   iteration, rank, summary.residual_history.back()));
-      if (last_failure != EvalStatus::ok)
+      if (search.last_failure != EvalStatus::ok)
         return finish(NewtonStatus::evaluation_failed,
                       fmt::format("eigen: line search found no evaluable point at iteration "
                                   "{} ({})",
-                                  iteration, to_string(last_failure)));
+                                  iteration, to_string(search.last_failure)));
       return finish(NewtonStatus::diverged,
                     fmt::format("eigen: line search failed at iteration {}, ||F||_inf = {:.3e}",
                                 iteration, summary.residual_history.back()));
