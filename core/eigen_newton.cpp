@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "core/compressed_jacobian.hpp"
 #include "core/sparse_least_squares.hpp"
@@ -186,6 +187,53 @@ LineSearch line_search(const Problem& problem, const NewtonOptions& options, con
   return out;
 }
 
+// How a solve ends after a step (the history's last entry: ||F||_inf at the new x): converged,
+// stalled on a scaled step below step_tolerance, or not yet (nullopt). chord: the step was a
+// chord step (the message counts them).
+struct StepEnd {
+  NewtonStatus status;
+  std::string message;
+};
+
+std::optional<StepEnd> after_step(const NewtonSummary& summary, const NewtonOptions& options,
+                                  double scaled_step, int iteration, bool chord) {
+  const double norm = summary.residual_history.back();
+  if (norm <= options.residual_tolerance)
+    return StepEnd{NewtonStatus::converged,
+                   chord ? fmt::format("eigen: converged in {} iterations ({} chord), ||F||_inf "
+                                       "= {:.3e}",
+                                       iteration, summary.chord_steps, norm)
+                         : fmt::format("eigen: converged in {} iterations, ||F||_inf = {:.3e}",
+                                       iteration, norm)};
+  if (scaled_step <= options.step_tolerance)
+    return StepEnd{NewtonStatus::stalled,
+                   fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
+                               "{}, ||F||_inf = {:.3e}",
+                               scaled_step, iteration, norm)};
+  return std::nullopt;
+}
+
+// The start of a solve: F(x) into r and its norm into the history; an end when x does not fit
+// the problem, F(x) fails, or x already converged.
+std::optional<StepEnd> start_solve(const Problem& problem, const Vector& x,
+                                   const NewtonOptions& options, Vector& r,
+                                   NewtonSummary& summary) {
+  if (x.size() != problem.num_unknowns())
+    return StepEnd{NewtonStatus::evaluation_failed,
+                   fmt::format("eigen: starting point has {} entries, problem has {} unknowns",
+                               x.size(), problem.num_unknowns())};
+  const EvalStatus eval = problem.residual(x, r);
+  if (eval != EvalStatus::ok)
+    return StepEnd{NewtonStatus::evaluation_failed,
+                   fmt::format("eigen: residual at the starting point: {}", to_string(eval))};
+  summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
+  if (summary.residual_history.back() <= options.residual_tolerance)
+    return StepEnd{NewtonStatus::converged,
+                   fmt::format("eigen: starting point already converged, ||F||_inf = {:.3e}",
+                               summary.residual_history.back())};
+  return std::nullopt;
+}
+
 }  // namespace
 
 int minimum_norm_solve(const Matrix& J, const Vector& rhs, double rank_cutoff, Vector& dx) {
@@ -214,21 +262,9 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     return recorder.finish(summary, status, std::move(message));
   };
 
-  if (x.size() != problem.num_unknowns())
-    return finish(NewtonStatus::evaluation_failed,
-                  fmt::format("eigen: starting point has {} entries, problem has {} unknowns",
-                              x.size(), problem.num_unknowns()));
-
   Vector r;
-  EvalStatus eval = problem.residual(x, r);
-  if (eval != EvalStatus::ok)
-    return finish(NewtonStatus::evaluation_failed,
-                  fmt::format("eigen: residual at the starting point: {}", to_string(eval)));
-  summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
-  if (summary.residual_history.back() <= options_.residual_tolerance)
-    return finish(NewtonStatus::converged,
-                  fmt::format("eigen: starting point already converged, ||F||_inf = {:.3e}",
-                              summary.residual_history.back()));
+  if (const std::optional<StepEnd> end = start_solve(problem, x, options_, r, summary))
+    return finish(end->status, end->message);
 
   const Vector scale = problem.typical_scale().cwiseAbs();
   Matrix J;
@@ -257,18 +293,12 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
                    scaled_step)) {
       ++summary.chord_steps;
       summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
-      if (summary.residual_history.back() <= options_.residual_tolerance)
-        return finish(NewtonStatus::converged,
-                      fmt::format("eigen: converged in {} iterations ({} chord), ||F||_inf "
-                                  "= {:.3e}",
-                                  iteration, summary.chord_steps, summary.residual_history.back()));
-      if (scaled_step <= options_.step_tolerance)
-        return finish(NewtonStatus::stalled,
-                      fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
-                                  "{}, ||F||_inf = {:.3e}",
-                                  scaled_step, iteration, summary.residual_history.back()));
+      if (const std::optional<StepEnd> end =
+              after_step(summary, options_, scaled_step, iteration, true))
+        return finish(end->status, end->message);
       continue;
     }
+    EvalStatus eval;
     {
       const CorrectorJacobians loose(options_.jacobian_check_tolerance);
       eval = problem.jacobian(x, J);
@@ -308,15 +338,9 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     x.swap(trial_x);
     r.swap(trial_r);
     summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
-    if (summary.residual_history.back() <= options_.residual_tolerance)
-      return finish(NewtonStatus::converged,
-                    fmt::format("eigen: converged in {} iterations, ||F||_inf = {:.3e}", iteration,
-                                summary.residual_history.back()));
-    if (scaled_step <= options_.step_tolerance)
-      return finish(NewtonStatus::stalled,
-                    fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
-                                "{}, ||F||_inf = {:.3e}",
-                                scaled_step, iteration, summary.residual_history.back()));
+    if (const std::optional<StepEnd> end =
+            after_step(summary, options_, scaled_step, iteration, false))
+      return finish(end->status, end->message);
   }
   return finish(NewtonStatus::max_iterations,
                 fmt::format("eigen: no convergence in {} iterations, ||F||_inf = {:.3e}",
