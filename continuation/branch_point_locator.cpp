@@ -16,9 +16,9 @@ Locator::Locator(const ScaledProblem& problem, ScaledProblem* own,
     : problem_(problem), own_(own), options_(options), hooks_(hooks) {
   // What the chord steps leave is finished by Gauss-Newton that keeps its Jacobian while it
   // contracts (core::NewtonOptions::reuse_jacobian), to the verifier's tolerance: a located
-  // point's correction within max_iterations 10, a probe's within 5 (the probes that converged
-  // on the contact bar at 100 intervals took at most 4 iterations of the loop's corrector; the
-  // ones that did not, 6 to 10).
+  // point's correction within max_iterations 10, a probe's within 5 (the probes that converge
+  // on the contact bar at 100 intervals take at most 4 iterations of the loop's corrector; the
+  // ones that do not, 6 to 10).
   core::NewtonOptions newton = options.verification.corrector_options();
   newton.reuse_jacobian = true;
   newton.max_iterations = 10;

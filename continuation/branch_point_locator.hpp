@@ -44,7 +44,7 @@ inline core::Matrix jacobian_in_unit_scale(const core::Matrix& J, const core::Ve
 // of the branch is close to its tangent, which is in N. One residual per step.
 // The rank is revealed by a complete orthogonal decomposition (column-pivoted QR, then a QR of
 // the kept rows: J P = Q [T 0; 0 0] Z), pivots below cutoff counting as zero: 0.34 ms for the
-// 200 x 101 Jacobian of the contact bar at 100 intervals where the thin SVD took 6 ms.
+// 200 x 101 Jacobian of the contact bar at 100 intervals where the thin SVD takes 6 ms.
 struct Chord {
   core::Matrix jacobian;  // J itself
   Eigen::CompleteOrthogonalDecomposition<core::Matrix> cod;

@@ -14,20 +14,20 @@
 
 namespace backbone::core {
 
-// The smallest singular triplet of the tall matrix A (rows >= cols) from the triangular factor R
-// of A's Householder QR (sigma(R) = sigma(A)): a Krylov basis of inverse iteration on R^T R from
+// The smallest singular triplet of the tall matrix A (rows >= cols) from the triangular factor R of
+// A's Householder QR (sigma(R) = sigma(A)): a Krylov basis of inverse iteration on R^T R from
 // `start` (the reference's right vector: the triplet moves little between points), and the
-// Rayleigh-Ritz triplet of R on it (the smallest singular triplet of R K, K orthonormal).
-// Plain inverse iteration converges as (sigma_1 / sigma_2)^2 per step, which near a branch point
-// of the contact bar, where some twenty singular values vanish together, took the 200 steps
-// allowed and then the SVD; the Ritz triplet of the Krylov space resolves the smallest of the
-// cluster in a few tens of vectors. Measured on the 201 x 101 bordered matrix of the contact bar
-// at 100 intervals: the QR takes 0.34 ms where the thin SVD took 6 ms, and each vector two
-// triangular solves (~10 us). Converged when the triplet's residual |R^T u - sigma v| (a singular
-// value of A lies within it of sigma) is below 1e-4 sigma plus 1e-12 |A|_F: the location needs
-// the value to a few digits, and near a root the residual stalls at 1e-13..1e-12 |A|_F (the
-// round-off of the basis); false when it is not within 40 vectors (at the contact bar's located
-// points, sigma ~ 1e-9 inside a cluster: 6 of 83 calls): the caller falls back to the SVD.
+// Rayleigh-Ritz triplet of R on it (the smallest singular triplet of R K, K orthonormal). Plain
+// inverse iteration converges as (sigma_1 / sigma_2)^2 per step, which near a branch point of the
+// contact bar, where some twenty singular values vanish together, needs hundreds of steps; the Ritz
+// triplet of the Krylov space resolves the smallest of the cluster in a few tens of vectors.
+// Measured on the 201 x 101 bordered matrix of the contact bar at 100 intervals: the QR takes 0.34
+// ms where the thin SVD takes 6 ms, and each vector two triangular solves (~10 us). Converged when
+// the triplet's residual |R^T u - sigma v| (a singular value of A lies within it of sigma) is below
+// 1e-4 sigma plus 1e-12 |A|_F: the location needs the value to a few digits, and near a root the
+// residual stalls at 1e-13..1e-12 |A|_F (the round-off of the basis); false when it is not within
+// 40 vectors (at the contact bar's located points, sigma ~ 1e-9 inside a cluster: 6 of 83 calls):
+// the caller falls back to the SVD.
 bool smallest_singular_triplet(const Matrix& A, const Vector& start, Vector& left, Vector& right,
                                double& sigma) {
   const Eigen::Index n = A.cols();
@@ -120,7 +120,7 @@ double largest_singular_value(const Gram& gram, Eigen::Index n) {
   // Golub-Kahan-Lanczos bidiagonalisation of R (fully reorthogonalised), the largest
   // singular value of its bidiagonal, until that moves by less than 1e-10 of itself (at most
   // 60 steps; Lanczos finds the extreme values in a few tens of steps where power iteration on
-  // a clustered top of the spectrum took hundreds, and left 0.3 % on the contact bar).
+  // a clustered top of the spectrum takes hundreds, and leaves 0.3 % on the contact bar).
   double sigma_max = 0;
   {
     const int steps = static_cast<int>(std::min<Eigen::Index>(60, n));

@@ -59,7 +59,7 @@ struct Probe {
 // the correction) at iterates farther than `radius` from x. A probe's end is used only within
 // |h| / drift_ratio of x (found_neighbour needs it within drift_ratio |h| of the stepped point,
 // and the rotation takes secants up to 1 / drift_ratio long): a correction that has wandered
-// beyond that is not expected back, and its further Jacobians were most of the cost of a
+// beyond that is not expected back, and its further Jacobians are most of the cost of a
 // rank report on a many-dimensional family (core/README.md, 'Rank reports'). Residuals (line
 // searches, chord steps) stay allowed.
 class ProbeRegion : public Problem {
