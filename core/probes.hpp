@@ -19,6 +19,7 @@
 #include <memory>
 
 #include "core/newton.hpp"
+#include "core/problem.hpp"
 #include "core/types.hpp"
 
 namespace backbone::core {
