@@ -56,7 +56,15 @@
 #include "core/newton.hpp"
 #include "core/rank_report.hpp"
 
+namespace backbone::core {
+class SerialQueue;  // core/job_queue.hpp
+}  // namespace backbone::core
+
 namespace backbone::continuation {
+
+namespace branch_point {
+class Locator;  // locates and verifies one candidate (branch_point_locator.hpp)
+}  // namespace branch_point
 
 // The signed test function at one point, with the singular vectors that fix its sign.
 struct TestFunctionValue {
@@ -118,12 +126,7 @@ class BranchPointDetector {
 
  private:
   using Sample = TestFunctionSample;
-  struct Evaluation;
-  struct Chord;
-  class Locator;      // locates and verifies one candidate (branch_points.cpp)
-  struct Job;         // what it needs of the detector: the bracket's samples, J, the units then
-  struct Point;       // what add() hands over: the point, its J, the units then
-  class SerialQueue;  // a thread that runs tasks in order
+  struct Point;  // what add() hands over: the point, its J, the units then
   // The test function at the point, and the brackets it closes (submit): on the sampling thread,
   // or here without one.
   void sample(Point p);
@@ -146,9 +149,9 @@ class BranchPointDetector {
   // sampling thread, which pushes onto the locating one, stops first.
   std::unique_ptr<core::Problem> worker_base_;
   std::unique_ptr<ScaledProblem> worker_problem_;
-  std::unique_ptr<Locator> locator_;
-  std::unique_ptr<SerialQueue> locating_;
-  std::unique_ptr<SerialQueue> sampling_;
+  std::unique_ptr<branch_point::Locator> locator_;  // branch_point_locator.hpp
+  std::unique_ptr<core::SerialQueue> locating_;
+  std::unique_ptr<core::SerialQueue> sampling_;
 };
 
 }  // namespace backbone::continuation

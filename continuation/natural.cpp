@@ -47,77 +47,101 @@ core::BorderRow parameter_row(const core::Problem& problem, const NaturalParamet
 
 namespace {
 
+// What the natural loop carries from one step to the next: the point, its parameter value and
+// the next step, and the point and parameter step before it (the secant predictor).
+struct NaturalState {
+  core::Vector x;
+  double lambda = 0;
+  double ds = 0;
+  core::Vector previous;
+  double previous_step = 0;
+};
+
+// The state the next step starts from, saved with each point for a restart.
+std::shared_ptr<LoopState> saved_state(const core::Vector& z, double value,
+                                       const core::Vector& before, double step, double next_ds) {
+  auto state = std::make_shared<LoopState>();
+  state->method = Method::natural;
+  state->z = z;
+  state->lambda = value;
+  state->previous = before;
+  state->previous_step = step;
+  state->ds = next_ds;
+  return state;
+}
+
+// The parameter in the problem's units, for messages.
+double in_units(const ScaledProblem& problem, const NaturalParameter& parameter, double lambda) {
+  return parameter.kind == NaturalParameter::Kind::unknown
+             ? lambda * problem.scale()[parameter.index]
+             : lambda;
+}
+
+// dx/dlambda for the predictor: tangent of the curve scaled so that dp = 1, or the secant; zero
+// (the last point as the prediction) for neither or where the tangent cannot be solved for.
+core::Vector predictor_rate(const ParameterConstraintSystem& system, const NaturalState& s,
+                            const ContinuationOptions& options, int n) {
+  core::Vector rate = core::Vector::Zero(n);
+  if (options.predictor == Predictor::secant && s.previous_step != 0) {
+    rate = (s.x - s.previous) / s.previous_step;
+  } else if (options.predictor == Predictor::tangent) {
+    core::Matrix J;
+    if (system.jacobian(s.x, J) == core::EvalStatus::ok) {
+      // dF/dx . rate = 0, dp/dx . rate = 1: the last of J's rows (m + 1 >= n of them; least
+      // squares when the system is overdetermined).
+      core::Vector rhs = core::Vector::Zero(J.rows());
+      rhs[J.rows() - 1] = 1.0;
+      core::Vector candidate = J.colPivHouseholderQr().solve(rhs);
+      if (candidate.allFinite()) rate = candidate;
+    }
+  }
+  return rate;
+}
+
 // The loop proper, in the scaled unknowns z of `problem` (in_scaled_unknowns): an unknown
 // parameter is then z_index, stepped by ds (ds times its typical scale in the problem's units).
 // It starts from guess (corrected at its own parameter value) or, with `from`, continues from a
-// saved state (restart.hpp) without correcting anything.
+// saved state (restart.hpp) without correcting anything. Each step: predictor_rate, the
+// corrected step (ds shrinking on failure), record with the state after it (ds adapted), then
+// the state moves on.
 Branch natural_loop(const ScaledProblem& problem, const core::Vector& guess,
                     const NaturalParameter& parameter, const LoopState* from, bool record_from,
                     const BranchStart& start, core::Corrector& corrector,
                     const ContinuationOptions& options, const ContinuationHooks& hooks) {
   const int n = problem.num_unknowns();
-  // The parameter in the problem's units, for messages.
-  const auto in_units = [&](double lambda) {
-    return parameter.kind == NaturalParameter::Kind::unknown
-               ? lambda * problem.scale()[parameter.index]
-               : lambda;
-  };
   LoopSteps steps(problem, corrector, options, hooks, start);
   // The row's value is the parameter's at the last point (an observable row is divided by it).
   const double lambda0 = from ? from->lambda : parameter_value(problem, parameter, guess);
   ParameterConstraintSystem system(problem, parameter, lambda0);
-  core::Vector x = from ? from->z : guess;
-  double lambda = lambda0;
-  double ds = from ? from->ds : options.ds;
-  core::Vector previous = from ? from->previous : x;
-  double previous_step = from ? from->previous_step : 0;
-  // The state the next step starts from, saved with each point for a restart.
-  const auto state_at = [&](const core::Vector& z, double value, const core::Vector& before,
-                            double step, double next_ds) {
-    auto state = std::make_shared<LoopState>();
-    state->method = Method::natural;
-    state->z = z;
-    state->lambda = value;
-    state->previous = before;
-    state->previous_step = step;
-    state->ds = next_ds;
-    return state;
-  };
+  NaturalState s;
+  s.x = from ? from->z : guess;
+  s.lambda = lambda0;
+  s.ds = from ? from->ds : options.ds;
+  s.previous = from ? from->previous : s.x;
+  s.previous_step = from ? from->previous_step : 0;
   if (from) {
     steps.resume(*from, record_from);
   } else {
-    if (!steps.start(system, x, fmt::format(" at {} = {:.10g}", parameter.name, in_units(lambda0))))
+    if (!steps.start(
+            system, s.x,
+            fmt::format(" at {} = {:.10g}", parameter.name, in_units(problem, parameter, lambda0))))
       return steps.take();
-    previous = x;
-    steps.report_first(state_at(x, lambda, x, 0.0, ds));
+    s.previous = s.x;
+    steps.report_first(saved_state(s.x, s.lambda, s.x, 0.0, s.ds));
   }
   while (steps.begin_step()) {
     const int index = steps.next_index();
-    // dx/dlambda for the predictor: tangent of the curve scaled so that dp = 1, or the secant.
-    core::Vector rate = core::Vector::Zero(n);
-    if (options.predictor == Predictor::secant && previous_step != 0) {
-      rate = (x - previous) / previous_step;
-    } else if (options.predictor == Predictor::tangent) {
-      core::Matrix J;
-      if (system.jacobian(x, J) == core::EvalStatus::ok) {
-        // dF/dx . rate = 0, dp/dx . rate = 1: the last of J's rows (m + 1 >= n of them; least
-        // squares when the system is overdetermined).
-        core::Vector rhs = core::Vector::Zero(J.rows());
-        rhs[J.rows() - 1] = 1.0;
-        core::Vector candidate = J.colPivHouseholderQr().solve(rhs);
-        if (candidate.allFinite()) rate = candidate;
-      }
-    }
+    const core::Vector rate = predictor_rate(system, s, options, n);
     core::Vector y;
     double step = 0;
     const CorrectedStep corrected =
-        steps.correct(ds, y, [&](double ds_try, core::Vector& predicted) {
+        steps.correct(s.ds, y, [&](double ds_try, core::Vector& predicted) {
           step = parameter.direction * ds_try;
-          predicted = x + step * rate;
-          system.set_value(lambda + step);
+          predicted = s.x + step * rate;
+          system.set_value(s.lambda + step);
           return corrector.solve(system, predicted);
         });
-    ds = corrected.ds;
+    s.ds = corrected.ds;
     if (!corrected.accepted)
       return steps.end(
           corrected.last_failure == core::NewtonStatus::evaluation_failed
@@ -125,19 +149,19 @@ Branch natural_loop(const ScaledProblem& problem, const core::Vector& guess,
               : StopReason::step_floor,
           fmt::format("no point {} could be corrected at {} = {:.10g} +- steps >= ds_min = "
                       "{:.3g} (a fold in {}?) from {} (last Newton status {}: {})",
-                      index, parameter.name, in_units(lambda), options.ds_min, parameter.name,
-                      steps.describe(x), core::to_string(corrected.last_failure),
+                      index, parameter.name, in_units(problem, parameter, s.lambda), options.ds_min,
+                      parameter.name, steps.describe(s.x), core::to_string(corrected.last_failure),
                       corrected.last_message));
     const int iterations = corrected.summary.iterations;
-    const double next_ds = adapted_step(ds, iterations, options);
-    if (!steps.record(x, y, y - x, iterations, ds, index + 1 == options.max_points,
-                      state_at(y, lambda + step, x, step, next_ds)))
+    const double next_ds = adapted_step(s.ds, iterations, options);
+    if (!steps.record(s.x, y, y - s.x, iterations, s.ds, index + 1 == options.max_points,
+                      saved_state(y, s.lambda + step, s.x, step, next_ds)))
       return steps.take();
-    previous = x;
-    previous_step = step;
-    x = y;
-    lambda += step;
-    ds = next_ds;
+    s.previous = s.x;
+    s.previous_step = step;
+    s.x = y;
+    s.lambda += step;
+    s.ds = next_ds;
   }
   return steps.take();
 }

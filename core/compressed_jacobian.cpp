@@ -112,6 +112,124 @@ std::vector<int> colour_columns(const JacobianPattern& pattern, int m, int n) {
   return colour(pattern, m, n).colour;
 }
 
+namespace {
+
+// Each column's step h_j, its entry p_j of the check direction (0 for a dense column) and the
+// columns of each colour.
+struct ColourSteps {
+  Vector h, p;
+  std::vector<std::vector<int>> groups;
+};
+
+ColourSteps colour_steps(const Vector& x, const Vector& scale, double rel, const Colouring& c) {
+  const Eigen::Index n = x.size();
+  ColourSteps out;
+  out.h.resize(n);
+  out.p.resize(n);
+  out.groups.resize(static_cast<std::size_t>(c.colours));
+  for (int j = 0; j < n; ++j) {
+    out.h[j] = finite_difference_step(x[j], scale[j], rel);
+    // Dense columns are differenced alone, as column by column: the check leaves them out (it
+    // would only add their second-order terms, or a kink of F along them, to its error).
+    volatile double shifted = x[j] + fixed_weight(static_cast<std::uint64_t>(j)) * out.h[j];
+    out.p[j] = c.dense[static_cast<std::size_t>(j)] ? 0.0 : shifted - x[j];
+    if (c.colour[static_cast<std::size_t>(j)] >= 0)
+      out.groups[static_cast<std::size_t>(c.colour[static_cast<std::size_t>(j)])].push_back(j);
+  }
+  return out;
+}
+
+// The residuals the compressed Jacobian is made of: per colour F(x + its steps) (and F(x - its
+// steps), central), then F(x + p) (the check), then F(x).
+struct ColourResiduals {
+  Vector r0;                       // F(x)
+  std::vector<Vector> plus;        // colours, then the check direction
+  std::vector<Vector> minus;       // central only
+  std::vector<EvalStatus> status;  // per task; the last, F(x)'s
+};
+
+// Task t < colours: that colour's step(s); task colours: the check direction; the last, F(x)
+// itself, which the differences need only at the end: with threads, no residual runs alone.
+ColourResiduals colour_residuals(const Problem& problem, const Vector& x, const ColourSteps& steps,
+                                 int colours, bool central, int threads) {
+  ColourResiduals out;
+  const int tasks = colours + 2;
+  const int base = colours + 1;
+  out.plus.resize(static_cast<std::size_t>(base));
+  out.minus.resize(static_cast<std::size_t>(central ? base : 0));
+  out.status.assign(static_cast<std::size_t>(tasks), EvalStatus::ok);
+  auto task = [&](int t) {
+    const std::size_t ts = static_cast<std::size_t>(t);
+    if (t == base) {
+      out.status[ts] = problem.residual(x, out.r0);
+      return;
+    }
+    const bool check = t == colours;
+    Vector xs = x;
+    if (check)
+      xs += steps.p;
+    else
+      for (int j : steps.groups[ts]) xs[j] = x[j] + steps.h[j];
+    EvalStatus st = problem.residual(xs, out.plus[ts]);
+    if (st == EvalStatus::ok && central) {
+      xs = x;
+      if (check)
+        xs -= steps.p;
+      else
+        for (int j : steps.groups[ts]) xs[j] = x[j] - steps.h[j];
+      st = problem.residual(xs, out.minus[ts]);
+    }
+    out.status[ts] = st;
+  };
+  run_tasks(tasks, threads, task);
+  return out;
+}
+
+// The check: with the pattern right, J p and F(x + p) - F(x) (d) agree to the finite-difference
+// error: the second-order terms of F over the steps (O(h) relative), the round-off of F
+// (O(eps / h) relative) and, where F has a kink (the contact bar's contact events), the
+// difference between the secants of the columns and of p across it. Per row the tolerance is
+// tau * (a_i + sigma max_k a_k), a_i = sum_j |J_ij p_j| the size of the first-order terms of
+// that row; the floor covers rows whose terms nearly vanish, since F's round-off is shared by
+// all rows (one simulation), not proportional to each row. tau = 1e-3, sigma = 1e-2: on the
+// contact bar's smooth points the error stays below 5e-6 in these units (modes 1 and 2, both
+// formulations, energies from grazing to 2e4 times it, tests/problems/contact_bar/
+// test_jacobian_pattern.cpp), and at its kinks (the grazing start, the resonance at T = 3.2)
+// it reaches 1.5e-3 in a few of ~370 Jacobians of a mode-1 branch, whose compressed J still
+// equals the column-by-column one to 1.4e-6 (so those fallbacks are false alarms; 1e-4 raises
+// 12 of them). A missed entry J_ij shows up in row i as |J_ij h_j| |w_j - w_k| (w_k the weight
+// of the column it was read for, or 0), of the order of the entry itself, and is caught once
+// that exceeds the tolerance: a pattern can only drop entries below about 1e-3 of their row's
+// size unnoticed (a structural mistake drops entries of the row's own size).
+// The largest error over its tolerance (the check passes at 1 or below).
+double check_error(const Matrix& J, const Vector& p, const Vector& d, const Colouring& c,
+                   double tau) {
+  const Eigen::Index m = J.rows(), n = J.cols();
+  Vector jp = Vector::Zero(m), size = Vector::Zero(m);
+  for (int j = 0; j < n; ++j) {
+    if (c.dense[static_cast<std::size_t>(j)]) {
+      jp += J.col(j) * p[j];
+      size += J.col(j).cwiseAbs() * std::abs(p[j]);
+    } else {
+      for (int i : c.column_rows[static_cast<std::size_t>(j)]) {
+        jp[i] += J(i, j) * p[j];
+        size[i] += std::abs(J(i, j) * p[j]);
+      }
+    }
+  }
+  constexpr double sigma = 1e-2;
+  const double floor = sigma * (m > 0 ? size.maxCoeff() : 0.0);
+  double worst = 0;
+  for (int i = 0; i < m; ++i) {
+    const double tolerance = tau * (size[i] + floor);
+    const double error = std::abs(jp[i] - d[i]);
+    worst = std::max(worst, tolerance > 0 ? error / tolerance : (error > 0 ? HUGE_VAL : 0.0));
+  }
+  return worst;
+}
+
+}  // namespace
+
 EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const Vector& x,
                                                  const JacobianPattern& pattern, Matrix& J,
                                                  const FiniteDifferenceOptions& options,
@@ -125,56 +243,13 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
   const Colouring& c = *colouring;
   out.colours = c.colours;
   const bool central = options.scheme == FiniteDifferenceOptions::Scheme::central;
-  const double rel = relative_step(options);
-  const Vector scale = problem.typical_scale();
-
-  Vector r0;
-  Vector h(n), p(n);
-  std::vector<std::vector<int>> groups(static_cast<std::size_t>(c.colours));
-  for (int j = 0; j < n; ++j) {
-    h[j] = finite_difference_step(x[j], scale[j], rel);
-    // Dense columns are differenced alone, as column by column: the check leaves them out (it
-    // would only add their second-order terms, or a kink of F along them, to its error).
-    volatile double shifted = x[j] + fixed_weight(static_cast<std::uint64_t>(j)) * h[j];
-    p[j] = c.dense[static_cast<std::size_t>(j)] ? 0.0 : shifted - x[j];
-    if (c.colour[static_cast<std::size_t>(j)] >= 0)
-      groups[static_cast<std::size_t>(c.colour[static_cast<std::size_t>(j)])].push_back(j);
-  }
-
-  // Task t < colours: that colour's step(s); task colours: the check direction; the last, F(x)
-  // itself, which the differences need only at the end: with threads, no residual runs alone.
-  const int tasks = c.colours + 2;
+  const ColourSteps steps = colour_steps(x, problem.typical_scale(), relative_step(options), c);
+  const ColourResiduals r =
+      colour_residuals(problem, x, steps, c.colours, central, options.threads);
   const int base = c.colours + 1;
-  std::vector<Vector> plus(static_cast<std::size_t>(base)),
-      minus(static_cast<std::size_t>(central ? base : 0));
-  std::vector<EvalStatus> status(static_cast<std::size_t>(tasks), EvalStatus::ok);
-  auto task = [&](int t) {
-    const std::size_t ts = static_cast<std::size_t>(t);
-    if (t == base) {
-      status[ts] = problem.residual(x, r0);
-      return;
-    }
-    const bool check = t == c.colours;
-    Vector xs = x;
-    if (check)
-      xs += p;
-    else
-      for (int j : groups[ts]) xs[j] = x[j] + h[j];
-    EvalStatus st = problem.residual(xs, plus[ts]);
-    if (st == EvalStatus::ok && central) {
-      xs = x;
-      if (check)
-        xs -= p;
-      else
-        for (int j : groups[ts]) xs[j] = x[j] - h[j];
-      st = problem.residual(xs, minus[ts]);
-    }
-    status[ts] = st;
-  };
-  run_tasks(tasks, options.threads, task);
   out.residuals += 1 + base * (central ? 2 : 1);
-  if (status[static_cast<std::size_t>(base)] != EvalStatus::ok)
-    return status[static_cast<std::size_t>(base)];
+  if (r.status[static_cast<std::size_t>(base)] != EvalStatus::ok)
+    return r.status[static_cast<std::size_t>(base)];
   auto fall_back = [&] {
     out.fell_back = true;
     const long before = problem.counters().residuals;
@@ -182,81 +257,43 @@ EvalStatus compressed_finite_difference_jacobian(const Problem& problem, const V
     out.residuals += static_cast<int>(problem.counters().residuals - before);
     return fs;
   };
-  for (EvalStatus st : status)
+  for (EvalStatus st : r.status)
     if (st != EvalStatus::ok) return fall_back();
 
   auto difference = [&](int t) -> Vector {
     const std::size_t ts = static_cast<std::size_t>(t);
-    return central ? Vector(0.5 * (plus[ts] - minus[ts])) : Vector(plus[ts] - r0);
+    return central ? Vector(0.5 * (r.plus[ts] - r.minus[ts])) : Vector(r.plus[ts] - r.r0);
   };
   J.setZero(m, n);
   for (int t = 0; t < c.colours; ++t) {
     const Vector d = difference(t);
-    for (int j : groups[static_cast<std::size_t>(t)]) {
+    for (int j : steps.groups[static_cast<std::size_t>(t)]) {
       if (c.dense[static_cast<std::size_t>(j)])
-        J.col(j) = d / h[j];
+        J.col(j) = d / steps.h[j];
       else
-        for (int i : c.column_rows[static_cast<std::size_t>(j)]) J(i, j) = d[i] / h[j];
+        for (int i : c.column_rows[static_cast<std::size_t>(j)]) J(i, j) = d[i] / steps.h[j];
     }
   }
 
-  // The check: with the pattern right, J p and F(x + p) - F(x) agree to the finite-difference
-  // error: the second-order terms of F over the steps (O(h) relative), the round-off of F
-  // (O(eps / h) relative) and, where F has a kink (the contact bar's contact events), the
-  // difference between the secants of the columns and of p across it. Per row the tolerance is
-  // tau * (a_i + sigma max_k a_k), a_i = sum_j |J_ij p_j| the size of the first-order terms of
-  // that row; the floor covers rows whose terms nearly vanish, since F's round-off is shared by
-  // all rows (one simulation), not proportional to each row. tau = 1e-3, sigma = 1e-2: on the
-  // contact bar's smooth points the error stays below 5e-6 in these units (modes 1 and 2, both
-  // formulations, energies from grazing to 2e4 times it, tests/problems/contact_bar/
-  // test_jacobian_pattern.cpp), and at its kinks (the grazing start, the resonance at T = 3.2)
-  // it reaches 1.5e-3 in a few of ~370 Jacobians of a mode-1 branch, whose compressed J still
-  // equalled the column-by-column one to 1.4e-6 (so those fallbacks are false alarms; 1e-4
-  // raised 12 of them). A missed entry J_ij shows up in row i as |J_ij h_j| |w_j - w_k| (w_k
-  // the weight of the column it was read for, or 0), of the order of the entry itself, and is
-  // caught once that exceeds the tolerance: a pattern can only drop entries below about 1e-3
-  // of their row's size unnoticed (a structural mistake drops entries of the row's own size).
-  const Vector d = difference(c.colours);
-  Vector jp = Vector::Zero(m), size = Vector::Zero(m);
-  for (int j = 0; j < n; ++j) {
-    if (c.dense[static_cast<std::size_t>(j)]) {
-      jp += J.col(j) * p[j];
-      size += J.col(j).cwiseAbs() * std::abs(p[j]);
-    } else {
-      for (int i : c.column_rows[static_cast<std::size_t>(j)]) {
-        jp[i] += J(i, j) * p[j];
-        size[i] += std::abs(J(i, j) * p[j]);
-      }
-    }
-  }
   const double tau = std::max(pattern.check_tolerance, CorrectorJacobians::tolerance());
-  constexpr double sigma = 1e-2;
-  const double floor = sigma * (m > 0 ? size.maxCoeff() : 0.0);
-  for (int i = 0; i < m; ++i) {
-    const double tolerance = tau * (size[i] + floor);
-    const double error = std::abs(jp[i] - d[i]);
-    out.check_error =
-        std::max(out.check_error, tolerance > 0 ? error / tolerance : (error > 0 ? HUGE_VAL : 0.0));
-  }
-  if (!(out.check_error <= 1)) {
-    if (!pattern.wider) {
-      // A kink, not a missed entry, and a corrector judges its answer by F: keep J.
-      if (pattern.structural && CorrectorJacobians::tolerance() > 0) {
-        out.kept_unchecked = true;
-        return EvalStatus::ok;
-      }
-      return fall_back();
+  out.check_error = check_error(J, steps.p, difference(c.colours), c, tau);
+  if (out.check_error <= 1) return EvalStatus::ok;
+  if (!pattern.wider) {
+    // A kink, not a missed entry, and a corrector judges its answer by F: keep J.
+    if (pattern.structural && CorrectorJacobians::tolerance() > 0) {
+      out.kept_unchecked = true;
+      return EvalStatus::ok;
     }
-    CompressedJacobianReport wider;
-    const EvalStatus ws =
-        compressed_finite_difference_jacobian(problem, x, pattern.wider(), J, options, &wider);
-    out.widened = true;
-    out.fell_back = wider.fell_back;
-    out.kept_unchecked = wider.kept_unchecked;
-    out.residuals += wider.residuals;
-    return ws;
+    return fall_back();
   }
-  return EvalStatus::ok;
+  CompressedJacobianReport wider;
+  const EvalStatus ws =
+      compressed_finite_difference_jacobian(problem, x, pattern.wider(), J, options, &wider);
+  out.widened = true;
+  out.fell_back = wider.fell_back;
+  out.kept_unchecked = wider.kept_unchecked;
+  out.residuals += wider.residuals;
+  return ws;
 }
 
 namespace {

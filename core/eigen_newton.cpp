@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "core/compressed_jacobian.hpp"
 #include "core/sparse_least_squares.hpp"
@@ -128,6 +129,111 @@ bool chord_step_pays(double norm2, const Vector& trial_r, const NewtonOptions& o
   return rate <= 0.5 &&
          trial_r.lpNorm<Eigen::Infinity>() * std::pow(rate, 6) <= options.residual_tolerance;
 }
+
+// Scaled length of the step alpha dx from x: max_j |alpha dx_j| / max(|x_j|, typical scale_j).
+double scaled_step_length(const Vector& dx, double alpha, const Vector& x, const Vector& scale) {
+  double scaled_step = 0;
+  for (Eigen::Index j = 0; j < x.size(); ++j)
+    scaled_step = std::max(scaled_step,
+                           std::abs(alpha * dx[j]) / std::max({std::abs(x[j]), scale[j], 1e-300}));
+  return scaled_step;
+}
+
+// A chord step from x on the kept factorization: taken (x and r moved, its scaled length in
+// scaled_step) when it can be evaluated and pays (chord_step_pays); else x and r stay.
+bool chord_step(const Problem& problem, LeastSquares& factorization, const NewtonOptions& options,
+                const Vector& scale, double norm2, Vector& x, Vector& r, Vector& dx,
+                Vector& trial_x, Vector& trial_r, double& scaled_step) {
+  const int rank = factorization.solve(-r, dx);
+  trial_x = x + dx;
+  if (!(rank > 0 && dx.allFinite() && problem.residual(trial_x, trial_r) == EvalStatus::ok &&
+        chord_step_pays(norm2, trial_r, options)))
+    return false;
+  scaled_step = scaled_step_length(dx, 1.0, x, scale);
+  x.swap(trial_x);
+  r.swap(trial_r);
+  return true;
+}
+
+// The backtracking line search along dx from x (|F(x)|_2 = norm2): alpha halves until the
+// Armijo condition holds (at most 30 times); without options.line_search, the full step only.
+struct LineSearch {
+  double alpha = 1.0;
+  bool accepted = false;                     // trial_x = x + alpha dx, trial_r = F(trial_x)
+  EvalStatus last_failure = EvalStatus::ok;  // of the last residual that failed
+  bool failed_full_step = false;             // without line search: F(x + dx) failed (last_failure)
+};
+
+LineSearch line_search(const Problem& problem, const NewtonOptions& options, const Vector& x,
+                       const Vector& dx, double norm2, Vector& trial_x, Vector& trial_r) {
+  constexpr double armijo = 1e-4;
+  constexpr int max_halvings = 30;
+  LineSearch out;
+  for (int halving = 0; halving <= (options.line_search ? max_halvings : 0); ++halving) {
+    trial_x = x + out.alpha * dx;
+    const EvalStatus s = problem.residual(trial_x, trial_r);
+    if (s == EvalStatus::ok &&
+        (!options.line_search || trial_r.norm() <= (1.0 - armijo * out.alpha) * norm2)) {
+      out.accepted = true;
+      break;
+    }
+    if (s != EvalStatus::ok) out.last_failure = s;
+    if (!options.line_search && s != EvalStatus::ok) {
+      out.failed_full_step = true;
+      return out;
+    }
+    out.alpha *= 0.5;
+  }
+  return out;
+}
+
+// How a solve ends after a step (the history's last entry: ||F||_inf at the new x): converged,
+// stalled on a scaled step below step_tolerance, or not yet (nullopt). chord: the step was a
+// chord step (the message counts them).
+struct StepEnd {
+  NewtonStatus status;
+  std::string message;
+};
+
+std::optional<StepEnd> after_step(const NewtonSummary& summary, const NewtonOptions& options,
+                                  double scaled_step, int iteration, bool chord) {
+  const double norm = summary.residual_history.back();
+  if (norm <= options.residual_tolerance)
+    return StepEnd{NewtonStatus::converged,
+                   chord ? fmt::format("eigen: converged in {} iterations ({} chord), ||F||_inf "
+                                       "= {:.3e}",
+                                       iteration, summary.chord_steps, norm)
+                         : fmt::format("eigen: converged in {} iterations, ||F||_inf = {:.3e}",
+                                       iteration, norm)};
+  if (scaled_step <= options.step_tolerance)
+    return StepEnd{NewtonStatus::stalled,
+                   fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
+                               "{}, ||F||_inf = {:.3e}",
+                               scaled_step, iteration, norm)};
+  return std::nullopt;
+}
+
+// The start of a solve: F(x) into r and its norm into the history; an end when x does not fit
+// the problem, F(x) fails, or x already converged.
+std::optional<StepEnd> start_solve(const Problem& problem, const Vector& x,
+                                   const NewtonOptions& options, Vector& r,
+                                   NewtonSummary& summary) {
+  if (x.size() != problem.num_unknowns())
+    return StepEnd{NewtonStatus::evaluation_failed,
+                   fmt::format("eigen: starting point has {} entries, problem has {} unknowns",
+                               x.size(), problem.num_unknowns())};
+  const EvalStatus eval = problem.residual(x, r);
+  if (eval != EvalStatus::ok)
+    return StepEnd{NewtonStatus::evaluation_failed,
+                   fmt::format("eigen: residual at the starting point: {}", to_string(eval))};
+  summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
+  if (summary.residual_history.back() <= options.residual_tolerance)
+    return StepEnd{NewtonStatus::converged,
+                   fmt::format("eigen: starting point already converged, ||F||_inf = {:.3e}",
+                               summary.residual_history.back())};
+  return std::nullopt;
+}
+
 }  // namespace
 
 int minimum_norm_solve(const Matrix& J, const Vector& rhs, double rank_cutoff, Vector& dx) {
@@ -156,21 +262,9 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     return recorder.finish(summary, status, std::move(message));
   };
 
-  if (x.size() != problem.num_unknowns())
-    return finish(NewtonStatus::evaluation_failed,
-                  fmt::format("eigen: starting point has {} entries, problem has {} unknowns",
-                              x.size(), problem.num_unknowns()));
-
   Vector r;
-  EvalStatus eval = problem.residual(x, r);
-  if (eval != EvalStatus::ok)
-    return finish(NewtonStatus::evaluation_failed,
-                  fmt::format("eigen: residual at the starting point: {}", to_string(eval)));
-  summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
-  if (summary.residual_history.back() <= options_.residual_tolerance)
-    return finish(NewtonStatus::converged,
-                  fmt::format("eigen: starting point already converged, ||F||_inf = {:.3e}",
-                              summary.residual_history.back()));
+  if (const std::optional<StepEnd> end = start_solve(problem, x, options_, r, summary))
+    return finish(end->status, end->message);
 
   const Vector scale = problem.typical_scale().cwiseAbs();
   Matrix J;
@@ -187,41 +281,24 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     chord = true;
   }
   Vector dx, trial_x, trial_r;
-  constexpr double armijo = 1e-4;
-  constexpr int max_halvings = 30;
 
   for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
     summary.iterations = iteration;
     const double norm2 = r.norm();
-    // Chord step: the factorization of an earlier Jacobian, kept while it contracts.
-    if (have_factorization && chord) {
-      const int rank = factorization.solve(-r, dx);
-      trial_x = x + dx;
-      if (rank > 0 && dx.allFinite() && problem.residual(trial_x, trial_r) == EvalStatus::ok &&
-          chord_step_pays(norm2, trial_r, options_)) {
-        double scaled_step = 0;
-        for (Eigen::Index j = 0; j < x.size(); ++j)
-          scaled_step =
-              std::max(scaled_step, std::abs(dx[j]) / std::max({std::abs(x[j]), scale[j], 1e-300}));
-        x.swap(trial_x);
-        r.swap(trial_r);
-        ++summary.chord_steps;
-        summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
-        if (summary.residual_history.back() <= options_.residual_tolerance)
-          return finish(
-              NewtonStatus::converged,
-              fmt::format("eigen: converged in {} iterations ({} chord), ||F||_inf "
-                          "= {:.3e}",
-                          iteration, summary.chord_steps, summary.residual_history.back()));
-        if (scaled_step <= options_.step_tolerance)
-          return finish(NewtonStatus::stalled,
-                        fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
-                                    "{}, ||F||_inf = {:.3e}",
-                                    scaled_step, iteration, summary.residual_history.back()));
-        continue;
-      }
-      // Too slow (or not evaluable): a fresh Jacobian at x, in this same iteration.
+    // Chord step: the factorization of an earlier Jacobian, kept while it contracts. Too slow
+    // (or not evaluable): a fresh Jacobian at x, in this same iteration.
+    double scaled_step = 0;
+    if (have_factorization && chord &&
+        chord_step(problem, factorization, options_, scale, norm2, x, r, dx, trial_x, trial_r,
+                   scaled_step)) {
+      ++summary.chord_steps;
+      summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
+      if (const std::optional<StepEnd> end =
+              after_step(summary, options_, scaled_step, iteration, true))
+        return finish(end->status, end->message);
+      continue;
     }
+    EvalStatus eval;
     {
       const CorrectorJacobians loose(options_.jacobian_check_tolerance);
       eval = problem.jacobian(x, J);
@@ -237,38 +314,23 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
       return finish(NewtonStatus::linear_solver_failed,
                     fmt::format("eigen: non-finite Newton step at iteration {}", iteration));
 
-    double alpha = 1.0;
-    bool accepted = false;
-    EvalStatus last_failure = EvalStatus::ok;
-    for (int halving = 0; halving <= (options_.line_search ? max_halvings : 0); ++halving) {
-      trial_x = x + alpha * dx;
-      const EvalStatus s = problem.residual(trial_x, trial_r);
-      if (s == EvalStatus::ok &&
-          (!options_.line_search || trial_r.norm() <= (1.0 - armijo * alpha) * norm2)) {
-        accepted = true;
-        break;
-      }
-      if (s != EvalStatus::ok) last_failure = s;
-      if (!options_.line_search && s != EvalStatus::ok)
-        return finish(NewtonStatus::evaluation_failed,
-                      fmt::format("eigen: residual at iteration {}: {}", iteration, to_string(s)));
-      alpha *= 0.5;
-    }
+    const LineSearch search = line_search(problem, options_, x, dx, norm2, trial_x, trial_r);
+    if (search.failed_full_step)
+      return finish(NewtonStatus::evaluation_failed,
+                    fmt::format("eigen: residual at iteration {}: {}", iteration,
+                                to_string(search.last_failure)));
     // Scaled step length: relative to max(|x_j|, typical scale_j).
-    double scaled_step = 0;
-    for (Eigen::Index j = 0; j < x.size(); ++j)
-      scaled_step = std::max(
-          scaled_step, std::abs(alpha * dx[j]) / std::max({std::abs(x[j]), scale[j], 1e-300}));
-    if (!accepted) {
+    scaled_step = scaled_step_length(dx, search.alpha, x, scale);
+    if (!search.accepted) {
       if (scaled_step <= options_.step_tolerance || rank == 0)
         return finish(NewtonStatus::stalled,
                       fmt::format("eigen: stalled at iteration {} (rank {}), ||F||_inf = {:.3e}",
                                   iteration, rank, summary.residual_history.back()));
-      if (last_failure != EvalStatus::ok)
+      if (search.last_failure != EvalStatus::ok)
         return finish(NewtonStatus::evaluation_failed,
                       fmt::format("eigen: line search found no evaluable point at iteration "
                                   "{} ({})",
-                                  iteration, to_string(last_failure)));
+                                  iteration, to_string(search.last_failure)));
       return finish(NewtonStatus::diverged,
                     fmt::format("eigen: line search failed at iteration {}, ||F||_inf = {:.3e}",
                                 iteration, summary.residual_history.back()));
@@ -276,15 +338,9 @@ NewtonSummary EigenNewton::solve_from(const Problem& problem, Vector& x,
     x.swap(trial_x);
     r.swap(trial_r);
     summary.residual_history.push_back(r.lpNorm<Eigen::Infinity>());
-    if (summary.residual_history.back() <= options_.residual_tolerance)
-      return finish(NewtonStatus::converged,
-                    fmt::format("eigen: converged in {} iterations, ||F||_inf = {:.3e}", iteration,
-                                summary.residual_history.back()));
-    if (scaled_step <= options_.step_tolerance)
-      return finish(NewtonStatus::stalled,
-                    fmt::format("eigen: scaled step {:.3e} below step_tolerance at iteration "
-                                "{}, ||F||_inf = {:.3e}",
-                                scaled_step, iteration, summary.residual_history.back()));
+    if (const std::optional<StepEnd> end =
+            after_step(summary, options_, scaled_step, iteration, false))
+      return finish(end->status, end->message);
   }
   return finish(NewtonStatus::max_iterations,
                 fmt::format("eigen: no convergence in {} iterations, ||F||_inf = {:.3e}",

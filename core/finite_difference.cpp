@@ -5,11 +5,11 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <thread>
 #include <vector>
 
 #include "core/compressed_jacobian.hpp"
 #include "core/errors.hpp"
+#include "core/job_queue.hpp"
 
 namespace backbone::core {
 
@@ -102,22 +102,6 @@ EvalStatus Problem::compute_jacobian(const Vector& x, Matrix& J) const {
   if (report.widened) counters_.jacobian_widenings++;
   if (report.fell_back) counters_.jacobian_fallbacks++;
   return s;
-}
-
-void run_tasks(int tasks, int threads, const std::function<void(int)>& task) {
-  threads = std::max(1, std::min(threads, tasks));
-  if (threads == 1) {
-    for (int t = 0; t < tasks; ++t) task(t);
-    return;
-  }
-  std::atomic<int> next{0};
-  const auto work = [&] {
-    for (int t = next++; t < tasks; t = next++) task(t);
-  };
-  std::vector<std::thread> pool;
-  for (int k = 1; k < threads; ++k) pool.emplace_back(work);
-  work();
-  for (auto& th : pool) th.join();
 }
 
 }  // namespace backbone::core

@@ -19,8 +19,8 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 
+#include "core/job_queue.hpp"  // run_tasks: the columns (and colours) on threads
 #include "core/problem.hpp"
 
 namespace backbone::core {
@@ -43,13 +43,6 @@ double fixed_weight(std::uint64_t index);
 
 EvalStatus finite_difference_jacobian(const Problem& problem, const Vector& x, Matrix& J,
                                       const FiniteDifferenceOptions& options = {});
-
-// Runs task(0), ..., task(tasks - 1) on min(threads, tasks) threads (at least 1; the calling
-// thread is one of them), each thread taking the next task not yet taken: the Jacobian's
-// columns (and colours, compressed_jacobian). Dynamic, not striped, because the cores of a
-// shared virtual machine do not run at one speed (core/README.md, 'Threads'). Each task must
-// write only its own outputs, so the result does not depend on which thread ran what.
-void run_tasks(int tasks, int threads, const std::function<void(int)>& task);
 
 // Threads of the default finite-difference Jacobian, 1 at start. Throws InputError("threads")
 // unless 1 <= threads <= max_jacobian_threads.

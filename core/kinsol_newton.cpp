@@ -115,6 +115,50 @@ void error_callback(int, const char* module, const char* function, char* message
                                 message ? message : "");
 }
 
+// KINSOL's settings for one solve: the callbacks on data, the tolerances and iteration budget
+// of options, exact Newton. The first flag that is not KIN_SUCCESS, or KIN_SUCCESS.
+int configure(void* mem, CallbackData& data, N_Vector u, SUNLinearSolver LS, SUNMatrix A,
+              const NewtonOptions& options) {
+  int flag = KINSetErrHandlerFn(mem, error_callback, &data);
+  if (flag == KIN_SUCCESS) flag = KINInit(mem, residual_callback, u);
+  if (flag == KIN_SUCCESS) flag = KINSetUserData(mem, &data);
+  if (flag == KIN_SUCCESS) flag = KINSetLinearSolver(mem, LS, A);
+  if (flag == KIN_SUCCESS) flag = KINSetJacFn(mem, jacobian_callback);
+  if (flag == KIN_SUCCESS) flag = KINSetFuncNormTol(mem, options.residual_tolerance);
+  if (flag == KIN_SUCCESS) flag = KINSetScaledStepTol(mem, options.step_tolerance);
+  if (flag == KIN_SUCCESS) flag = KINSetNumMaxIters(mem, options.max_iterations);
+  // Exact Newton: a fresh Jacobian at every iterate (KINSOL's default reuses it 10 times).
+  if (flag == KIN_SUCCESS) flag = KINSetMaxSetupCalls(mem, 1);
+  return flag;
+}
+
+// The corrector's status for KINSol's return flag (final_norm: ||F||_inf at the returned
+// iterate, negative when not evaluable; failure: what the callbacks saw fail).
+NewtonStatus status_of(int flag, double final_norm, EvalStatus failure,
+                       const NewtonOptions& options) {
+  switch (flag) {
+    case KIN_SUCCESS:
+    case KIN_INITIAL_GUESS_OK:
+      return NewtonStatus::converged;
+    case KIN_STEP_LT_STPTOL:
+      return final_norm >= 0 && final_norm <= options.residual_tolerance ? NewtonStatus::converged
+                                                                         : NewtonStatus::stalled;
+    case KIN_MAXITER_REACHED:
+      return NewtonStatus::max_iterations;
+    case KIN_LINESEARCH_NONCONV:
+    case KIN_LINESEARCH_BCFAIL:
+    case KIN_MXNEWT_5X_EXCEEDED:
+      return failure != EvalStatus::ok ? NewtonStatus::evaluation_failed : NewtonStatus::diverged;
+    case KIN_SYSFUNC_FAIL:
+    case KIN_FIRST_SYSFUNC_ERR:
+    case KIN_REPTD_SYSFUNC_ERR:
+      return NewtonStatus::evaluation_failed;
+    default:
+      return failure != EvalStatus::ok ? NewtonStatus::evaluation_failed
+                                       : NewtonStatus::linear_solver_failed;
+  }
+}
+
 }  // namespace
 
 KinsolNewton::KinsolNewton(const NewtonOptions& options) : options_(options) {
@@ -169,16 +213,7 @@ NewtonSummary KinsolNewton::solve(const Problem& problem, Vector& x) {
   as_eigen(f_scale.get()).setOnes();  // so that KINSOL's fnormtol tests ||F||_inf
 
   void* mem = kinsol.get();
-  int flag = KINSetErrHandlerFn(mem, error_callback, &data);
-  if (flag == KIN_SUCCESS) flag = KINInit(mem, residual_callback, u.get());
-  if (flag == KIN_SUCCESS) flag = KINSetUserData(mem, &data);
-  if (flag == KIN_SUCCESS) flag = KINSetLinearSolver(mem, LS.get(), A.get());
-  if (flag == KIN_SUCCESS) flag = KINSetJacFn(mem, jacobian_callback);
-  if (flag == KIN_SUCCESS) flag = KINSetFuncNormTol(mem, options_.residual_tolerance);
-  if (flag == KIN_SUCCESS) flag = KINSetScaledStepTol(mem, options_.step_tolerance);
-  if (flag == KIN_SUCCESS) flag = KINSetNumMaxIters(mem, options_.max_iterations);
-  // Exact Newton: a fresh Jacobian at every iterate (KINSOL's default reuses it 10 times).
-  if (flag == KIN_SUCCESS) flag = KINSetMaxSetupCalls(mem, 1);
+  int flag = configure(mem, data, u.get(), LS.get(), A.get(), options_);
   if (flag != KIN_SUCCESS)
     return finish(
         NewtonStatus::linear_solver_failed,
@@ -210,32 +245,7 @@ NewtonSummary KinsolNewton::solve(const Problem& problem, Vector& x) {
   const std::string message = fmt::format("kinsol: {} after {} iterations, ||F||_inf = {}{}", name,
                                           iterations, norm_text, detail);
 
-  switch (flag) {
-    case KIN_SUCCESS:
-    case KIN_INITIAL_GUESS_OK:
-      return finish(NewtonStatus::converged, message);
-    case KIN_STEP_LT_STPTOL:
-      return finish(final_norm >= 0 && final_norm <= options_.residual_tolerance
-                        ? NewtonStatus::converged
-                        : NewtonStatus::stalled,
-                    message);
-    case KIN_MAXITER_REACHED:
-      return finish(NewtonStatus::max_iterations, message);
-    case KIN_LINESEARCH_NONCONV:
-    case KIN_LINESEARCH_BCFAIL:
-    case KIN_MXNEWT_5X_EXCEEDED:
-      return finish(
-          data.failure != EvalStatus::ok ? NewtonStatus::evaluation_failed : NewtonStatus::diverged,
-          message);
-    case KIN_SYSFUNC_FAIL:
-    case KIN_FIRST_SYSFUNC_ERR:
-    case KIN_REPTD_SYSFUNC_ERR:
-      return finish(NewtonStatus::evaluation_failed, message);
-    default:
-      return finish(data.failure != EvalStatus::ok ? NewtonStatus::evaluation_failed
-                                                   : NewtonStatus::linear_solver_failed,
-                    message);
-  }
+  return finish(status_of(flag, final_norm, data.failure, options_), message);
 }
 
 }  // namespace backbone::core

@@ -6,12 +6,8 @@
 // the floating-point values the column-by-column difference uses: the two agree bit for bit.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <atomic>
-#include <chrono>
 #include <cmath>
 #include <set>
-#include <thread>
 
 #include "core/compressed_jacobian.hpp"
 #include "core/errors.hpp"
@@ -201,38 +197,6 @@ TEST(CompressedJacobian, AStructuralPatternIsKeptInACorrectorsScopeOnly) {
     EXPECT_TRUE(report.widened);
     EXPECT_TRUE(report.kept_unchecked);
     EXPECT_FALSE(report.fell_back);
-  }
-}
-
-TEST(RunTasks, EachTaskRunsOnceAndTheCallingThreadTakesPart) {
-  // The tasks are taken dynamically: every index exactly once, whatever the number of threads
-  // (also more threads than tasks), and the calling thread is one of the workers. With 2
-  // threads, task 0 waits until the other four have run: only the other thread can run them
-  // meanwhile (striped, thread 0 would have to run tasks 2 and 4 itself; the wait gives up
-  // after 10 s and the count below fails).
-  for (int threads : {1, 2, 3, 8}) {
-    const int tasks = 5;
-    std::vector<int> runs(tasks, 0);
-    std::vector<std::thread::id> who(tasks);
-    std::atomic<int> done{0};
-    run_tasks(tasks, threads, [&](int t) {
-      if (t == 0 && threads == 2) {
-        const auto start = std::chrono::steady_clock::now();
-        while (done < tasks - 1 &&
-               std::chrono::steady_clock::now() - start < std::chrono::seconds(10))
-          std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      }
-      runs[static_cast<std::size_t>(t)]++;
-      who[static_cast<std::size_t>(t)] = std::this_thread::get_id();
-      done++;
-    });
-    EXPECT_EQ(runs, std::vector<int>(tasks, 1)) << threads << " threads";
-    if (threads <= 2) {  // with more threads the workers may take every task first
-      EXPECT_NE(std::find(who.begin(), who.end(), std::this_thread::get_id()), who.end());
-    }
-    if (threads == 2) {
-      EXPECT_EQ(std::count(who.begin(), who.end(), who[0]), 1);
-    }
   }
 }
 
