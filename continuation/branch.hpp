@@ -2,7 +2,7 @@
 //
 // Every point carries its solution vector x (layout of the problem), the observables the problem
 // reports there, the verified dimension of the solution set (rank report + re-correction along
-// the candidate null directions, core/rank_report.hpp), and the cost of getting it (Newton
+// the candidate null directions, core/rank/rank_report.hpp), and the cost of getting it (Newton
 // iterations, Jacobian evaluations, wall seconds). A run that fails keeps every point corrected
 // before the failure: the StopReason and message say why it ended. branch_table turns a branch
 // into the columns of branch.csv (observables by name, then the bookkeeping columns).
@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "core/problem.hpp"
-#include "core/rank_report.hpp"
-#include "core/table.hpp"
+#include "core/rank/rank_report.hpp"
+#include "core/io/table.hpp"
 #include "core/types.hpp"
 
 namespace backbone::continuation {
@@ -105,7 +105,7 @@ struct BranchPointReport {
   double tangent_angle = 0;
   core::Vector attached_point;  // that probed point (unknowns), empty when none
   // Every probed point found on the attached family (unknowns), in the order of the probed
-  // directions; attached_point is one of them (continuation/follow.hpp switches onto one).
+  // directions; attached_point is one of them (continuation/branch_points/follow.hpp switches onto one).
   std::vector<core::Vector> attached_points;
   core::Observables attached_description;  // ContinuationHooks::describe_branch_point
   double seconds = 0;                      // wall time of location and verification

@@ -24,7 +24,7 @@
 #include <string>
 
 #include "continuation/branch.hpp"
-#include "core/newton.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::continuation {
 

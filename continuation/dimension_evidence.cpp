@@ -5,7 +5,7 @@
 #include <chrono>
 
 #include "continuation/scaled_problem.hpp"
-#include "core/bordered_system.hpp"
+#include "core/solvers/bordered_system.hpp"
 
 namespace backbone::continuation {
 

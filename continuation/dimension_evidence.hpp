@@ -1,6 +1,6 @@
 // The dimension of the solution set at one point, with its evidence: the singular values of the
 // column-scaled Jacobian, the threshold and the gap of the rank report, then every probe along
-// a candidate null direction (core/rank_report.hpp) with the distance the re-corrected point
+// a candidate null direction (core/rank/rank_report.hpp) with the distance the re-corrected point
 // kept from the stepped one. Generic over core::Problem; `backbone inspect` prints it (continuation/cli/inspect.hpp).
 //
 //   core::RankOptions rank; rank.relative_threshold = 1e-5;
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "core/problem.hpp"
-#include "core/rank_report.hpp"
+#include "core/rank/rank_report.hpp"
 
 namespace backbone::continuation {
 

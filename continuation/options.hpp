@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "core/rank_report.hpp"
+#include "core/rank/rank_report.hpp"
 
 namespace backbone::continuation {
 
@@ -92,7 +92,7 @@ struct ContinuationOptions {
   // Pseudo-arclength: each correction starts with chord steps on the factorization of the
   // previous point's Jacobian (bordered with the step direction), and each verification probe
   // with chord steps on the probed point's Jacobian; a fresh Jacobian only when a chord step
-  // contracts too slowly (core/newton.hpp). The answer is judged by F alone.
+  // contracts too slowly (core/solvers/newton.hpp). The answer is judged by F alone.
   bool chord_corrections = true;
   // Both loops in z = x ./ typical_scale() (see scaled_problem.hpp): pseudo-arclength's ds and
   // both arclength columns in those units, natural steps of an unknown in units of its typical

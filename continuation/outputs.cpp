@@ -15,7 +15,7 @@
 
 #include "continuation/restart.hpp"
 #include "core/errors.hpp"
-#include "core/plot.hpp"
+#include "core/io/plot.hpp"
 
 namespace backbone::continuation {
 

@@ -9,10 +9,10 @@
 #include <map>
 #include <sstream>
 
-#include "continuation/loop_steps.hpp"
+#include "continuation/internal/loop_steps.hpp"
 #include "continuation/outputs.hpp"
 #include "core/errors.hpp"
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 
 namespace backbone::continuation {
 

@@ -23,7 +23,7 @@
 #include <utility>
 #include <vector>
 
-#include "continuation/branch_points.hpp"
+#include "continuation/branch_points/branch_points.hpp"
 #include "continuation/options.hpp"
 #include "core/problem.hpp"
 #include "core/types.hpp"

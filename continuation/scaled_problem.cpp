@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "core/compressed_jacobian.hpp"
+#include "core/jacobians/compressed_jacobian.hpp"
 #include "core/errors.hpp"
 
 namespace backbone::continuation {

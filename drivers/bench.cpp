@@ -16,9 +16,9 @@
 
 #include "continuation/cli/bench_report.hpp"
 #include "core/errors.hpp"
-#include "core/finite_difference.hpp"
-#include "core/output_folder.hpp"
-#include "core/scene.hpp"
+#include "core/jacobians/finite_difference.hpp"
+#include "core/io/output_folder.hpp"
+#include "core/io/scene.hpp"
 #include "drivers/internal/commands.hpp"
 #include "drivers/internal/plugins.hpp"
 

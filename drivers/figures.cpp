@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "core/errors.hpp"
-#include "core/output_folder.hpp"
-#include "core/scene.hpp"
+#include "core/io/output_folder.hpp"
+#include "core/io/scene.hpp"
 #include "drivers/internal/commands.hpp"
 #include "drivers/internal/plugins.hpp"
 

@@ -4,7 +4,7 @@
 #include <fmt/format.h>
 
 #include "core/errors.hpp"
-#include "core/scene.hpp"
+#include "core/io/scene.hpp"
 
 namespace backbone::drivers {
 

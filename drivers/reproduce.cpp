@@ -10,9 +10,9 @@
 #include <filesystem>
 
 #include "core/errors.hpp"
-#include "core/output_folder.hpp"
-#include "core/scene.hpp"
-#include "core/table.hpp"
+#include "core/io/output_folder.hpp"
+#include "core/io/scene.hpp"
+#include "core/io/table.hpp"
 #include "drivers/internal/commands.hpp"
 #include "drivers/internal/plugins.hpp"
 

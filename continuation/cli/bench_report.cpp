@@ -7,7 +7,7 @@
 #include <sstream>
 #include <system_error>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 
 namespace backbone::cli {
 

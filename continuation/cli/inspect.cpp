@@ -6,8 +6,8 @@
 #include "continuation/dimension_evidence.hpp"
 #include "continuation/outputs.hpp"
 #include "core/errors.hpp"
-#include "core/periodic_orbit.hpp"
-#include "core/scene_ini.hpp"
+#include "core/orbits/periodic_orbit.hpp"
+#include "core/io/scene_ini.hpp"
 
 namespace backbone::cli {
 

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <limits>
 
-#include "continuation/natural.hpp"
-#include "continuation/pseudo_arclength.hpp"
+#include "continuation/methods/natural.hpp"
+#include "continuation/methods/pseudo_arclength.hpp"
 #include "core/errors.hpp"
-#include "core/finite_difference.hpp"
+#include "core/jacobians/finite_difference.hpp"
 
 namespace backbone::cli {
 

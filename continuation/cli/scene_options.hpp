@@ -19,13 +19,13 @@
 #include <memory>
 #include <string>
 
-#include "continuation/follow.hpp"
+#include "continuation/branch_points/follow.hpp"
 #include "continuation/options.hpp"
 #include "continuation/restart.hpp"
-#include "continuation/switching.hpp"
-#include "core/newton.hpp"
-#include "core/periodic_orbit.hpp"
-#include "core/scene.hpp"
+#include "continuation/methods/switching.hpp"
+#include "core/solvers/newton.hpp"
+#include "core/orbits/periodic_orbit.hpp"
+#include "core/io/scene.hpp"
 
 namespace backbone::cli {
 

@@ -8,11 +8,11 @@
 #include <cstdio>
 
 #include "continuation/cli/progress.hpp"
-#include "continuation/follow.hpp"
+#include "continuation/branch_points/follow.hpp"
 #include "core/errors.hpp"
-#include "core/output_folder.hpp"
-#include "core/scene_ini.hpp"
-#include "core/table.hpp"
+#include "core/io/output_folder.hpp"
+#include "core/io/scene_ini.hpp"
+#include "core/io/table.hpp"
 
 namespace backbone::cli {
 

@@ -26,10 +26,10 @@
 #include "continuation/cli/stop_signals.hpp"
 #include "continuation/outputs.hpp"
 #include "continuation/restart.hpp"
-#include "core/newton.hpp"
-#include "core/output_folder.hpp"
-#include "core/periodic_orbit.hpp"
-#include "core/scene.hpp"
+#include "core/solvers/newton.hpp"
+#include "core/io/output_folder.hpp"
+#include "core/orbits/periodic_orbit.hpp"
+#include "core/io/scene.hpp"
 
 namespace backbone::cli {
 

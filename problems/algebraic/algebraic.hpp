@@ -6,7 +6,7 @@
 //   Circle      x^2 + y^2 - R^2 = 0 in R^2: a closed curve of length 2 pi R. Dimension 1.
 //   Sphere      |x|^2 - R^2 = 0 in R^3: one equation, three unknowns. Dimension 2.
 // Curves crossing other solution sets at exactly known branch points (tests of the branch-point
-// detection, continuation/branch_points.hpp):
+// detection, continuation/branch_points/branch_points.hpp):
 //   Transcritical   x (lambda - 1 - x) = 0: the line x = 0 and the line x = lambda - 1 cross at
 //                   (0, 1) at 45 degrees.
 //   AxisAndCircle   x (x^2 + y^2 - 1) = 0: the y axis meets the unit circle at right angles at

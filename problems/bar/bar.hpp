@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 
 namespace backbone::bar {
 

@@ -1,6 +1,6 @@
 // The conservative Duffing oscillator x'' + x + x^3 = 0 as a periodic-orbit problem.
 //
-// A core::OdeOrbitProblem of dimension 1 (core/ode_orbit.hpp): unknowns [x0 | T], the orbit
+// A core::OdeOrbitProblem of dimension 1 (core/orbits/ode_orbit.hpp): unknowns [x0 | T], the orbit
 // starts at rest at amplitude x0 (v0 = 0); the flow (CVODE, Adams, rtol 1e-13), both shooting
 // formulations and the analytic Jacobian (variational equations) come from core. Residuals
 // (README.md, section 'Residuals and Jacobians'):
@@ -21,7 +21,7 @@
 
 #include <boost/program_options.hpp>
 
-#include "core/ode_orbit.hpp"
+#include "core/orbits/ode_orbit.hpp"
 
 namespace backbone::duffing {
 

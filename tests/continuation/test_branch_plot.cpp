@@ -12,7 +12,7 @@
 #include <string>
 
 #include "continuation/outputs.hpp"
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 
 namespace fs = std::filesystem;
 

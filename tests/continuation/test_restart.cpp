@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "continuation/branch_points.hpp"
-#include "continuation/natural.hpp"
-#include "continuation/pseudo_arclength.hpp"
+#include "continuation/branch_points/branch_points.hpp"
+#include "continuation/methods/natural.hpp"
+#include "continuation/methods/pseudo_arclength.hpp"
 #include "continuation/restart.hpp"
-#include "continuation/switching.hpp"
+#include "continuation/methods/switching.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
 #include "tests/continuation/test_support.hpp"

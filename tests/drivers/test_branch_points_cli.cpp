@@ -15,7 +15,7 @@
 #include <string>
 
 #include "core/errors.hpp"
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
 namespace {
@@ -124,7 +124,7 @@ TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
   EXPECT_NEAR(t.column("period")[static_cast<std::size_t>(row)], 3.5, 1e-7);
   // Its 24 probes step across a kink of F (the period's column of J changes by rank one). They
   // learn it from the first probe's Jacobian and difference it at the others' starts
-  // (continuation/branch_points.cpp, verify()), so location and verification need far fewer
+  // (continuation/branch_points/branch_points.cpp, verify()), so location and verification need far fewer
   // Jacobians than the probes, each of which would otherwise take at least one of its own.
   EXPECT_LE(t.column("jacobian_evaluations")[static_cast<std::size_t>(row)], 20);
   EXPECT_GE(t.column("dimension")[static_cast<std::size_t>(row)], 20);

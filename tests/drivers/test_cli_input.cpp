@@ -12,8 +12,8 @@
 #include <memory>
 #include <sstream>
 
-#include "core/output_folder.hpp"
-#include "core/table.hpp"
+#include "core/io/output_folder.hpp"
+#include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
 namespace {

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
 namespace {

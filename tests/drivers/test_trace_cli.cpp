@@ -13,7 +13,7 @@
 #include <sstream>
 #include <string>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
 namespace {

@@ -17,8 +17,8 @@
 
 #include "continuation/outputs.hpp"
 #include "core/errors.hpp"
-#include "core/scene.hpp"
-#include "core/table.hpp"
+#include "core/io/scene.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/solver/scene.hpp"
 
 namespace {

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "core/plot.hpp"
-#include "core/table.hpp"
+#include "core/io/plot.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/metrics.hpp"
 #include "problems/contact_bar/bench/support.hpp"

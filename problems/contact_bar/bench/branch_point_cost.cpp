@@ -26,7 +26,7 @@
 #include "continuation/cli/bench_report.hpp"
 #include "continuation/cli/plugin.hpp"
 #include "core/errors.hpp"
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/support.hpp"
 #include "problems/contact_bar/cli/trace.hpp"

@@ -18,9 +18,9 @@
 
 #include "continuation/cli/bench_report.hpp"
 #include "core/errors.hpp"
-#include "core/finite_difference.hpp"
-#include "core/plot.hpp"
-#include "core/scene.hpp"
+#include "core/jacobians/finite_difference.hpp"
+#include "core/io/plot.hpp"
+#include "core/io/scene.hpp"
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/metrics.hpp"
 #include "problems/contact_bar/bench/peers.hpp"

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "core/types.hpp"
 
 namespace backbone::contact_bar {

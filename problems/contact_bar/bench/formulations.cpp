@@ -12,13 +12,13 @@
 #include <utility>
 #include <vector>
 
-#include "continuation/natural.hpp"
-#include "core/finite_difference.hpp"
-#include "core/newton.hpp"
-#include "core/periodic_orbit.hpp"
-#include "core/plot.hpp"
-#include "core/rank_report.hpp"
-#include "core/table.hpp"
+#include "continuation/methods/natural.hpp"
+#include "core/jacobians/finite_difference.hpp"
+#include "core/solvers/newton.hpp"
+#include "core/orbits/periodic_orbit.hpp"
+#include "core/io/plot.hpp"
+#include "core/rank/rank_report.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/metrics.hpp"
 #include "problems/contact_bar/bench/support.hpp"
@@ -107,7 +107,7 @@ NewtonTrace trace_newton(const ContactBarOrbitProblem& problem, const core::Vect
 }
 
 // Rank report of the shooting Jacobian (2N equations, N + 1 unknowns) as the continuation makes
-// it (continuation/point_recorder.cpp: the problem's forward-difference Jacobian, relative
+// it (continuation/internal/point_recorder.cpp: the problem's forward-difference Jacobian, relative
 // threshold 1e-8, candidate null directions verified by re-correction), and the same with an
 // absolute floor at the measured uncertainty of that Jacobian, ||J_forward - J_central||_2
 // (Weyl: singular values below it cannot be told from zero), and the central-difference
@@ -140,7 +140,7 @@ RankColumns rank_columns(const core::PeriodicOrbitProblem& problem, const core::
   c.period_column_forward = forward.col(period).lpNorm<Eigen::Infinity>();
   c.period_column_central = central.col(period).lpNorm<Eigen::Infinity>();
   c.uncertainty = Eigen::JacobiSVD<core::Matrix>(forward - central).singularValues()[0];
-  // The continuation's verifier (continuation/point_recorder.cpp): default VerifyOptions.
+  // The continuation's verifier (continuation/internal/point_recorder.cpp): default VerifyOptions.
   const core::VerifyOptions verify;
   const auto verifier = core::make_verifier(verify);
   core::RankOptions absolute;

@@ -17,10 +17,10 @@
 #include <vector>
 
 #include "continuation/cli/plugin.hpp"
-#include "continuation/switching.hpp"
-#include "core/plot.hpp"
-#include "core/scene.hpp"
-#include "core/table.hpp"
+#include "continuation/methods/switching.hpp"
+#include "core/io/plot.hpp"
+#include "core/io/scene.hpp"
+#include "core/io/table.hpp"
 #include "problems/bar/bar.hpp"
 #include "problems/contact_bar/bench/metrics.hpp"
 

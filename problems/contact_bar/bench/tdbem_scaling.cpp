@@ -1,8 +1,8 @@
 // Benchmark tdbem_scaling (bench.hpp): TD-BEM CPU time against the number of steps.
 #include <fmt/format.h>
 
-#include "core/plot.hpp"
-#include "core/table.hpp"
+#include "core/io/plot.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/metrics.hpp"
 #include "problems/contact_bar/bench/support.hpp"

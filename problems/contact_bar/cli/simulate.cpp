@@ -8,7 +8,7 @@
 
 #include "continuation/outputs.hpp"
 #include "core/errors.hpp"
-#include "core/plot.hpp"
+#include "core/io/plot.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/solver/bar_solvers.hpp"
 #include "problems/contact_bar/solver/scene.hpp"

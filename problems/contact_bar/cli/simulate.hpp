@@ -14,7 +14,7 @@
 #include <boost/program_options.hpp>
 #include <filesystem>
 
-#include "core/scene.hpp"
+#include "core/io/scene.hpp"
 
 namespace backbone::contact_bar {
 

@@ -25,7 +25,7 @@
 #include <memory>
 
 #include "core/errors.hpp"
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/cli/simulate.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/orbits/attached_content.hpp"

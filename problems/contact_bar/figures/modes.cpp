@@ -7,9 +7,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/plot.hpp"
-#include "core/scene.hpp"
-#include "core/table.hpp"
+#include "core/io/plot.hpp"
+#include "core/io/scene.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/orbits/grazing_limits.hpp"
 #include "problems/contact_bar/solver/scene.hpp"

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <string>
 
-#include "core/plot.hpp"
-#include "core/scene.hpp"
-#include "core/table.hpp"
+#include "core/io/plot.hpp"
+#include "core/io/scene.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/solver/scene.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"

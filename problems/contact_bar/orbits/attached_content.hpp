@@ -3,7 +3,7 @@
 // changes').
 //
 // Both orbits (the point on the branch and a nearby point of the attached family, e.g. the probe
-// of a branch point, continuation/branch_points.hpp) are re-simulated over their own period by
+// of a branch point, continuation/branch_points/branch_points.hpp) are re-simulated over their own period by
 // the given solver (the exact oracle), the end displacement sampled at `samples` instants of one
 // period each; their difference is the attached content. Its spectrum over the period gives the
 // dominant harmonic (frequency_ratio: the content's frequency over the orbit's), and its sign

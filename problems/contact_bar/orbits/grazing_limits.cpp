@@ -10,7 +10,7 @@
 #include <limits>
 
 #include "core/errors.hpp"
-#include "core/newton.hpp"
+#include "core/solvers/newton.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"

@@ -30,7 +30,7 @@
 #include <string>
 #include <vector>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "core/types.hpp"
 #include "problems/bar/bar.hpp"
 #include "problems/contact_bar/orbits/subharmonic.hpp"

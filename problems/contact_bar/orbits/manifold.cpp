@@ -10,7 +10,7 @@
 
 #include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
-#include "core/plot.hpp"
+#include "core/io/plot.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
 

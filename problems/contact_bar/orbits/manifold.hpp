@@ -1,5 +1,5 @@
 // The 2D manifold of subharmonic orbits near omega2 / 2 (energy x shape), covered by an atlas
-// (continuation/atlas.hpp; README.md, section 'Subharmonic continuum').
+// (continuation/methods/atlas.hpp; README.md, section 'Subharmonic continuum').
 //
 // `backbone trace SCENE --branch subharmonic_manifold --energy_min E1 --energy_max E2 --out DIR`
 // builds the continuum's problem (start on the wall, two free knots), traces its first member
@@ -20,10 +20,10 @@
 #include <filesystem>
 #include <vector>
 
-#include "continuation/atlas.hpp"
+#include "continuation/methods/atlas.hpp"
 #include "continuation/cli/plugin.hpp"
-#include "core/scene.hpp"
-#include "core/table.hpp"
+#include "core/io/scene.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 
 namespace backbone::contact_bar {

@@ -37,7 +37,7 @@
 #include <vector>
 
 #include "continuation/scaled_problem.hpp"
-#include "core/periodic_orbit.hpp"
+#include "core/orbits/periodic_orbit.hpp"
 #include "problems/bar/bar.hpp"
 
 namespace backbone::contact_bar {

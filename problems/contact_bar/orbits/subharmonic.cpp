@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "continuation/dimension_evidence.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
 #include "problems/exact_bar/exact_solution.hpp"

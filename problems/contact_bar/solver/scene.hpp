@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "core/scene.hpp"
+#include "core/io/scene.hpp"
 #include "problems/bar/bar.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"
 

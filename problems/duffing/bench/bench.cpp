@@ -14,11 +14,11 @@
 #include <sstream>
 
 #include "continuation/cli/bench_report.hpp"
-#include "continuation/pseudo_arclength.hpp"
+#include "continuation/methods/pseudo_arclength.hpp"
 #include "core/errors.hpp"
-#include "core/newton.hpp"
-#include "core/plot.hpp"
-#include "core/table.hpp"
+#include "core/solvers/newton.hpp"
+#include "core/io/plot.hpp"
+#include "core/io/table.hpp"
 #include "problems/duffing/duffing.hpp"
 
 #ifndef BACKBONE_DUFFING_PEERS_DIR

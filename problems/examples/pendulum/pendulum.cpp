@@ -22,10 +22,10 @@
 #include <string>
 
 #include "continuation/cli/plugin.hpp"
-#include "continuation/pseudo_arclength.hpp"
-#include "core/newton.hpp"
-#include "core/ode_orbit.hpp"
-#include "core/table.hpp"
+#include "continuation/methods/pseudo_arclength.hpp"
+#include "core/solvers/newton.hpp"
+#include "core/orbits/ode_orbit.hpp"
+#include "core/io/table.hpp"
 
 namespace backbone::pendulum {
 

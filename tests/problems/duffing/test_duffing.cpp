@@ -7,9 +7,9 @@
 #include <iostream>
 #include <numbers>
 
-#include "continuation/natural.hpp"
-#include "continuation/pseudo_arclength.hpp"
-#include "core/rank_report.hpp"
+#include "continuation/methods/natural.hpp"
+#include "continuation/methods/pseudo_arclength.hpp"
+#include "core/rank/rank_report.hpp"
 #include "problems/duffing/duffing.hpp"
 
 using namespace backbone;

@@ -85,7 +85,7 @@ TEST(ContactBarBranchScaling, TinyBranchesGiveTheTableColumnsAndTheClosedForm) {
 }
 
 // Every column of the finite-difference Jacobian is computed by the same operations whatever
-// the thread count (core/finite_difference.hpp), so 2 threads must give one thread's matrix bit
+// the thread count (core/jacobians/finite_difference.hpp), so 2 threads must give one thread's matrix bit
 // for bit; a small grid keeps it fast.
 TEST(ContactBarBranchScaling, TwoThreadJacobianIsBitIdentical) {
   const contact_bar::JacobianThreadsTiming t = contact_bar::time_jacobian_threads(10, 1);

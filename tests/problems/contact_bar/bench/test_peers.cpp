@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <iostream>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/bench/peers.hpp"
 
 using namespace backbone;

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <string>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
 namespace {

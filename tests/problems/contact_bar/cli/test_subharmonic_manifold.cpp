@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
 namespace {

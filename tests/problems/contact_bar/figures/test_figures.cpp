@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
 
 namespace {

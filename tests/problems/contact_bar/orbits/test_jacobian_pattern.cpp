@@ -8,8 +8,8 @@
 
 #include <cmath>
 
-#include "core/compressed_jacobian.hpp"
-#include "core/finite_difference.hpp"
+#include "core/jacobians/compressed_jacobian.hpp"
+#include "core/jacobians/finite_difference.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/contact_bar/solver/bar_solvers.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"

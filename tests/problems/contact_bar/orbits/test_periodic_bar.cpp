@@ -9,12 +9,12 @@
 #include <memory>
 #include <thread>
 
-#include "continuation/pseudo_arclength.hpp"
+#include "continuation/methods/pseudo_arclength.hpp"
 #include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
-#include "core/finite_difference.hpp"
-#include "core/newton.hpp"
-#include "core/rank_report.hpp"
+#include "core/jacobians/finite_difference.hpp"
+#include "core/solvers/newton.hpp"
+#include "core/rank/rank_report.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"

@@ -8,7 +8,7 @@
 
 #include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
-#include "core/rank_report.hpp"
+#include "core/rank/rank_report.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/contact_bar/orbits/subharmonic.hpp"

@@ -11,7 +11,7 @@
 #include <numbers>
 
 #include "core/errors.hpp"
-#include "core/table.hpp"
+#include "core/io/table.hpp"
 #include "problems/duffing/bench/bench.hpp"
 #include "problems/duffing/duffing.hpp"
 

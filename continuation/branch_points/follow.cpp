@@ -1,0 +1,181 @@
+#include "continuation/branch_points/follow.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "continuation/outputs.hpp"
+#include "continuation/methods/pseudo_arclength.hpp"
+#include "continuation/scaled_problem.hpp"
+#include "core/errors.hpp"
+#include "core/orbits/periodic_orbit.hpp"
+#include "core/io/table.hpp"
+
+namespace backbone::continuation {
+
+namespace {
+
+double observable_of(const core::Observables& observables, const std::string& name) {
+  for (const auto& [key, value] : observables)
+    if (key == name) return value;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+FollowSelection parse_follow(const std::string& text) {
+  FollowSelection s;
+  if (text == "none") return s;
+  if (text == "all") {
+    s.kind = FollowSelection::Kind::all;
+    return s;
+  }
+  try {
+    std::size_t used = 0;
+    const long k = std::stol(text, &used);
+    if (used == text.size() && k >= 1 && k <= std::numeric_limits<int>::max()) {
+      s.kind = FollowSelection::Kind::one;
+      s.k = static_cast<int>(k);
+      return s;
+    }
+  } catch (const std::exception&) {
+  }
+  throw core::InputError(
+      "follow",
+      fmt::format("must be none, all or a row K >= 1 of branch_points.csv (got '{}')", text));
+}
+
+std::optional<AttachedStart> attached_start(const core::Problem& problem,
+                                            const BranchPointReport& report,
+                                            const std::string& observable, int rank) {
+  if (report.x.size() == 0 || rank < 0) return std::nullopt;
+  const ScaledProblem scaled(problem);
+  const core::Vector zx = scaled.to_scaled(report.x);
+  const double fx = observable_of(problem.observables(report.x), observable);
+  std::vector<AttachedStart> starts;
+  for (std::size_t i = 0; i < report.attached_points.size(); ++i) {
+    const core::Vector& y = report.attached_points[i];
+    const double distance = (scaled.to_scaled(y) - zx).norm();
+    const double change = observable_of(problem.observables(y), observable) - fx;
+    if (!(distance > 0) || !std::isfinite(change)) continue;
+    const double sign = change < 0 ? -1.0 : 1.0;
+    starts.push_back({report.x + sign * (y - report.x), sign * (y - report.x), static_cast<int>(i),
+                      std::abs(change) / distance});
+  }
+  std::stable_sort(
+      starts.begin(), starts.end(),
+      [](const AttachedStart& a, const AttachedStart& b) { return a.growth > b.growth; });
+  if (rank >= static_cast<int>(starts.size())) return std::nullopt;
+  return starts[static_cast<std::size_t>(rank)];
+}
+
+FollowedBranch follow_attached(const core::Problem& problem, const BranchPointReport& report,
+                               const std::string& observable, core::Corrector& corrector,
+                               const ContinuationOptions& options, const ContinuationHooks& hooks,
+                               int start_rank) {
+  FollowedBranch f;
+  if (!report.verified()) {
+    f.message = "not verified (no attached direction found by the probes): not followed";
+    return f;
+  }
+  f.start = attached_start(problem, report, observable, start_rank);
+  if (!f.start) {
+    f.message = fmt::format("no probed point with a finite {}: not followed", observable);
+    return f;
+  }
+  ContinuationOptions o = options;
+  o.method = Method::arclength;
+  o.branch_points.detect = false;
+  if (o.branch_points.max_turn_degrees > 0)
+    o.branch_points.max_turn_degrees =
+        std::max(o.branch_points.max_turn_degrees, follow_max_turn_degrees);
+  f.branch = pseudo_arclength(problem, f.start->guess, f.start->direction, corrector, o, hooks);
+  f.message = f.branch.message;
+  return f;
+}
+
+core::NewtonOptions follow_newton_options(const core::NewtonOptions& newton,
+                                          const ContinuationOptions& options) {
+  core::NewtonOptions o = newton;
+  o.rank_cutoff = std::max(o.rank_cutoff, options.rank.relative_threshold);
+  return o;
+}
+
+std::vector<FollowedBranch> follow_branch_points(
+    const core::Problem& problem, const Branch& branch, const FollowRun& run,
+    core::Corrector& corrector, const ContinuationOptions& options, const ContinuationHooks& hooks,
+    const std::filesystem::path& out,
+    const std::function<void(const std::filesystem::path&, const Branch&)>& extra,
+    const std::map<std::string, std::string>& units) {
+  std::vector<FollowedBranch> followed;
+  ContinuationOptions o = options;
+  o.max_points = run.max_points;
+  // The verified rank report (one probe per candidate direction, up to 19 at the contact bar's
+  // T = 3.6 point at 100 intervals) cost 30-50 s per followed point there: every 10th point.
+  if (o.rank_check_every > 0) o.rank_check_every = std::max(o.rank_check_every, 10);
+  const auto* periodic = dynamic_cast<const core::PeriodicOrbitProblem*>(&problem);
+  for (std::size_t i = 0; i < branch.branch_points.size(); ++i) {
+    const int k = static_cast<int>(i) + 1;
+    if (!run.selection.selects(k)) continue;
+    const BranchPointReport& report = branch.branch_points[i];
+    if (!report.verified() && run.selection.kind == FollowSelection::Kind::all) continue;
+    const std::filesystem::path dir = out / fmt::format("branch_point_{}", k);
+    std::filesystem::remove_all(dir);
+    FollowedBranch f;
+    if (!report.verified()) {  // only its summary.txt, no empty branch files
+      std::filesystem::create_directories(dir);
+      f = follow_attached(problem, report, run.observable, corrector, o, hooks);
+    } else {
+      // A start whose branch ends early is retried from the next fastest probe (the files are
+      // rewritten: they hold the last attempt).
+      for (int attempt = 0; attempt < std::max(1, run.start_attempts); ++attempt) {
+        if (attempt > 0 && !attached_start(problem, report, run.observable, attempt)) break;
+        BranchWriter writer(dir, periodic);
+        ContinuationHooks h = hooks;
+        h.on_point = [&](const BranchPoint& p) { writer.append(p); };
+        h.on_branch_point = nullptr;
+        h.on_attempt = nullptr;
+        f = follow_attached(problem, report, run.observable, corrector, o, h, attempt);
+        f.attempts = attempt + 1;
+        if (!f.branch.ended_early() || (h.cancel_requested && h.cancel_requested())) break;
+      }
+    }
+    f.branch_point = k;
+    if (!f.branch.points.empty()) {
+      plot_branch(dir, core::Table::read_csv(dir / "branch.csv"),
+                  fmt::format("attached at branch point {} ({} points)", k, f.branch.points.size()),
+                  units);
+      if (extra) extra(dir, f.branch);
+    }
+    core::write_text_atomically(
+        dir / "summary.txt",
+        fmt::format(
+            "branch_point {}\npoints {}\nstart_probe {}\nattempts {}\nstop_reason {}\nmessage {}\n",
+            k, f.branch.points.size(), f.start ? f.start->probe : -1, f.attempts,
+            f.branch.points.empty() ? "-" : to_string(f.branch.reason), f.message));
+    followed.push_back(std::move(f));
+  }
+  return followed;
+}
+
+std::string follow_line(const FollowedBranch& f, const std::string& observable) {
+  if (f.branch.points.empty()) return fmt::format("branch point {}: {}", f.branch_point, f.message);
+  double e_lo = std::numeric_limits<double>::infinity(), e_hi = -e_lo;
+  double t_lo = e_lo, t_hi = -e_lo;
+  for (const BranchPoint& p : f.branch.points) {
+    const double e = p.observable(observable), t = p.observable("period");
+    e_lo = std::min(e_lo, e);
+    e_hi = std::max(e_hi, e);
+    t_lo = std::min(t_lo, t);
+    t_hi = std::max(t_hi, t);
+  }
+  return fmt::format(
+      "branch point {}: {} points, {} in [{:.4g}, {:.4g}], period varies by {:.2e} "
+      "(relative), {} ({})",
+      f.branch_point, f.branch.points.size(), observable, e_lo, e_hi,
+      (t_hi - t_lo) / std::abs(t_lo), to_string(f.branch.reason), f.message);
+}
+
+}  // namespace backbone::continuation

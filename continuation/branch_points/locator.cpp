@@ -1,0 +1,429 @@
+#include "continuation/internal/branch_point_locator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "continuation/methods/pseudo_arclength.hpp"
+#include "core/solvers/bordered_system.hpp"
+#include "core/solvers/eigen_newton.hpp"
+
+namespace backbone::continuation::branch_point {
+
+Locator::Locator(const ScaledProblem& problem, ScaledProblem* own,
+                 const ContinuationOptions& options, const ContinuationHooks& hooks)
+    : problem_(problem), own_(own), options_(options), hooks_(hooks) {
+  // What the chord steps leave is finished by Gauss-Newton that keeps its Jacobian while it
+  // contracts (core::NewtonOptions::reuse_jacobian), to the verifier's tolerance: a located
+  // point's correction within max_iterations 10, a probe's within 5 (the probes that converge
+  // on the contact bar at 100 intervals take at most 4 iterations of the loop's corrector; the
+  // ones that do not, 6 to 10).
+  core::NewtonOptions newton = options.verification.corrector_options();
+  newton.reuse_jacobian = true;
+  newton.max_iterations = 10;
+  finisher_ = core::make_corrector("eigen", newton);
+  newton.max_iterations = 5;
+  probe_finisher_ = core::make_corrector("eigen", newton);
+}
+
+void Locator::run(Job job, std::vector<BranchPointReport>& found) {
+  if (own_) own_->set_units(job.scale, job.residual_factor);
+  last_jacobian_ = std::move(job.last_jacobian);
+  jacobian_scale_ = job.jacobian_scale;
+  found_ = &found;
+  locate(job.polyline, job.sign_change);
+  found_ = nullptr;
+}
+
+double Locator::null_cutoff() const {
+  // The rank report's: relative to the branch's Jacobian scale (verify()).
+  return options_.rank.relative_threshold * jacobian_scale_;
+}
+
+const Chord& Locator::chord_of(const Evaluation& e) const {
+  if (!e.chord) e.chord = std::make_shared<const Chord>(e.jacobian, null_cutoff());
+  return *e.chord;
+}
+
+Evaluation Locator::evaluate(const std::vector<Sample>& polyline, double s,
+                             const TestFunctionValue& reference, const Chord* initial,
+                             const Evaluation* last, const Evaluation* near) {
+  Evaluation e;
+  std::size_t i = 0;
+  while (i + 2 < polyline.size() && s > polyline[i + 1].s) ++i;
+  const Sample& a = polyline[i];
+  const Sample& b = polyline[i + 1];
+  const double length = b.s - a.s;
+  const double fraction = length > 0 ? std::clamp((s - a.s) / length, 0.0, 1.0) : 0.0;
+  const core::Vector segment = b.z - a.z;
+  const core::Vector through = a.z + fraction * segment;
+  const core::Vector normal = segment.normalized();
+  const core::Vector f = factor();
+  e.s = s;
+  // Start: the cubic Hermite interpolant of the two samples and their tangents (error O(L^4) in
+  // the chord length L, where the chord's own is O(L^2)), moved onto the hyperplane.
+  {
+    const double L = segment.norm(), t = fraction;
+    const core::Vector ta = a.tangent.dot(segment) < 0 ? core::Vector(-a.tangent) : a.tangent;
+    const core::Vector tb = b.tangent.dot(segment) < 0 ? core::Vector(-b.tangent) : b.tangent;
+    e.z = (2 * t * t * t - 3 * t * t + 1) * a.z + (t * t * t - 2 * t * t + t) * L * ta +
+          (-2 * t * t * t + 3 * t * t) * b.z + (t * t * t - t * t) * L * tb;
+    e.z += normal * normal.dot(through - e.z);
+    if (!e.z.allFinite() || a.tangent.size() != a.z.size() || b.tangent.size() != b.z.size())
+      e.z = through;
+  }
+  // From a corrected point of the location nearer than the polyline's samples, a tangent
+  // predictor onto the hyperplane and chord steps on that point's Jacobian: the bracket shrinks
+  // much faster than the polyline's interpolation error does.
+  // Else chord steps on the last evaluation's Jacobian (the sample's before the first).
+  const Chord* chord = nullptr;
+  if (near && near->ok) {
+    const double along = normal.dot(near->tangent);
+    if (std::abs(along) >= 0.5) {
+      e.z = near->z + near->tangent * (normal.dot(through - near->z) / along);
+      chord = &chord_of(*near);
+    }
+  }
+  if (!chord) chord = last ? &chord_of(*last) : initial;
+  if (!chord || !chord_correct(*chord, normal, through, e.z)) {
+    // From where the chord steps got to, in the loop's units (fresh Jacobians).
+    const core::BorderedSystem on_plane(
+        problem_, {core::BorderRow::hyperplane(normal.cwiseProduct(f).normalized(),
+                                               through.cwiseQuotient(f))});
+    core::Vector z = e.z.cwiseQuotient(f);
+    if (!finisher_->solve(on_plane, z).converged() || !z.allFinite()) return e;
+    e.z = z.cwiseProduct(f);
+  }
+  // A point on another family is not a point of the branch: it must stay near the chord.
+  if ((e.z - through).norm() > 0.25 * segment.norm()) return e;
+  core::Matrix J;
+  const long residuals_before = problem_.base().counters().residuals;
+  if (problem_.jacobian(e.z.cwiseQuotient(f), J) != core::EvalStatus::ok) return e;
+  if (problem_.base().counters().residuals > residuals_before)
+    jacobian_residuals_ = problem_.base().counters().residuals - residuals_before;
+  e.jacobian = in_unit_scale(J);
+  if (tangent_from_jacobian(e.jacobian, normal, options_.rank.relative_threshold, e.tangent) !=
+      core::EvalStatus::ok)
+    return e;
+  e.tau = bordered_test_function(e.jacobian, e.tangent, jacobian_scale_, &reference, true);
+  e.ok = true;
+  return e;
+}
+
+// What a location has learned so far: the best point (sampled or evaluated), every corrected
+// evaluation (for the next one's start) and every |tau| seen (for the minimisation of |tau|).
+struct Locator::Location {
+  Location(const std::vector<Sample>& samples, std::shared_ptr<const Chord> last_chord,
+           const core::Matrix& last_jacobian);
+  // Keeps e (corrected at s), and makes it the best point when its |tau| is the smallest yet.
+  void keep(Evaluation& e, double s);
+  const Evaluation* last() const { return done.empty() ? nullptr : &done.back(); }
+  // The corrected evaluation nearest to s when it is nearer than every sample of the polyline.
+  const Evaluation* nearest(double s) const;
+  // The test function's value at the known point (sample or evaluation) nearest to s: the
+  // reference that orients an evaluation at s (and starts its inverse iteration). Each value is
+  // oriented like its reference's, so the values of a chain of continued links share one sign
+  // convention, and a sign change between any two of them is a crossing.
+  TestFunctionValue tau_near(double s) const;
+
+  const std::vector<Sample>& polyline;
+  // Each correction starts with chord steps on the last Jacobian evaluated (Chord): the
+  // bracket is short, so it is close; the loop's corrector takes over when they stall. This
+  // one is the last sample's (null without it), used until a first evaluation is made.
+  std::shared_ptr<const Chord> chord;
+  // The best point so far: at first the sampled one with the smallest |tau|.
+  core::Vector best_z, best_tangent;
+  core::Matrix best_jacobian;               // empty: not kept (a sample before the last)
+  std::shared_ptr<const Chord> best_chord;  // of best_jacobian, when a sample's
+  int best_done = -1;                       // when an evaluation's: its index in done
+  double best_s = 0, best_value = std::numeric_limits<double>::infinity();
+  std::vector<Evaluation> done;  // every corrected evaluation, for the next one's start
+  // Every value seen, for the minimisation of |tau| (a dip, or a secant iteration whose
+  // singular triplet stopped following the reference's).
+  std::vector<std::pair<double, double>> seen;  // (s, |tau|)
+  int steps = 0;                                // evaluations made
+};
+
+Locator::Location::Location(const std::vector<Sample>& samples,
+                            std::shared_ptr<const Chord> last_chord,
+                            const core::Matrix& last_jacobian)
+    : polyline(samples), chord(std::move(last_chord)) {
+  for (const Sample& p : polyline)
+    if (std::abs(p.tau.value) < std::abs(best_value)) {
+      best_z = p.z;
+      best_tangent = p.tangent;
+      best_s = p.s;
+      best_value = p.tau.value;
+      const bool last = &p == &polyline.back();
+      best_jacobian = last ? last_jacobian : core::Matrix();
+      best_chord = last ? chord : nullptr;
+    }
+  for (const Sample& p : polyline) seen.emplace_back(p.s, std::abs(p.tau.value));
+}
+
+void Locator::Location::keep(Evaluation& e, double s) {
+  if (std::abs(e.tau.value) < std::abs(best_value)) {
+    best_z = e.z;
+    best_tangent = e.tangent;
+    best_s = s;
+    best_value = e.tau.value;
+    best_jacobian = e.jacobian;
+    best_chord = nullptr;
+    best_done = static_cast<int>(done.size());
+  }
+  done.push_back(e);
+}
+
+const Evaluation* Locator::Location::nearest(double s) const {
+  double distance = std::numeric_limits<double>::infinity();
+  for (const Sample& p : polyline) distance = std::min(distance, std::abs(p.s - s));
+  const Evaluation* best = nullptr;
+  for (const Evaluation& e : done)
+    if (std::abs(e.s - s) < distance) {
+      distance = std::abs(e.s - s);
+      best = &e;
+    }
+  return best;
+}
+
+TestFunctionValue Locator::Location::tau_near(double s) const {
+  if (const Evaluation* e = nearest(s)) return e->tau;
+  const Sample* closest = &polyline.front();
+  for (const Sample& p : polyline)
+    if (std::abs(p.s - s) < std::abs(closest->s - s)) closest = &p;
+  return closest->tau;
+}
+
+// The secant iteration on the signed test function: its last two values, and whether they
+// bracket a root.
+struct Locator::Secant {
+  bool root_finding = false;  // the iteration runs
+  bool bracketed = false;     // f_prev and f_last have opposite signs
+  double s_prev = 0, f_prev = 0, s_last = 0, f_last = 0;
+};
+
+Evaluation Locator::evaluate_at(Location& at, double s, const TestFunctionValue& reference) {
+  Evaluation e = evaluate(at.polyline, s, reference, at.chord.get(), at.last(), at.nearest(s));
+  ++at.steps;
+  return e;
+}
+
+void Locator::locate(const std::vector<Sample>& polyline, bool sign_change) {
+  const auto started = std::chrono::steady_clock::now();
+  const core::EvaluationCounters& counters = problem_.base().counters();
+  const long jacobians_before = counters.jacobians, residuals_before = counters.residuals;
+  // Located when |tau| is 1e-3 of the rank report's relative threshold: J is singular there at
+  // the resolution the verification uses, with a margin, and the period of a contact-bar point
+  // within ~3e-8 (at 100 intervals: 3.6 + 2.8e-9, 3.5 - 3.9e-10, 3.2 - 2.8e-8). Below that the
+  // finite-difference noise of the test function (4e-9..8e-9 at T = 3.6) stalls the iteration:
+  // at 1e-4 of it the location spends 6 more evaluations there for nothing. Near the root a
+  // step costs one Jacobian and a few residuals (tangent predictor from the nearest evaluation).
+  const double located_value = 1e-3 * options_.rank.relative_threshold;
+  BranchPointReport report;
+  report.sign_change = sign_change;
+  std::shared_ptr<const Chord> chord;
+  if (last_jacobian_.size() > 0)
+    chord = std::make_shared<const Chord>(last_jacobian_, null_cutoff());
+  Location at(polyline, std::move(chord), last_jacobian_);
+  Secant secant = start_secant(at, sign_change);
+  if (secant.root_finding) secant_steps(at, secant, located_value);
+  minimise_modulus(at, located_value);
+  verify_best(at, report);
+  report.jacobian_evaluations = counters.jacobians - jacobians_before;
+  report.residual_evaluations = counters.residuals - residuals_before;
+  report.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  found_->push_back(std::move(report));
+}
+
+// Secant steps on the signed test function, regula falsi (Illinois: the stale end's value
+// halved) once two values of opposite signs bracket the root. A sign change starts bracketed
+// by its two samples. A dip starts from its smallest sample and an evaluation at 1 % of the
+// way towards its smaller neighbour: near the root tau is linear in s over a short stretch
+// only (other singular values take over farther out), so the secant through the two
+// extrapolates to it where a fit through the three samples does not (on the contact bar at
+// 100 intervals the V through the samples of the dip at T = 3.6 puts it 0.022 off, 4.7 times
+// the distance of the smallest sample; the secant through that sample and one 1e-3 away puts
+// it 1e-6 off).
+Locator::Secant Locator::start_secant(Location& at, bool sign_change) {
+  const std::vector<Sample>& polyline = at.polyline;
+  Secant secant;
+  secant.root_finding = sign_change;
+  secant.bracketed = sign_change;
+  if (sign_change) {
+    secant.s_prev = polyline[0].s;
+    secant.f_prev = polyline[0].tau.value;
+    secant.s_last = polyline[1].s;
+    secant.f_last = polyline[1].tau.value;
+  } else if (polyline.size() == 3) {
+    const Sample& middle = polyline[1];
+    const bool right = std::abs(polyline[2].tau.value) < std::abs(polyline[0].tau.value);
+    const double delta = 0.01 * (right ? polyline[2].s - middle.s : polyline[0].s - middle.s);
+    const double s = middle.s + delta;
+    Evaluation e = evaluate_at(at, s, middle.tau);
+    if (e.ok) {
+      at.keep(e, s);
+      at.seen.emplace_back(s, std::abs(e.tau.value));
+      secant.s_prev = middle.s;
+      secant.f_prev = middle.tau.value;
+      secant.s_last = s;
+      secant.f_last = e.tau.value;
+      secant.root_finding = e.tau.continued;
+      secant.bracketed = secant.f_prev * secant.f_last < 0;
+    }
+  }
+  return secant;
+}
+
+// A root brings |tau| down superlinearly; a sign change that is a jump of tau (the
+// finite-difference Jacobian across a change of the contact sequence) or a dip that is not a
+// root does not: three evaluations in a row that do not halve the smallest |tau| end the
+// iteration. When it ends at a root (bracket below location_tolerance, |tau| located, or
+// stalled), the values seen are dropped: there is nothing left to minimise.
+void Locator::secant_steps(Location& at, Secant& secant, double located_value) {
+  const BranchPointOptions& o = options_.branch_points;
+  double& s_prev = secant.s_prev;
+  double& f_prev = secant.f_prev;
+  double& s_last = secant.s_last;
+  double& f_last = secant.f_last;
+  bool& bracketed = secant.bracketed;
+  const double s_min = at.polyline.front().s, s_max = at.polyline.back().s;
+  double smallest = std::min(std::abs(f_prev), std::abs(f_last));
+  int stale = 0;
+  bool left_range = false;
+  while (at.steps < o.max_location_steps && std::abs(s_last - s_prev) > o.location_tolerance &&
+         stale < 3 && !(std::abs(at.best_value) <= located_value)) {
+    double s = (s_prev * f_last - s_last * f_prev) / (f_last - f_prev);
+    if (bracketed) {
+      const double lo = std::min(s_prev, s_last), hi = std::max(s_prev, s_last);
+      if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
+    } else if (!(s > s_min && s < s_max)) {
+      left_range = true;
+      break;
+    }
+    Evaluation e = evaluate_at(at, s, at.tau_near(s));
+    if (!e.ok) break;
+    at.keep(e, s);
+    at.seen.emplace_back(s, std::abs(e.tau.value));
+    if (std::abs(e.tau.value) < 0.5 * smallest) {
+      smallest = std::abs(e.tau.value);
+      stale = 0;
+    } else {
+      ++stale;
+    }
+    if (!e.tau.continued) break;
+    if (e.tau.value == 0) {
+      at.seen.clear();
+      break;
+    }
+    if (e.tau.value * f_last < 0) {
+      bracketed = true;
+      s_prev = s_last;
+      f_prev = f_last;
+    } else if (bracketed) {
+      f_prev *= 0.5;
+    } else {
+      s_prev = s_last;
+      f_prev = f_last;
+    }
+    s_last = s;
+    f_last = e.tau.value;
+  }
+  if (!left_range && (std::abs(s_last - s_prev) <= o.location_tolerance || stale >= 3 ||
+                      std::abs(at.best_value) <= located_value))
+    at.seen.clear();
+}
+
+// Minimise |tau| from the smallest value seen and its neighbours: |tau| ~ |s - s*| near a
+// simple crossing, so fit the V through the three (the steeper side's chord does not straddle
+// the kink), golden section when the fit does not shrink the bracket. Stops when the bracket
+// is below location_tolerance, or when six evaluations in a row did not halve the smallest
+// value (a minimum that does not reach zero: a near miss, reported unverified).
+void Locator::minimise_modulus(Location& at, double located_value) {
+  const BranchPointOptions& o = options_.branch_points;
+  std::vector<std::pair<double, double>>& seen = at.seen;
+  std::sort(seen.begin(), seen.end());
+  std::size_t middle = 0;
+  for (std::size_t i = 1; i < seen.size(); ++i)
+    if (seen[i].second < seen[middle].second) middle = i;
+  if (!(middle > 0 && middle + 1 < seen.size())) return;
+  double sa = seen[middle - 1].first, fa = seen[middle - 1].second;
+  double sb = seen[middle].first, fb = seen[middle].second;
+  double sc = seen[middle + 1].first, fc = seen[middle + 1].second;
+  double previous_width = sc - sa, reference_value = fb;
+  int without_progress = 0;
+  // A minimum that stays flat above the rank threshold is a jump of the finite-difference test
+  // function, not a root: three evaluations in a row that neither halve the smallest value nor
+  // exceed twice it end the iteration (on the contact bar at 100 intervals the unverified
+  // candidates at T = 3.332 and 3.142 read 1.2e-4..1.5e-4 and 5.5e-4..6.6e-4 at each of their
+  // six V-fit evaluations; the verified dip at 3.6 starts 4-5 times above its sampled value).
+  // Below the threshold the iteration is at the noise and keeps its six.
+  int flat = 0;
+  bool golden = false;
+  while (at.steps < o.max_location_steps && sc - sa > o.location_tolerance && fb > located_value &&
+         without_progress < 6 && flat < 3) {
+    double s;
+    const bool right_larger = sc - sb > sb - sa;
+    if (golden) {
+      s = right_larger ? sb + 0.381966 * (sc - sb) : sb - 0.381966 * (sb - sa);
+    } else {
+      const double m1 = (fa - fb) / (sb - sa), m2 = (fc - fb) / (sc - sb);
+      s = m1 >= m2 ? sc - fc / m1 : sa + fa / m2;
+      const double nudge = 0.25 * o.location_tolerance;
+      if (std::abs(s - sb) < nudge) s = right_larger ? sb + nudge : sb - nudge;
+      if (!(s > sa && s < sc)) s = right_larger ? 0.5 * (sb + sc) : 0.5 * (sa + sb);
+    }
+    Evaluation e = evaluate_at(at, s, at.tau_near(s));
+    if (!e.ok) break;
+    at.keep(e, s);
+    const double f = std::abs(e.tau.value);
+    if (f < fb) {
+      if (s < sb) {
+        sc = sb;
+        fc = fb;
+      } else {
+        sa = sb;
+        fa = fb;
+      }
+      sb = s;
+      fb = f;
+    } else if (s < sb) {
+      sa = s;
+      fa = f;
+    } else {
+      sc = s;
+      fc = f;
+    }
+    if (fb < 0.5 * reference_value) {
+      reference_value = fb;
+      without_progress = 0;
+      flat = 0;
+    } else {
+      ++without_progress;
+      flat = f <= 2 * reference_value && reference_value > options_.rank.relative_threshold
+                 ? flat + 1
+                 : 0;
+    }
+    const double width = sc - sa;
+    golden = width > 0.7 * previous_width;
+    previous_width = width;
+  }
+}
+
+// The report's location (the best point, the sample it follows) and its verification there.
+void Locator::verify_best(Location& at, BranchPointReport& report) {
+  const std::vector<Sample>& polyline = at.polyline;
+  report.location_steps = at.steps;
+  report.test_value = at.best_value;
+  report.arclength = at.best_s;
+  report.after_point = polyline.front().index;
+  for (const Sample& p : polyline)
+    if (p.s <= at.best_s) report.after_point = p.index;
+  if (report.after_point == polyline.back().index && polyline.size() > 1)
+    report.after_point = polyline[polyline.size() - 2].index;
+  if (at.best_done >= 0) at.best_chord = at.done[static_cast<std::size_t>(at.best_done)].chord;
+  verify(report, at.best_z, at.best_tangent, at.best_jacobian, at.best_chord.get());
+}
+
+}  // namespace backbone::continuation::branch_point

@@ -1,0 +1,118 @@
+#include "continuation/internal/point_recorder.hpp"
+
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/rank/rank_report.hpp"
+
+namespace backbone::continuation {
+
+PointRecorder::PointRecorder(const core::Problem& problem, const ContinuationOptions& options,
+                             const core::Problem* counted)
+    : problem_(problem), counted_(counted ? *counted : problem), options_(options) {
+  if (options.rank_check_every > 0 && options.verify)
+    verifier_ = core::make_verifier(options.verification);
+}
+
+void PointRecorder::begin() {
+  start_ = std::chrono::steady_clock::now();
+  residuals_at_start_ = counted_.counters().residuals;
+  jacobians_at_start_ = counted_.counters().jacobians;
+}
+
+double PointRecorder::elapsed_seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_direction,
+                               const core::Vector* previous) {
+  core::Matrix J;
+  if (problem_.jacobian(point.x, J) != core::EvalStatus::ok) return;
+  core::RankOptions rank = options_.rank;
+  rank.full_spectrum = false;  // sigma_max and the values around the threshold suffice here
+  core::RankReport report = core::rank_report(J, rank);
+  const core::Matrix* nearby = options_.chord_corrections ? &J : nullptr;
+  if (verifier_) {
+    core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, report,
+                                 nearby, previous);
+    point.dimension = report.verified_dimension;
+  } else {
+    point.dimension = report.nullity;
+  }
+  point.rank = std::move(report);
+  recheck_dimension(point, curve_direction, nearby, previous);
+}
+
+void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,
+                                      const core::Matrix* jacobian, const core::Vector* previous) {
+  if (!verifier_ || !point.rank || point.rank->verified_dimension < 0 || point.dimension >= 1)
+    return;
+  point.dimension_flag = DimensionFlag::unconfirmed;
+  const double norm = curve_direction.norm();
+  if (curve_direction.size() != point.x.size() || !(norm > 0) || !std::isfinite(norm)) return;
+  core::RankReport along;
+  along.null_directions = curve_direction / norm;
+  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, along,
+                               jacobian, previous);
+  if (along.verified_dimension != 1) return;
+  // The curve is there. The rest of the candidate null space, orthogonal to it: the columns of
+  // an orthonormal basis of span(D) after the curve direction's component in it.
+  point.dimension_flag = DimensionFlag::rechecked;
+  point.dimension = 1;
+  const core::Matrix& D = point.rank->null_directions;
+  const Eigen::Index k = D.cols();
+  if (k < 2) return;
+  const core::Vector in_span = D.transpose() * along.null_directions.col(0);
+  if (!(in_span.norm() > 0)) return;
+  Eigen::HouseholderQR<core::Matrix> qr(core::Matrix(in_span / in_span.norm()));
+  const core::Matrix Q = qr.householderQ();
+  core::RankReport others;
+  others.null_directions = D * Q.rightCols(k - 1);
+  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, others,
+                               jacobian, previous);
+  point.dimension += std::max(others.verified_dimension, 0);
+}
+
+BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_iterations,
+                                  double ds, double arclength, bool force_rank,
+                                  const core::Vector& curve_direction,
+                                  const core::Vector* previous) {
+  BranchPoint p;
+  p.index = index;
+  p.x = x;
+  p.observables = problem_.observables(x);
+  core::Vector r;
+  p.residual = problem_.residual(x, r) == core::EvalStatus::ok
+                   ? r.lpNorm<Eigen::Infinity>()
+                   : std::numeric_limits<double>::quiet_NaN();
+  p.newton_iterations = newton_iterations;
+  p.step_size = ds;
+  p.arclength = arclength;
+  const bool due = options_.rank_check_every > 0 && index % options_.rank_check_every == 0;
+  if (due || (force_rank && options_.rank_check_every > 0))
+    check_rank(p, curve_direction, previous);
+  p.residual_evaluations = counted_.counters().residuals - residuals_at_start_;
+  p.jacobian_evaluations = counted_.counters().jacobians - jacobians_at_start_;
+  p.seconds = elapsed_seconds();
+  return p;
+}
+
+const Bound* PointRecorder::violated_bound(const BranchPoint& point, double& value) const {
+  for (const Bound& b : options_.bounds) {
+    const double v = point.observable(b.observable);
+    if (std::isnan(v)) continue;
+    if (v < b.min) {
+      value = b.min;
+      return &b;
+    }
+    if (v > b.max) {
+      value = b.max;
+      return &b;
+    }
+  }
+  return nullptr;
+}
+
+}  // namespace backbone::continuation
