@@ -60,7 +60,7 @@ core::Table branch_table(const Branch& branch) {
   std::vector<std::string> columns{"point"};
   columns.insert(columns.end(), names.begin(), names.end());
   for (const char* c : {"dimension", "dimension_flag", "nullity", "sigma_zero", "sigma_kept",
-                        "residual", "newton_iterations", "step_size", "arclength", "seconds",
+                        "residual", "newton_iterations", "step_size", "arclength",
                         "jacobian_evaluations", "residual_evaluations"})
     columns.push_back(c);
   core::Table table(columns);
@@ -87,7 +87,6 @@ core::Table branch_table(const Branch& branch) {
     row.push_back(p.newton_iterations);
     row.push_back(p.step_size);
     row.push_back(p.arclength);
-    row.push_back(p.seconds);
     row.push_back(static_cast<double>(p.jacobian_evaluations));
     row.push_back(static_cast<double>(p.residual_evaluations));
     table.add_row(row);
@@ -113,9 +112,9 @@ core::Table branch_point_table(const Branch& branch, const core::Observables& te
   std::vector<std::string> columns = observables;
   columns.push_back("dimension");
   columns.insert(columns.end(), described.begin(), described.end());
-  for (const char* c : {"tangent_angle", "verified", "nullity", "after_point", "arclength",
-                        "test_value", "sign_change", "location_steps", "jacobian_evaluations",
-                        "residual_evaluations", "seconds"})
+  for (const char* c :
+       {"tangent_angle", "verified", "nullity", "after_point", "arclength", "test_value",
+        "sign_change", "location_steps", "jacobian_evaluations", "residual_evaluations"})
     columns.push_back(c);
   core::Table table(columns);
   for (const BranchPointReport& r : branch.branch_points) {
@@ -123,12 +122,12 @@ core::Table branch_point_table(const Branch& branch, const core::Observables& te
     for (const std::string& n : observables) row.push_back(value_of(r.observables, n));
     row.push_back(r.attached_dimension);
     for (const std::string& n : described) row.push_back(value_of(r.attached_description, n));
-    row.insert(row.end(),
-               {r.tangent_angle, r.verified() ? 1.0 : 0.0, static_cast<double>(r.nullity),
-                static_cast<double>(r.after_point), r.arclength, r.test_value,
-                r.sign_change ? 1.0 : 0.0, static_cast<double>(r.location_steps),
-                static_cast<double>(r.jacobian_evaluations),
-                static_cast<double>(r.residual_evaluations), r.seconds});
+    row.insert(
+        row.end(),
+        {r.tangent_angle, r.verified() ? 1.0 : 0.0, static_cast<double>(r.nullity),
+         static_cast<double>(r.after_point), r.arclength, r.test_value, r.sign_change ? 1.0 : 0.0,
+         static_cast<double>(r.location_steps), static_cast<double>(r.jacobian_evaluations),
+         static_cast<double>(r.residual_evaluations)});
     table.add_row(row);
   }
   return table;

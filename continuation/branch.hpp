@@ -3,14 +3,16 @@
 // Every point carries its solution vector x (layout of the problem), the observables the problem
 // reports there, the verified dimension of the solution set (rank report + re-correction along
 // the candidate null directions, core/rank/rank_report.hpp), and the cost of getting it (Newton
-// iterations, Jacobian evaluations, wall seconds). A run that fails keeps every point corrected
-// before the failure: the StopReason and message say why it ended. branch_table turns a branch
-// into the columns of branch.csv (observables by name, then the bookkeeping columns).
+// iterations, Jacobian and residual evaluations, wall seconds). A run that fails keeps every
+// point corrected before the failure: the StopReason and message say why it ended. branch_table
+// turns a branch into the columns of branch.csv (observables by name, then the bookkeeping
+// columns): the deterministic ones only, so that a rerun writes the same file; the wall seconds
+// are on the progress lines and in the bench cases.
 //
 //   Branch branch = pseudo_arclength(problem, start, direction, *newton, options, hooks);
 //   if (branch.reason != StopReason::max_points) fmt::print("{}\n", branch.message);
 //   for (const BranchPoint& p : branch.points) use(p.x, p.observable("energy"), p.dimension);
-//   core::Table t = branch_table(branch);   // point, period, frequency, energy, ..., seconds
+//   core::Table t = branch_table(branch);   // point, period, frequency, energy, ..., cost
 //   t.write_csv(out / "branch.csv");
 #pragma once
 
@@ -132,8 +134,8 @@ struct Branch {
 // dimension, dimension_flag (DimensionFlag: 0 as verified, 1 re-checked along the tangent, 2
 // below the curve's 1 and unconfirmed), nullity (candidate, -1 when unchecked), sigma_zero and
 // sigma_kept (largest singular value counted as zero and smallest kept, relative to the largest),
-// residual, newton_iterations, step_size, arclength, seconds, jacobian_evaluations,
-// residual_evaluations.
+// residual, newton_iterations, step_size, arclength, jacobian_evaluations,
+// residual_evaluations. Repeated runs write it bit for bit: it holds no wall time.
 core::Table branch_table(const Branch& branch);
 
 // branch_points.csv: one row per located candidate (Branch::branch_points): its observables (the
@@ -142,7 +144,7 @@ core::Table branch_table(const Branch& branch);
 // columns (ContinuationHooks::describe_branch_point, e.g. frequency_ratio), tangent_angle
 // [degrees], verified (0/1), nullity (candidate directions at the point), after_point, arclength,
 // test_value, sign_change (0/1: located as a root, else as a dip's minimum), location_steps,
-// jacobian_evaluations, residual_evaluations (location and verification), seconds.
+// jacobian_evaluations, residual_evaluations (location and verification).
 core::Table branch_point_table(const Branch& branch, const core::Observables& template_point = {});
 
 }  // namespace backbone::continuation

@@ -7,8 +7,9 @@
 #include <cmath>
 #include <cstdio>
 
-#include "continuation/cli/progress.hpp"
+#include "continuation/branch.hpp"
 #include "continuation/branch_points/follow.hpp"
+#include "continuation/cli/progress.hpp"
 #include "core/errors.hpp"
 #include "core/io/output_folder.hpp"
 #include "core/io/scene_ini.hpp"
@@ -61,6 +62,25 @@ void check_bounds(const core::Scene& scene, const core::Problem& problem, const 
                       b.observable, start, below ? "below" : "above", below ? b.min : b.max));
     }
   }
+}
+
+// A resumed run appends rows to the saved branch.csv: its columns must be the ones this run
+// writes (another version, or another problem, wrote other ones).
+void check_saved_columns(const std::filesystem::path& dir, const core::Problem& problem,
+                         const core::Vector& x) {
+  continuation::BranchPoint point;
+  point.x = x;
+  point.observables = problem.observables(x);
+  continuation::Branch one;
+  one.points.push_back(point);
+  const std::vector<std::string> expected = continuation::branch_table(one).columns();
+  const std::vector<std::string> saved = core::Table::read_csv(dir / "branch.csv").columns();
+  if (saved != expected)
+    throw core::InputError(
+        "resume", fmt::format("'{}' has the columns {}, this run writes {}: resume it with the "
+                              "version that wrote it, or --start DIR:K into a new folder",
+                              (dir / "branch.csv").string(), fmt::join(saved, ","),
+                              fmt::join(expected, ",")));
 }
 
 }  // namespace
@@ -125,6 +145,7 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
   if (t.restart)
     continuation::take_up(*t.restart, restart_key, static_cast<int>(start_direction), problem,
                           options, t.setup.guess, t.direction);
+  if (t.restart && !t.resume.empty()) check_saved_columns(t.resume, problem, t.setup.guess);
   if (t.restart && !t.resume.empty() && !t.restart->note.empty()) {
     // The saved states belong to another run's loop: the folder keeps none of them.
     continuation::forget_saved_states(t.resume);

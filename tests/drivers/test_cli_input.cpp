@@ -200,6 +200,28 @@ TEST(TraceInput, ResumeWithAnotherRunsStatesKeepsNoneOfThem) {
   EXPECT_EQ(own, 3);    // the resumed points carry this run's arclength states
 }
 
+TEST(TraceOutputs, ARerunWritesEveryFileBitForBit) {
+  // No output of a trace holds a wall time (they are on the progress lines and in the bench), so
+  // the main job rerun leaves results/ as it was outside results/bench.
+  const fs::path first = cli::scratch("trace_outputs", "first");
+  const fs::path second = cli::scratch("trace_outputs", "second");
+  const std::string run = small + " --detect_branch_points true";
+  ASSERT_EQ(cli::run("trace", run, first).code, 0);
+  ASSERT_EQ(cli::run("trace", run, second).code, 0);
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(first)) {
+    const auto read = [](const fs::path& p) {
+      std::ifstream in(p, std::ios::binary);
+      return std::string((std::istreambuf_iterator<char>(in)), {});
+    };
+    const fs::path other = second / entry.path().filename();
+    ASSERT_TRUE(fs::exists(other)) << other;
+    EXPECT_EQ(read(entry.path()), read(other)) << entry.path().filename();
+    ++files;
+  }
+  EXPECT_GE(files, 8);  // branch, orbits, unknowns, state, summary, scene, closed form, figure
+}
+
 TEST(OutputFolderInput, AFolderThatCannotBeCreatedIsBadInputForEveryCommand) {
   // /proc takes no new folders; bench and reproduce checked nothing before their first case.
   const fs::path proc = "/proc/backbone_test";

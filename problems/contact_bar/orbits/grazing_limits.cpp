@@ -465,12 +465,12 @@ GrazingLimits grazing_limits(const bar::BarSetup& setup, const bar::BarSolver& s
 core::Table grazing_limit_table(const GrazingLimits& g) {
   core::Table t({"limit", "ok", "free_knots", "energy", "period", "contact_phases",
                  "grazing_instants", "min_gap", "phase_duration", "residual", "return_error",
-                 "shift_distance", "evaluations", "seconds"});
+                 "shift_distance", "evaluations"});
   for (const GrazingLimit& l : g.limits)
     t.add_row({l.name == "shape_1" ? 1.0 : 0.0, l.ok ? 1.0 : 0.0, double(l.free_knots), l.energy,
                l.period, double(l.structure.contact_phases), double(l.structure.grazing_instants),
                l.structure.min_gap, l.phase_duration, l.residual, l.return_error, g.shift_distance,
-               double(l.evaluations), l.seconds});
+               double(l.evaluations)});
   return t;
 }
 

@@ -407,13 +407,13 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   // 40 steps per period, 13 elements at N = 160), with entries as large as the largest
   // (tests/problems/contact_bar/test_jacobian_pattern.cpp). So the bare supports come first,
   // checked to 1e-4 of each row's size instead of the default 1e-3 (above what the check's
-  // finite differences and kinks leave on a complete pattern, problems/contact_bar/orbits/README.md, section 'Jacobian pattern'), and
-  // the c dt margin is their `wider` pattern, built only for the Jacobians whose check fails:
-  // the bare supports take fewer residuals. The exact solver follows the characteristics
-  // exactly: the bare supports are its structural pattern.
-  // Without free knots, the exact solver's bare supports and the TD-BEM's c dt margin hold
-  // every entry, so a check that fails on them is a kink of F (a contact event moved by the
-  // check's step): structural, kept by a corrector (core/problem.hpp), which spares the rank
+  // finite differences and kinks leave on a complete pattern,
+  // problems/contact_bar/orbits/README.md, section 'Jacobian pattern'), and the c dt margin is
+  // their `wider` pattern, built only for the Jacobians whose check fails: the bare supports take
+  // fewer residuals. The exact solver follows the characteristics exactly: the bare supports are
+  // its structural pattern. Without free knots, the exact solver's bare supports and the TD-BEM's c
+  // dt margin hold every entry, so a check that fails on them is a kink of F (a contact event moved
+  // by the check's step): structural, kept by a corrector (core/problem.hpp), which spares the rank
   // report's probes a column-by-column Jacobian each. With free knots (the subharmonic
   // members) they are not: a kept pattern there stalls the probes of
   // SubharmonicRepresentation.VerifiedDimensionIsTwo where column-by-column Jacobians converge.

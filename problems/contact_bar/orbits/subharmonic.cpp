@@ -7,9 +7,9 @@
 #include <limits>
 #include <vector>
 
+#include "continuation/dimension_evidence.hpp"
 #include "core/errors.hpp"
 #include "core/io/table.hpp"
-#include "continuation/dimension_evidence.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
 #include "problems/exact_bar/exact_solution.hpp"
 
@@ -93,7 +93,7 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
   if (check) rank.relative_threshold = rank_threshold;
   core::Table table({"point", "energy", "period", "period_closed_form", "relative_error", "shape",
                      "contact_phases", "grazing_instants", "min_gap", "return_error", "dimension_F",
-                     "nullity_F", "gap_F", "seconds_F"});
+                     "nullity_F", "gap_F"});
   std::vector<double> dimensions;
   std::vector<bool> beside;  // the dimension came from J beside the point (rechecked)
   std::vector<ContactStructure> structures;
@@ -112,16 +112,15 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
     const std::size_t j = i + 1 < branch.points.size() ? i + 1 : (i > 0 ? i - 1 : i);
     if (check)
       e = continuation::dimension_evidence(alone, point.x, rank, core::VerifyOptions{},
-                             j != i ? branch.points[j].x : core::Vector{});
+                                           j != i ? branch.points[j].x : core::Vector{});
     dimensions.push_back(check ? e.report.verified_dimension : nan);
     beside.push_back(check && e.beside);
-    table.add_row({static_cast<double>(point.index), energy, period, exact,
-                   std::abs(period / exact - 1), point.observable("shape"),
-                   c.ok ? c.contact_phases : nan, c.ok ? c.grazing_instants : nan,
-                   c.ok ? c.min_gap : nan, re.worst(),
-                   check ? static_cast<double>(e.report.verified_dimension) : nan,
-                   check ? static_cast<double>(e.report.nullity) : nan, check ? e.report.gap : nan,
-                   check ? e.seconds : nan});
+    table.add_row(
+        {static_cast<double>(point.index), energy, period, exact, std::abs(period / exact - 1),
+         point.observable("shape"), c.ok ? c.contact_phases : nan, c.ok ? c.grazing_instants : nan,
+         c.ok ? c.min_gap : nan, re.worst(),
+         check ? static_cast<double>(e.report.verified_dimension) : nan,
+         check ? static_cast<double>(e.report.nullity) : nan, check ? e.report.gap : nan});
   }
   table.write_csv(out / "subharmonic_check.csv");
   // branch.csv gains the contact structure (columns contact_phases, grazing_instants, min_gap)

@@ -39,7 +39,7 @@ ContactStructure contact_structure(const bar::BarSetup& setup, double period);
 // After a subharmonic trace: DIR/subharmonic_check.csv, per point the energy, the period against
 // 2 T2 of mode 2 at that energy, the shape, the contact structure, the exact-oracle return error
 // and the verified dimension of the periodicity residual F alone (path rows off: dimension_F,
-// nullity_F, gap_F, seconds_F). branch.csv gains the columns contact_phases, grazing_instants
+// nullity_F, gap_F). branch.csv gains the columns contact_phases, grazing_instants
 // and min_gap; when rank_threshold is a number its dimension column is replaced by dimension_F
 // (the traced system F plus its path row has one dimension less).
 void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const ContactFamily& mode2,
