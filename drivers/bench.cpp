@@ -16,9 +16,9 @@
 
 #include "continuation/cli/bench_report.hpp"
 #include "core/errors.hpp"
-#include "core/jacobians/finite_difference.hpp"
 #include "core/io/output_folder.hpp"
 #include "core/io/scene.hpp"
+#include "core/jacobians/finite_difference.hpp"
 #include "drivers/internal/commands.hpp"
 #include "drivers/internal/plugins.hpp"
 
@@ -70,9 +70,11 @@ int run_bench(const std::vector<std::string>& args) {
   if (!selected.empty() && jobs.empty())
     throw core::InputError("case",
                            fmt::format("must be one of {} (got '{}')", case_names(), selected));
-  // InputError("threads") outside [1, max_jacobian_threads] (clamped first: no int overflow).
-  core::set_default_jacobian_threads(static_cast<int>(
-      std::clamp<long>(vm["threads"].as<long>(), 0, core::max_jacobian_threads + 1)));
+  const long threads = vm["threads"].as<long>();
+  if (threads < 1 || threads > core::max_jacobian_threads)
+    throw core::InputError(
+        "threads", fmt::format("must be in 1..{} (got {})", core::max_jacobian_threads, threads));
+  core::set_default_jacobian_threads(static_cast<int>(threads));
   const std::filesystem::path out = vm["out"].as<std::string>();
   core::check_output_folder("out", out);
   int status = core::exit_ok;

@@ -51,7 +51,9 @@ int main(int argc, char** argv, RegisterPlugins register_plugins) {
   keep_large_blocks();
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     print_usage();
-    return argc < 2 ? core::exit_bad_input : core::exit_ok;
+    if (argc >= 2) return core::exit_ok;
+    fmt::print(stderr, "backbone: a command is required (the list above)\n");
+    return core::exit_bad_input;
   }
   const std::string name = argv[1];
   auto it = commands().find(name);

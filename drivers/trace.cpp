@@ -24,10 +24,10 @@
 #include "continuation/restart.hpp"
 #include "core/errors.hpp"
 #include "core/io/output_folder.hpp"
-#include "core/orbits/periodic_orbit.hpp"
 #include "core/io/scene.hpp"
 #include "core/io/scene_ini.hpp"
 #include "core/io/table.hpp"
+#include "core/orbits/periodic_orbit.hpp"
 #include "drivers/internal/commands.hpp"
 #include "drivers/internal/plugins.hpp"
 
@@ -94,7 +94,15 @@ std::filesystem::path take_resume(std::vector<std::string>& args) {
   if (!std::filesystem::exists(resume / "scene.ini"))
     throw core::InputError(
         "resume", fmt::format("'{}' holds no scene.ini of a traced branch", resume.string()));
+  if (!std::filesystem::exists(resume / "summary.txt"))
+    throw core::InputError(
+        "resume", fmt::format("'{}' holds no summary.txt of a traced branch", resume.string()));
   const std::string branch = core::read_text_value(resume / "summary.txt", "branch");
+  for (const std::string& word : args)
+    if (word == "--start" || word.rfind("--start=", 0) == 0)
+      throw core::InputError("start",
+                             "goes with a scene, not with --resume (which continues "
+                             "the folder's own branch)");
   args.erase(args.begin(), args.begin() + 2);
   args.insert(args.begin(),
               {(resume / "scene.ini").string(), "--branch", branch, "--out", resume.string()});

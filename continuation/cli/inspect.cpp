@@ -1,18 +1,21 @@
 #include "continuation/cli/inspect.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <filesystem>
 
 #include "continuation/cli/scene_options.hpp"
 #include "continuation/dimension_evidence.hpp"
 #include "continuation/outputs.hpp"
 #include "core/errors.hpp"
-#include "core/orbits/periodic_orbit.hpp"
 #include "core/io/scene_ini.hpp"
+#include "core/orbits/periodic_orbit.hpp"
 
 namespace backbone::cli {
 
-int inspect_command(const ProblemPlugin& plugin,
-                    const std::vector<std::string>& args) {
+int inspect_command(const ProblemPlugin& plugin, const std::vector<std::string>& args) {
   namespace po = boost::program_options;
   if (args.empty()) throw core::InputError("SCENE", "a scene file is required");
   po::options_description keys = plugin.scene_keys(), own("inspect");
@@ -22,9 +25,16 @@ int inspect_command(const ProblemPlugin& plugin,
   const core::Scene scene = core::read_scene(keys, args[0], {args.begin() + 1, args.end()}, own);
   if (!scene.has("orbit")) throw core::InputError("orbit", "needs DIR/orbits.csv:K");
   const auto [dir, point] = continuation::parse_saved_point(scene.text("orbit"), "orbit");
+  if (!std::filesystem::exists(dir / "unknowns.csv"))
+    throw core::InputError(
+        "orbit", fmt::format("'{}' holds no traced branch (no unknowns.csv)", dir.string()));
   const std::string branch = scene.has("branch")
                                  ? scene.text("branch")
                                  : core::read_text_value(dir / "summary.txt", "branch");
+  if (std::find(plugin.branches.begin(), plugin.branches.end(), branch) == plugin.branches.end())
+    throw core::InputError(scene.has("branch") ? "branch" : "orbit",
+                           fmt::format("'{}' is not a branch of {} (known: {})", branch,
+                                       plugin.name, fmt::join(plugin.branches, ", ")));
   const RunSettings run = read_run_settings(scene);
   TraceSetup setup = plugin.setup(scene, branch);
   if (auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get()))

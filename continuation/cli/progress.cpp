@@ -53,10 +53,9 @@ std::string point_line(const BranchPoint& p) {
 
 std::string branch_point_line(const BranchPointReport& r) {
   const std::string observables = observables_text(r.observables);
-  std::string verdict =
-      r.verified() ? fmt::format("verified, attached dimension {} (nullity {})",
-                                 r.attached_dimension, r.nullity)
-                   : fmt::format("not verified (nullity {})", r.nullity);
+  std::string verdict = r.verified() ? fmt::format("verified, attached dimension {} (nullity {})",
+                                                   r.attached_dimension, r.nullity)
+                                     : fmt::format("not verified (nullity {})", r.nullity);
   if (r.verified())
     for (const auto& [key, value] : r.attached_description)
       verdict += fmt::format(" {} {:.6g}", key, value);

@@ -135,6 +135,8 @@ void read_bounds(const core::Scene& scene, ContinuationOptions& o) {
     b.min = bound_value(spec.substr(first + 1, second - first - 1),
                         -std::numeric_limits<double>::infinity(), spec);
     b.max = bound_value(spec.substr(second + 1), std::numeric_limits<double>::infinity(), spec);
+    if (!(b.min < b.max))
+      throw core::InputError("bound", fmt::format("'{}': MIN must be below MAX", spec));
     o.bounds.push_back(b);
   }
 }
@@ -170,6 +172,14 @@ RunSettings read_run_settings(const core::Scene& scene) {
   o.branch_points.background = scene.flag("locate_in_background");
   read_bounds(scene, o);
   o.validate();
+  // Branch points are detected along a pseudo-arclength loop (the natural loop has no tangent to
+  // border J with); natural_then_arclength detects once it switches.
+  if (o.method == Method::natural && o.branch_points.detect)
+    throw core::InputError(
+        run.follow.selection.kind != FollowSelection::Kind::none ? "follow"
+                                                                 : "detect_branch_points",
+        "needs method arclength or natural_then_arclength (branch points are detected along "
+        "the arclength loop)");
   run.newton = scene.choice("newton", {"eigen", "kinsol"});
   run.newton_options.residual_tolerance = scene.positive("newton_tolerance");
   // A probe of the rank verification is a solution by the same standard as a point of the

@@ -4,7 +4,6 @@
 
 namespace backbone::cli {
 
-
 namespace {
 
 volatile std::sig_atomic_t first_signal = 0;

@@ -64,6 +64,21 @@ void check_bounds(const core::Scene& scene, const core::Problem& problem, const 
   }
 }
 
+// The natural methods' parameter: the period of a periodic-orbit problem, or an observable.
+void check_natural_parameter(const RunSettings& run, const core::Problem& problem,
+                             const core::Vector& guess, bool periodic) {
+  using continuation::Method;
+  if (run.options.method == Method::arclength) return;
+  if (periodic && run.natural_parameter == "period") return;
+  std::vector<std::string> names;
+  for (const auto& [name, value] : problem.observables(guess)) names.push_back(name);
+  if (std::find(names.begin(), names.end(), run.natural_parameter) == names.end())
+    throw core::InputError(
+        "natural_parameter",
+        fmt::format("'{}' is not an observable of {} (its observables: {})", run.natural_parameter,
+                    problem.name(), fmt::join(names, ", ")));
+}
+
 // A resumed run appends rows to the saved branch.csv: its columns must be the ones this run
 // writes (another version, or another problem, wrote other ones).
 void check_saved_columns(const std::filesystem::path& dir, const core::Problem& problem,
@@ -162,6 +177,7 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
                                                  "(use newton = eigen, least squares)",
                                                  entry.name, m, n));
   check_bounds(scene, problem, t.setup.guess, options, t.restart.has_value());
+  check_natural_parameter(t.run, problem, t.setup.guess, t.periodic != nullptr);
   // A consistent overdetermined system (m > n - 1) still has curves of solutions.
   t.expected_dimension = n - std::min(m, n - 1);
   return t;

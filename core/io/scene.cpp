@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string_view>
+#include <typeinfo>
 
 #include "core/errors.hpp"
 
@@ -37,8 +38,36 @@ std::string message_of(const po::error& e) {
   return copy.what();
 }
 
-// Boost's messages quote the option with its dashes; the user wants the key.
-[[noreturn]] void rethrow_as_input_error(const po::error& e, const std::string& where) {
+// What a value of `key` must be, from its type in `keys` ("a number", "a whole number", ...).
+std::string value_rule(const po::options_description* keys, const std::string& key) {
+  const po::option_description* option = keys ? keys->find_nothrow(key, false) : nullptr;
+  const auto* typed =
+      option
+          ? dynamic_cast<const po::value_semantic_codecvt_helper<char>*>(option->semantic().get())
+          : nullptr;
+  const auto* base = dynamic_cast<const po::typed_value_base*>(typed);
+  if (!base) return "a valid value";
+  const std::type_info& type = base->value_type();
+  if (type == typeid(double)) return "a number (like 1e-3)";
+  if (type == typeid(long) || type == typeid(int)) return "a whole number in the range of a long";
+  if (type == typeid(bool)) return "true or false";
+  return "a valid value";
+}
+
+// Boost's messages quote the option with its dashes; the user wants the key. A value that does
+// not parse is named with the rule it breaks (keys: where the key's type is looked up).
+[[noreturn]] void rethrow_as_input_error(const po::error& e, const std::string& where,
+                                         const po::options_description* keys = nullptr) {
+  if (const auto* invalid = dynamic_cast<const po::invalid_option_value*>(&e)) {
+    std::string key = invalid->get_option_name();
+    while (!key.empty() && key.front() == '-') key.erase(0, 1);
+    po::error_with_option_name copy = *invalid;
+    const auto& substitutions = copy.*SubstitutionsOf::member;
+    const auto value = substitutions.find("value");
+    if (!key.empty() && value != substitutions.end())
+      throw InputError(key, fmt::format("'{}' is not {}", message_of(po::error(value->second)),
+                                        value_rule(keys, key)));
+  }
   std::string message = message_of(e);
   throw InputError("", where.empty() ? message : where + ": " + message);
 }
@@ -224,20 +253,20 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
           fmt::format("unexpected argument '{}' (keys are given as --key value)", word));
     po::store(parsed, vm);
   } catch (const po::error& e) {
-    rethrow_as_input_error(e, "command line");
+    rethrow_as_input_error(e, "command line", &cli_keys);
   }
   if (!ini_path.empty()) {
     std::istringstream in = open_scene(ini_path);
     try {
       po::store(po::parse_config_file(in, file_keys, /*allow_unregistered=*/false), vm);
     } catch (const po::error& e) {
-      rethrow_as_input_error(e, ini_path);
+      rethrow_as_input_error(e, ini_path, &file_keys);
     }
   }
   try {
     po::notify(vm);
   } catch (const po::error& e) {
-    rethrow_as_input_error(e, "");
+    rethrow_as_input_error(e, "", &cli_keys);
   }
   return Scene(std::move(vm), ini_path);
 }
@@ -246,10 +275,15 @@ po::variables_map parse_options(const po::options_description& keys,
                                 const std::vector<std::string>& arguments) {
   po::variables_map vm;
   try {
-    po::store(po::command_line_parser(arguments).options(keys).run(), vm);
+    const po::parsed_options parsed = po::command_line_parser(arguments).options(keys).run();
+    for (const std::string& word : po::collect_unrecognized(parsed.options, po::include_positional))
+      throw InputError(
+          "command line",
+          fmt::format("unexpected argument '{}' (keys are given as --key value)", word));
+    po::store(parsed, vm);
     po::notify(vm);
   } catch (const po::error& e) {
-    throw InputError("", message_of(e));
+    rethrow_as_input_error(e, "", &keys);
   }
   return vm;
 }

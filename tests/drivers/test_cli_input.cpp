@@ -222,6 +222,50 @@ TEST(TraceOutputs, ARerunWritesEveryFileBitForBit) {
   EXPECT_GE(files, 8);  // branch, orbits, unknowns, state, summary, scene, closed form, figure
 }
 
+TEST(CommandLineInput, StrayWordsAreRefusedByEveryCommand) {
+  // Each of these ran its whole job (every benchmark, the whole main job) with the word ignored.
+  for (const std::string command : {"bench extra --case siconos_bar", "figures extra",
+                                    "reproduce extra --only mode1_orbit", "version extra"}) {
+    const fs::path out = cli::scratch("cli_input", "stray");
+    const cli::Run r = cli::run(command, "", out);
+    EXPECT_EQ(r.code, 2) << command << "\n" << r.err;
+    EXPECT_NE(r.err.find("extra"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << command;
+  }
+}
+
+TEST(CommandLineInput, AValueThatDoesNotParseIsNamedWithTheRuleItBreaks) {
+  cli::expect_bad_input("trace", small + " --length one", "length: 'one' is not a number",
+                        "cli_input_rule");
+  cli::expect_bad_input("trace", scene + " --branch mode1 --shooting_elements 20.5",
+                        "shooting_elements: '20.5' is not a whole number", "cli_input_rule");
+  cli::expect_bad_input("bench", "--case siconos_bar --threads 100000",
+                        "threads: must be in 1..256 (got 100000)", "cli_input_rule");
+}
+
+TEST(CommandLineInput, CombinationsTheMethodCannotDoAreRefused) {
+  cli::expect_bad_input("trace", small + " --method natural --follow all", "follow",
+                        "cli_input_combinations");
+  cli::expect_bad_input("trace", small + " --method natural --detect_branch_points true",
+                        "detect_branch_points", "cli_input_combinations");
+  cli::expect_bad_input("trace", small + " --method natural --natural_parameter nosuch",
+                        "natural_parameter", "cli_input_combinations");
+  cli::expect_bad_input("trace", small + " --bound energy:2:1", "bound", "cli_input_combinations");
+}
+
+TEST(CommandLineInput, ResumeTakesNoStartAndNeedsItsSummary) {
+  const fs::path dir = cli::scratch("cli_input", "resumed");
+  ASSERT_EQ(cli::run("trace", small + " --max_points 4", dir).code, 0);
+  int code = -1;
+  stdout_of("trace --resume " + dir.string() + " --start " + (dir / "orbits.csv:2").string(), code);
+  EXPECT_EQ(code, 2);
+  fs::remove(dir / "summary.txt");
+  stdout_of("trace --resume " + dir.string(), code);
+  EXPECT_EQ(code, 2);
+  stdout_of("", code);  // no command at all
+  EXPECT_EQ(code, 2);
+}
+
 TEST(OutputFolderInput, AFolderThatCannotBeCreatedIsBadInputForEveryCommand) {
   // /proc takes no new folders; bench and reproduce checked nothing before their first case.
   const fs::path proc = "/proc/backbone_test";
