@@ -135,13 +135,14 @@ TEST_F(SceneInput, ByteOrderMarkIsSkipped) {
 // percent_placeholder). Now it is refused at once, quoted with a lookalike percent sign.
 TEST_F(SceneInput, ValueHoldingABoostPlaceholderIsRefusedWithoutHanging) {
   const fs::path ini = write("percent.ini", "length = %value%'\n");
-  const std::string in_file = input_error([&] { read_scene(keys(), ini.string(), {}, {}); }, "");
+  const std::string in_file =
+      input_error([&] { read_scene(keys(), ini.string(), {}, {}); }, "length");
   EXPECT_NE(in_file.find("length"), std::string::npos) << in_file;
   const std::string on_line = input_error(
       [&] {
         read_scene(keys(), "", {"--points", "%value%"}, {});
       },
-      "");
+      "points");
   EXPECT_NE(on_line.find("points"), std::string::npos) << on_line;
 }
 
