@@ -21,9 +21,9 @@
 #include <string>
 #include <vector>
 
+#include "core/io/table.hpp"
 #include "core/problem.hpp"
 #include "core/rank/rank_report.hpp"
-#include "core/io/table.hpp"
 #include "core/types.hpp"
 
 namespace backbone::continuation {
@@ -96,7 +96,7 @@ struct BranchPointReport {
   int location_steps = 0;         // corrected points spent locating it
   // The problem's Jacobians and residuals spent locating and verifying it (its counters).
   long jacobian_evaluations = 0, residual_evaluations = 0;
-  int nullity = -1;               // candidate null directions of J at x (rank report)
+  int nullity = -1;  // candidate null directions of J at x (rank report)
   // Candidate directions beyond the traced tangent along which a probe found solutions (at most
   // options.branch_points.max_probes probed): the dimension of the attached family at this
   // resolution; verified_dimension = 1 + attached_dimension (the traced tangent counted).
@@ -107,7 +107,8 @@ struct BranchPointReport {
   double tangent_angle = 0;
   core::Vector attached_point;  // that probed point (unknowns), empty when none
   // Every probed point found on the attached family (unknowns), in the order of the probed
-  // directions; attached_point is one of them (continuation/branch_points/follow.hpp switches onto one).
+  // directions; attached_point is one of them (continuation/branch_points/follow.hpp switches onto
+  // one).
   std::vector<core::Vector> attached_points;
   core::Observables attached_description;  // ContinuationHooks::describe_branch_point
   double seconds = 0;                      // wall time of location and verification

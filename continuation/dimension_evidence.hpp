@@ -1,7 +1,8 @@
 // The dimension of the solution set at one point, with its evidence: the singular values of the
 // column-scaled Jacobian, the threshold and the gap of the rank report, then every probe along
 // a candidate null direction (core/rank/rank_report.hpp) with the distance the re-corrected point
-// kept from the stepped one. Generic over core::Problem; `backbone inspect` prints it (continuation/cli/inspect.hpp).
+// kept from the stepped one. Generic over core::Problem; `backbone inspect` prints it
+// (continuation/cli/inspect.hpp).
 //
 //   core::RankOptions rank; rank.relative_threshold = 1e-5;
 //   const DimensionEvidence e = dimension_evidence(problem, x, rank, core::VerifyOptions{});

@@ -31,8 +31,8 @@
 #include "continuation/branch.hpp"
 #include "continuation/options.hpp"
 #include "continuation/restart.hpp"  // parse_saved_point, restart_point: the restart format
-#include "core/orbits/periodic_orbit.hpp"
 #include "core/io/table.hpp"
+#include "core/orbits/periodic_orbit.hpp"
 
 namespace backbone::continuation {
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "core/jacobians/compressed_jacobian.hpp"
 #include "core/errors.hpp"
+#include "core/jacobians/compressed_jacobian.hpp"
 
 namespace backbone::continuation {
 

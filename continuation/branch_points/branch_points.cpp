@@ -8,8 +8,8 @@
 #include <mutex>
 
 #include "continuation/internal/branch_point_locator.hpp"
-#include "core/rank/few_singular_values.hpp"
 #include "core/job_queue.hpp"
+#include "core/rank/few_singular_values.hpp"
 
 namespace backbone::continuation {
 

@@ -53,8 +53,8 @@
 #include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
 #include "continuation/scaled_problem.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::core {
 class SerialQueue;  // core/job_queue.hpp

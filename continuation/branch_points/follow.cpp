@@ -6,12 +6,12 @@
 #include <cmath>
 #include <limits>
 
-#include "continuation/outputs.hpp"
 #include "continuation/methods/pseudo_arclength.hpp"
+#include "continuation/outputs.hpp"
 #include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
-#include "core/orbits/periodic_orbit.hpp"
 #include "core/io/table.hpp"
+#include "core/orbits/periodic_orbit.hpp"
 
 namespace backbone::continuation {
 

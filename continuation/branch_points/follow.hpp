@@ -32,8 +32,8 @@
 #include "continuation/branch.hpp"
 #include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/problem.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::continuation {
 

@@ -1,10 +1,9 @@
-#include "continuation/internal/branch_point_locator.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
+#include "continuation/internal/branch_point_locator.hpp"
 #include "continuation/methods/pseudo_arclength.hpp"
 #include "core/solvers/bordered_system.hpp"
 #include "core/solvers/eigen_newton.hpp"

@@ -6,9 +6,9 @@
 #include <optional>
 
 #include "continuation/internal/branch_point_locator.hpp"
-#include "core/solvers/bordered_system.hpp"
 #include "core/rank/few_singular_values.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/bordered_system.hpp"
 
 namespace backbone::continuation::branch_point {
 

@@ -16,7 +16,6 @@ namespace backbone::cli {
 // plugin of SCENE: builds the problem with plugin.setup (the branch of DIR/summary.txt unless
 // --branch), reads point K of DIR/unknowns.csv, prints the evidence. The scene must give the
 // trace's grid keys (DIR/scene.ini does). Returns the exit code; InputError for bad input.
-int inspect_command(const ProblemPlugin& plugin,
-                    const std::vector<std::string>& args);
+int inspect_command(const ProblemPlugin& plugin, const std::vector<std::string>& args);
 
 }  // namespace backbone::cli

@@ -33,9 +33,9 @@
 
 #include "continuation/branch.hpp"
 #include "continuation/options.hpp"
-#include "core/solvers/newton.hpp"
-#include "core/problem.hpp"
 #include "core/io/scene.hpp"
+#include "core/problem.hpp"
+#include "core/solvers/newton.hpp"
 #include "core/types.hpp"
 
 namespace backbone::cli {

@@ -20,12 +20,12 @@
 #include <string>
 
 #include "continuation/branch_points/follow.hpp"
+#include "continuation/methods/switching.hpp"
 #include "continuation/options.hpp"
 #include "continuation/restart.hpp"
-#include "continuation/methods/switching.hpp"
-#include "core/solvers/newton.hpp"
-#include "core/orbits/periodic_orbit.hpp"
 #include "core/io/scene.hpp"
+#include "core/orbits/periodic_orbit.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::cli {
 

@@ -26,10 +26,10 @@
 #include "continuation/cli/stop_signals.hpp"
 #include "continuation/outputs.hpp"
 #include "continuation/restart.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/io/output_folder.hpp"
-#include "core/orbits/periodic_orbit.hpp"
 #include "core/io/scene.hpp"
+#include "core/orbits/periodic_orbit.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::cli {
 

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/solvers/bordered_system.hpp"
 #include "core/errors.hpp"
+#include "core/solvers/bordered_system.hpp"
 
 namespace backbone::continuation {
 

@@ -1,8 +1,8 @@
 // Internal to backbone::continuation: the steps natural and pseudo-arclength continuation share.
 //
 // The two loops differ only in their predictor and in the row that borders F (the arclength
-// row t . (x - x_k) - ds, or the parameter row p(x) - lambda: core/solvers/bordered_system.hpp). The
-// rest is said once, here:
+// row t . (x - x_k) - ds, or the parameter row p(x) - lambda: core/solvers/bordered_system.hpp).
+// The rest is said once, here:
 //   - in_scaled_unknowns runs a loop in z = x ./ typical_scale() (options.scale_unknowns,
 //     scaled_problem.hpp) and hands points and hooks.reject_point back in the problem's unknowns,
 //     so ds, the step_size column and the arclength column are dimensionless in both loops;
@@ -41,12 +41,12 @@
 
 #include "continuation/branch.hpp"
 #include "continuation/callbacks.hpp"
-#include "continuation/options.hpp"
 #include "continuation/internal/point_recorder.hpp"
+#include "continuation/options.hpp"
 #include "continuation/restart.hpp"
 #include "continuation/scaled_problem.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/problem.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::continuation {
 

@@ -23,8 +23,8 @@
 
 #include "continuation/branch.hpp"
 #include "continuation/options.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/problem.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::continuation {
 

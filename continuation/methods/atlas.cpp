@@ -11,8 +11,8 @@
 #include <optional>
 
 #include "continuation/scaled_problem.hpp"
-#include "core/solvers/bordered_system.hpp"
 #include "core/errors.hpp"
+#include "core/solvers/bordered_system.hpp"
 
 namespace backbone::continuation {
 

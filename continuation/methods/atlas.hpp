@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "core/solvers/newton.hpp"
 #include "core/problem.hpp"
+#include "core/solvers/newton.hpp"
 #include "core/types.hpp"
 
 namespace backbone::continuation {

@@ -2,16 +2,16 @@
 //
 // The scalar is either one unknown (e.g. the period, as the paper does: fix T, solve for u0)
 // or a named observable of the problem (energy, amplitude...). Each point solves the square
-// system [F(x); p(x) - lambda] = 0 (F bordered by one parameter row, core/solvers/bordered_system.hpp;
-// ParameterConstraintSystem below) at lambda_k = lambda_0 + direction * sum of steps, from a
-// secant or tangent predictor. It cannot pass a fold in p: there Newton fails, ds shrinks to
-// ds_min and the branch ends with StopReason::step_floor, keeping the points computed so far
-// (switching.hpp then hands over to pseudo-arclength). The loop shares with pseudo-arclength
-// (loop_steps.hpp, continuation/README.md) the scaled unknowns (options.scale_unknowns: an
-// unknown parameter steps by ds * typical_scale, an observable in its own units), the arclength
-// column (sum of chords in the scaled unknowns, the same units as pseudo-arclength's), the
-// first-point and step checks of hooks.reject_point and landing on bounds (the last point lies on
-// the bound). The loop prints nothing.
+// system [F(x); p(x) - lambda] = 0 (F bordered by one parameter row,
+// core/solvers/bordered_system.hpp; ParameterConstraintSystem below) at lambda_k = lambda_0 +
+// direction * sum of steps, from a secant or tangent predictor. It cannot pass a fold in p: there
+// Newton fails, ds shrinks to ds_min and the branch ends with StopReason::step_floor, keeping the
+// points computed so far (switching.hpp then hands over to pseudo-arclength). The loop shares with
+// pseudo-arclength (loop_steps.hpp, continuation/README.md) the scaled unknowns
+// (options.scale_unknowns: an unknown parameter steps by ds * typical_scale, an observable in its
+// own units), the arclength column (sum of chords in the scaled unknowns, the same units as
+// pseudo-arclength's), the first-point and step checks of hooks.reject_point and landing on bounds
+// (the last point lies on the bound). The loop prints nothing.
 //
 //   auto newton = core::make_corrector("eigen", core::NewtonOptions{});
 //   ContinuationOptions opt; opt.method = Method::natural; opt.ds = 0.05; opt.max_points = 20;
@@ -26,9 +26,9 @@
 #include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
 #include "continuation/restart.hpp"
+#include "core/problem.hpp"
 #include "core/solvers/bordered_system.hpp"
 #include "core/solvers/newton.hpp"
-#include "core/problem.hpp"
 
 namespace backbone::continuation {
 

@@ -11,9 +11,9 @@
 #include "continuation/branch_points/branch_points.hpp"
 #include "continuation/internal/loop_steps.hpp"
 #include "continuation/scaled_problem.hpp"
+#include "core/errors.hpp"
 #include "core/solvers/bordered_system.hpp"
 #include "core/solvers/eigen_newton.hpp"
-#include "core/errors.hpp"
 
 namespace backbone::continuation {
 

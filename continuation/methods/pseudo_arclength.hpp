@@ -6,11 +6,11 @@
 // From a point x_k with unit tangent t_k the predictor is x_k + ds t_k (or the secant
 // direction), and the corrector solves F bordered by the arclength row,
 //     F(x) = 0,    t_k . (x - x_k) - ds = 0,
-// a core::BorderedSystem with one linear row (core/solvers/bordered_system.hpp, the LOCA habit): any
-// corrector solves it, KINSOL included, since it is square when m = n - 1. The tangent at a point
-// is the solution of [J; t_prev^T] t = [0; 1], normalised: it spans the null space of J and keeps
-// the orientation of the previous tangent, so the branch goes through folds without reversing.
-// The first point is the guess corrected on the hyperplane through it orthogonal to the
+// a core::BorderedSystem with one linear row (core/solvers/bordered_system.hpp, the LOCA habit):
+// any corrector solves it, KINSOL included, since it is square when m = n - 1. The tangent at a
+// point is the solution of [J; t_prev^T] t = [0; 1], normalised: it spans the null space of J and
+// keeps the orientation of the previous tangent, so the branch goes through folds without
+// reversing. The first point is the guess corrected on the hyperplane through it orthogonal to the
 // direction hint. Scaling (ds, step_size and arclength dimensionless, in z = x ./ typical_scale()),
 // the first point, the step shrinking, hooks.reject_point and landing on bounds are shared with
 // natural continuation (loop_steps.hpp, continuation/README.md); the branch's points are returned
@@ -30,8 +30,8 @@
 #include "continuation/callbacks.hpp"
 #include "continuation/options.hpp"
 #include "continuation/restart.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/problem.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::continuation {
 

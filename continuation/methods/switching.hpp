@@ -21,8 +21,8 @@
 #include "continuation/methods/natural.hpp"
 #include "continuation/options.hpp"
 #include "continuation/restart.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/problem.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::continuation {
 

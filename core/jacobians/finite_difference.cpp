@@ -7,8 +7,8 @@
 #include <limits>
 #include <vector>
 
-#include "core/jacobians/compressed_jacobian.hpp"
 #include "core/errors.hpp"
+#include "core/jacobians/compressed_jacobian.hpp"
 #include "core/job_queue.hpp"
 
 namespace backbone::core {

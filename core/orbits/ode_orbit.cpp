@@ -8,8 +8,8 @@
 #include <mutex>
 #include <stdexcept>
 
-#include "core/orbits/cvode_integrator.hpp"
 #include "core/errors.hpp"
+#include "core/orbits/cvode_integrator.hpp"
 
 namespace backbone::core {
 

@@ -8,9 +8,9 @@
 #include <limits>
 #include <vector>
 
-#include "core/solvers/bordered_system.hpp"
 #include "core/errors.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/bordered_system.hpp"
 
 namespace backbone::core {
 

@@ -18,8 +18,8 @@
 
 #include <memory>
 
-#include "core/solvers/newton.hpp"
 #include "core/problem.hpp"
+#include "core/solvers/newton.hpp"
 #include "core/types.hpp"
 
 namespace backbone::core {
@@ -63,8 +63,8 @@ std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options);
 // rotated ones, and direction_verified refers to it.
 // The corrector must handle m + 1 equations in n unknowns: KINSOL only when m + 1 == n.
 // jacobian_at_x (J of problem at x, when the caller has it) starts every probe's correction
-// with chord steps on its factorization (core/solvers/newton.hpp): a probe steps by `step`, so J(x) is
-// as good as a fresh one there, and a probe costs a few residuals instead of a Jacobian.
+// with chord steps on its factorization (core/solvers/newton.hpp): a probe steps by `step`, so J(x)
+// is as good as a fresh one there, and a probe costs a few residuals instead of a Jacobian.
 // neighbour (a solution already known near x: the branch's previous point) stands in for the
 // probe of a direction d it verifies by the same tests, as if a probe had stepped by
 // h = d . (neighbour - x) and been corrected onto it: ||F(neighbour)||_inf <= residual_tolerance

@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "core/solvers/newton.hpp"
 #include "core/rank/probes.hpp"  // VerifyOptions, make_verifier, verify_null_directions
+#include "core/solvers/newton.hpp"
 #include "core/types.hpp"
 
 namespace backbone::core {

@@ -5,8 +5,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "core/solvers/eigen_newton.hpp"
 #include "core/errors.hpp"
+#include "core/solvers/eigen_newton.hpp"
 #include "core/solvers/kinsol_newton.hpp"
 
 namespace backbone::core {

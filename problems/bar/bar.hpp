@@ -14,9 +14,10 @@
 //   bar::BarSetup s;
 //   s.material = {1.0, 1.0, 1.0, 1.0};                     // L, E, rho, A  (c = 1)
 //   s.left = {bar::EndType::fixed}; s.right = {bar::EndType::contact, 1e-3};
-//   s.u0 = bar::PiecewiseLinear({0.0, 1.0}, {0.0, -0.01});  // problems/contact_bar/orbits/README.md 'Mode 1'
-//   bar::SimulationOptions o; o.t_end = 3.1; o.dt = 1e-3;
-//   bar::History h = solver.simulate(s, o);                // h.contact_force, h.u_contact, ...
+//   s.u0 = bar::PiecewiseLinear({0.0, 1.0}, {0.0, -0.01});  //
+//   problems/contact_bar/orbits/README.md 'Mode 1' bar::SimulationOptions o; o.t_end = 3.1; o.dt =
+//   1e-3; bar::History h = solver.simulate(s, o);                // h.contact_force, h.u_contact,
+//   ...
 #pragma once
 
 #include <string>

@@ -11,11 +11,10 @@
 // number of signal segments (never a number of time steps). This is the reference of every
 // test and the accuracy limit of every benchmark.
 //
-//   bar::BarSetup s;                                        // problems/contact_bar/orbits/README.md 'Mode 1'
-//   s.right = {bar::EndType::contact, 1e-3};
-//   s.u0 = bar::PiecewiseLinear({0.0, 1.0}, {0.0, -0.01});
-//   exact_bar::ExactBarSolution sol = exact_bar::solve(s, 3.1);
-//   sol.contact_intervals();          // {[1.1, 2)}
+//   bar::BarSetup s;                                        //
+//   problems/contact_bar/orbits/README.md 'Mode 1' s.right = {bar::EndType::contact, 1e-3}; s.u0 =
+//   bar::PiecewiseLinear({0.0, 1.0}, {0.0, -0.01}); exact_bar::ExactBarSolution sol =
+//   exact_bar::solve(s, 3.1); sol.contact_intervals();          // {[1.1, 2)}
 //   sol.contact_force(1.5);           // 0.01 = EA |eps|
 //   sol.u(0.5, 3.1);                  // -0.005: back to u0
 //   sol.energy(2.0);                  // EA L eps^2 / 2

@@ -78,8 +78,8 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   EXPECT_GT(at("frequency_ratio"), 2);
   // The attached family leaves transversally to mode 1. The angle is the smallest over the
   // probes of a 7-8 dimensional null space that re-correct, and which do, and where, follows the
-  // round-off of the march (problems/contact_bar/solver/README.md, 'Hard cases'), so the angle moves by
-  // degrees under equivalent formulas. Bound 60 (mode 1 itself would give 0).
+  // round-off of the march (problems/contact_bar/solver/README.md, 'Hard cases'), so the angle
+  // moves by degrees under equivalent formulas. Bound 60 (mode 1 itself would give 0).
   EXPECT_GT(at("tangent_angle"), 60);
   fs::remove_all(out);
 }
@@ -124,8 +124,8 @@ TEST(BranchPointsCli, FollowsTheManyDimensionalFamilyAtThreeAndAHalf) {
   EXPECT_NEAR(t.column("period")[static_cast<std::size_t>(row)], 3.5, 1e-7);
   // Its 24 probes step across a kink of F (the period's column of J changes by rank one). They
   // learn it from the first probe's Jacobian and difference it at the others' starts
-  // (continuation/branch_points/branch_points.cpp, verify()), so location and verification need far fewer
-  // Jacobians than the probes, each of which would otherwise take at least one of its own.
+  // (continuation/branch_points/branch_points.cpp, verify()), so location and verification need far
+  // fewer Jacobians than the probes, each of which would otherwise take at least one of its own.
   EXPECT_LE(t.column("jacobian_evaluations")[static_cast<std::size_t>(row)], 20);
   EXPECT_GE(t.column("dimension")[static_cast<std::size_t>(row)], 20);
   const fs::path dir = out / ("branch_point_" + std::to_string(row + 1));

@@ -18,9 +18,9 @@
 
 #include "continuation/cli/bench_report.hpp"
 #include "core/errors.hpp"
-#include "core/jacobians/finite_difference.hpp"
 #include "core/io/plot.hpp"
 #include "core/io/scene.hpp"
+#include "core/jacobians/finite_difference.hpp"
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/metrics.hpp"
 #include "problems/contact_bar/bench/peers.hpp"
@@ -496,10 +496,11 @@ std::string variant_verdict(const ScalingRuns& r) {
       r.paper.complete
           ? fmt::format("reaches the bound at {:.2g}x the CPU with a worst error of {}",
                         r.paper.cpu_seconds / base.cpu_seconds, error_text(r.paper.worst_error))
-          : fmt::format("stops at E = {:.3g} after {} point(s) ({}: its Jacobian is degenerate "
-                        "on the family, problems/contact_bar/orbits/README.md, section 'Shooting on the "
-                        "bar'), so it has no branch cost to compare",
-                        r.paper.energy_reached, r.paper.points, r.paper.stop_reason),
+          : fmt::format(
+                "stops at E = {:.3g} after {} point(s) ({}: its Jacobian is degenerate "
+                "on the family, problems/contact_bar/orbits/README.md, section 'Shooting on the "
+                "bar'), so it has no branch cost to compare",
+                r.paper.energy_reached, r.paper.points, r.paper.stop_reason),
       r.eigen_square.cpu_seconds / base.cpu_seconds, r.kinsol_square.cpu_seconds / base.cpu_seconds,
       threads_n, r.threads_same ? "the same (bit for bit)" : "a DIFFERENT",
       r.threads.wall_seconds / r.threads_base.wall_seconds,

@@ -17,7 +17,8 @@ std::vector<cli::ProblemJob> bench_cases() {
        "corrector and threads; the FD Jacobian with 1 and 2 threads",
        bench_mode1_scaling},
       {"branch_point_cost",
-       "what branch-point detection adds to the mode-1 trace at 100 and 200 intervals (wall and CPU, "
+       "what branch-point detection adds to the mode-1 trace at 100 and 200 intervals (wall and "
+       "CPU, "
        "second thread or not) against the located periods' accuracy",
        bench_branch_point_cost},
   };

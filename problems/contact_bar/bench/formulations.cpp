@@ -13,12 +13,12 @@
 #include <vector>
 
 #include "continuation/methods/natural.hpp"
-#include "core/jacobians/finite_difference.hpp"
-#include "core/solvers/newton.hpp"
-#include "core/orbits/periodic_orbit.hpp"
 #include "core/io/plot.hpp"
-#include "core/rank/rank_report.hpp"
 #include "core/io/table.hpp"
+#include "core/jacobians/finite_difference.hpp"
+#include "core/orbits/periodic_orbit.hpp"
+#include "core/rank/rank_report.hpp"
+#include "core/solvers/newton.hpp"
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/metrics.hpp"
 #include "problems/contact_bar/bench/support.hpp"

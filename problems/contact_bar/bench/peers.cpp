@@ -11,10 +11,10 @@
 
 #include "continuation/cli/bench_report.hpp"
 #include "core/errors.hpp"
-#include "core/jacobians/finite_difference.hpp"
 #include "core/io/plot.hpp"
 #include "core/io/scene.hpp"
 #include "core/io/table.hpp"
+#include "core/jacobians/finite_difference.hpp"
 #include "problems/contact_bar/bench/support.hpp"
 #include "problems/contact_bar/cli/trace.hpp"
 #include "problems/contact_bar/orbits/family.hpp"

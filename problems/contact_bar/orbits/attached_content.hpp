@@ -1,12 +1,12 @@
 // What an orbit attached to a traced branch adds to it: the extra content of the contacting-end
-// displacement, computed from simulations (problems/contact_bar/orbits/README.md, section 'Dimension
-// changes').
+// displacement, computed from simulations (problems/contact_bar/orbits/README.md, section
+// 'Dimension changes').
 //
 // Both orbits (the point on the branch and a nearby point of the attached family, e.g. the probe
-// of a branch point, continuation/branch_points/branch_points.hpp) are re-simulated over their own period by
-// the given solver (the exact oracle), the end displacement sampled at `samples` instants of one
-// period each; their difference is the attached content. Its spectrum over the period gives the
-// dominant harmonic (frequency_ratio: the content's frequency over the orbit's), and its sign
+// of a branch point, continuation/branch_points/branch_points.hpp) are re-simulated over their own
+// period by the given solver (the exact oracle), the end displacement sampled at `samples` instants
+// of one period each; their difference is the attached content. Its spectrum over the period gives
+// the dominant harmonic (frequency_ratio: the content's frequency over the orbit's), and its sign
 // changes give the oscillations per period (half the number of zero crossings). No formula of
 // the ratio is used.
 //

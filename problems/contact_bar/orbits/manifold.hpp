@@ -20,8 +20,8 @@
 #include <filesystem>
 #include <vector>
 
-#include "continuation/methods/atlas.hpp"
 #include "continuation/cli/plugin.hpp"
+#include "continuation/methods/atlas.hpp"
 #include "core/io/scene.hpp"
 #include "core/io/table.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"

@@ -138,12 +138,12 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continu
   // The same ratio for the M periodicity rows (in units of u_s: then of max(u_s, A)), 1 for
   // the path rows; empty without options.amplitude_units.
   core::Vector local_residual_factor(const core::Vector& x) const override;
-  // Sparsity of the residual's Jacobian (problems/contact_bar/orbits/README.md, section 'Amplitude units'), for the TD-BEM and exact
-  // solvers: row i depends on u0 only near the images of its test support under x -> x +- c t
-  // (t = T/2 regular, T paper; reflected at both ends, open or closed: contact instants and
-  // fronts travel on the same characteristics), widened by one test element and, for the
-  // TD-BEM, one step c dt (its end histories are interpolated over a step). The period and
-  // free-knot columns are dense, and for the paper formulation the columns at the source of
+  // Sparsity of the residual's Jacobian (problems/contact_bar/orbits/README.md, section 'Amplitude
+  // units'), for the TD-BEM and exact solvers: row i depends on u0 only near the images of its test
+  // support under x -> x +- c t (t = T/2 regular, T paper; reflected at both ends, open or closed:
+  // contact instants and fronts travel on the same characteristics), widened by one test element
+  // and, for the TD-BEM, one step c dt (its end histories are interpolated over a step). The period
+  // and free-knot columns are dense, and for the paper formulation the columns at the source of
   // each contact release (found by one simulation at x). None (every column differenced) for
   // other solvers and with path rows (they are dense rows).
   std::optional<core::JacobianPattern> jacobian_pattern(const core::Vector& x) const override;

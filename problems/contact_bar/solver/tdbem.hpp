@@ -21,8 +21,8 @@
 // are the same test. `event` splits the step at the closing instant (root of the free
 // displacement, exact for linear data), at the release instant (sign change of the force) and
 // at the echoes of every such kink arriving from the other end (tau later), so that piecewise
-// linear solutions (problems/contact_bar/orbits/README.md, 'Mode 1') are reproduced to round-off off the time grid too.
-// Requires dt <= L / c (one step may not cross the bar).
+// linear solutions (problems/contact_bar/orbits/README.md, 'Mode 1') are reproduced to round-off
+// off the time grid too. Requires dt <= L / c (one step may not cross the bar).
 //
 //   contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
 //   bar::SimulationOptions o; o.t_end = 3.1; o.dt = 1e-2;

@@ -16,9 +16,9 @@
 #include "continuation/cli/bench_report.hpp"
 #include "continuation/methods/pseudo_arclength.hpp"
 #include "core/errors.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/io/plot.hpp"
 #include "core/io/table.hpp"
+#include "core/solvers/newton.hpp"
 #include "problems/duffing/duffing.hpp"
 
 #ifndef BACKBONE_DUFFING_PEERS_DIR

@@ -23,9 +23,9 @@
 
 #include "continuation/cli/plugin.hpp"
 #include "continuation/methods/pseudo_arclength.hpp"
-#include "core/solvers/newton.hpp"
-#include "core/orbits/ode_orbit.hpp"
 #include "core/io/table.hpp"
+#include "core/orbits/ode_orbit.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::pendulum {
 
@@ -85,7 +85,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
   s.problem = std::make_unique<Pendulum>();
   s.guess.resize(2);
   s.guess << scene.positive("amplitude"), 2.0 * std::numbers::pi;  // the linear period
-  s.direction = core::Vector::Unit(2, 0);                           // amplitude grows
+  s.direction = core::Vector::Unit(2, 0);                          // amplitude grows
   s.describe_point = [](const continuation::BranchPoint& p) {
     return fmt::format("exact period rel err {:.2e}", relative_period_error(p.x));
   };
@@ -120,10 +120,11 @@ int period_error(const std::filesystem::path& out) {
   table.write_csv(out / "period_error.csv");
   const bool reached = branch.reason == continuation::StopReason::bound_reached &&
                        std::abs(branch.points.back().x[0] - 3.0) < 1e-9;
-  fmt::print("period_error: {} points to A = {:.6f}, worst relative period error {:.3e} "
-             "(limit 1e-9) -> {}\n",
-             branch.points.size(), branch.points.empty() ? 0.0 : branch.points.back().x[0], worst,
-             reached && worst <= 1e-9 ? "ok" : "FAIL");
+  fmt::print(
+      "period_error: {} points to A = {:.6f}, worst relative period error {:.3e} "
+      "(limit 1e-9) -> {}\n",
+      branch.points.size(), branch.points.empty() ? 0.0 : branch.points.back().x[0], worst,
+      reached && worst <= 1e-9 ? "ok" : "FAIL");
   return reached && worst <= 1e-9 ? 0 : 1;
 }
 
@@ -137,7 +138,8 @@ void register_plugin(cli::PluginRegistry& registry) {
   p.branches = {"backbone"};
   p.setup = &setup_trace;
   p.units = {{"period", "s"}, {"frequency", "rad/s"}, {"energy", "J/kg"}, {"amplitude", "rad"}};
-  p.bench_cases = {{"period_error", "periods of A = 0.1 .. 3 against the exact period", period_error}};
+  p.bench_cases = {
+      {"period_error", "periods of A = 0.1 .. 3 against the exact period", period_error}};
   registry.add(std::move(p));
 }
 

@@ -142,9 +142,7 @@ template <class P>
 class Cloned : public P {
  public:
   using P::P;
-  std::unique_ptr<core::Problem> clone() const override {
-    return std::make_unique<Cloned>(*this);
-  }
+  std::unique_ptr<core::Problem> clone() const override { return std::make_unique<Cloned>(*this); }
 };
 
 // The branch with detection on the loop's thread and on the worker's: the same bits.
@@ -199,8 +197,8 @@ TEST(BorderedTestFunction, ChangesSignAcrossASimpleBranchPoint) {
 }
 
 // The test function comes from a Krylov basis of inverse iteration on a QR factor (iterate =
-// true; the SVD when it does not converge); the SVD is the oracle. Matrices [J; t^T] of 41 x 20 with
-// chosen singular values: a regular point (smallest 1e-2, gap 10), one at a located branch
+// true; the SVD when it does not converge); the SVD is the oracle. Matrices [J; t^T] of 41 x 20
+// with chosen singular values: a regular point (smallest 1e-2, gap 10), one at a located branch
 // point (1e-9) and a cluster (1e-6 and 1.000001e-6, where the iteration falls back to the SVD or
 // converges to the same value). Both are backward stable, so the values agree to a few
 // round-offs of |A| ~ 1 (1e-13 allows ~500 eps); the right vectors, where the gap separates
@@ -354,9 +352,9 @@ namespace {
 // with a corner at x = c: g(x) = x up to c (45 degrees), then slope tan 15 degrees, a turn of
 // 30 degrees. The analytic Jacobian at the corner is the incoming piece's, as a forward-
 // difference Jacobian that straddles an edge of a piecewise-affine family is neither piece's (the
-// contact bar's attached families at 100 intervals, continuation/branch_points/follow.hpp): the tangent there
-// points along the incoming piece, and every step from the corner turns by 30 degrees, whatever
-// ds is.
+// contact bar's attached families at 100 intervals, continuation/branch_points/follow.hpp): the
+// tangent there points along the incoming piece, and every step from the corner turns by 30
+// degrees, whatever ds is.
 class CorneredAttachedLine : public core::Problem {
  public:
   static constexpr double corner = 0.5;
@@ -442,7 +440,7 @@ TEST(BranchPoints, TableHasTheDocumentedColumns) {
   EXPECT_NEAR(t.column("tangent_angle")[0], 45.0, 1e-3);
   // The probe steps h (BranchPointOptions::probe_step) along x and lands on x = lambda - 1:
   // offset h sqrt(2).
-  EXPECT_NEAR(t.column("offset")[0],
-              continuation::BranchPointOptions{}.probe_step * std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(t.column("offset")[0], continuation::BranchPointOptions{}.probe_step * std::sqrt(2.0),
+              1e-9);
   EXPECT_EQ(t.column("verified")[0], 1.0);
 }

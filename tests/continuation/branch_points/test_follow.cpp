@@ -1,7 +1,7 @@
-// Following attached families (continuation/branch_points/follow.hpp) on algebraic curves whose attached
-// families are known exactly (problems/algebraic/algebraic.hpp): the switch picks a verified
-// probe, orients it so that the chosen observable grows, and the followed branch lies on the
-// exact attached family.
+// Following attached families (continuation/branch_points/follow.hpp) on algebraic curves whose
+// attached families are known exactly (problems/algebraic/algebraic.hpp): the switch picks a
+// verified probe, orients it so that the chosen observable grows, and the followed branch lies on
+// the exact attached family.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -68,8 +68,7 @@ TEST(Follow, TranscriticalSwitchesOntoTheExactAttachedLine) {
     // It starts at the probe: one step h (BranchPointOptions::probe_step) along the null
     // direction (1, 0) beyond the traced tangent, corrected onto the line (x unchanged by the
     // hyperplane x = h), and lands on the bound.
-    EXPECT_NEAR(f.branch.points.front().x[0], continuation::BranchPointOptions{}.probe_step,
-                1e-12);
+    EXPECT_NEAR(f.branch.points.front().x[0], continuation::BranchPointOptions{}.probe_step, 1e-12);
     EXPECT_NEAR(f.branch.points.back().x[0], 2.0, 1e-9);
   }
 }

@@ -1,6 +1,6 @@
-// The 2D atlas (continuation/methods/atlas.hpp) on the unit 2-sphere, whose points are known exactly:
-// a band between two latitudes is covered without holes (random exact points within one chart
-// radius of a chart centre), every centre lies on the sphere, inside the band, and neighbours
+// The 2D atlas (continuation/methods/atlas.hpp) on the unit 2-sphere, whose points are known
+// exactly: a band between two latitudes is covered without holes (random exact points within one
+// chart radius of a chart centre), every centre lies on the sphere, inside the band, and neighbours
 // are mutual; the whole sphere closes on itself; configuration errors name their field.
 #include <gtest/gtest.h>
 

@@ -14,8 +14,8 @@
 
 #include "continuation/methods/natural.hpp"
 #include "continuation/methods/pseudo_arclength.hpp"
-#include "continuation/scaled_problem.hpp"
 #include "continuation/methods/switching.hpp"
+#include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
 #include "problems/algebraic/algebraic.hpp"
 #include "tests/continuation/test_support.hpp"

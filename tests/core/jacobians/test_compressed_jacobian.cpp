@@ -9,8 +9,8 @@
 #include <cmath>
 #include <set>
 
-#include "core/jacobians/compressed_jacobian.hpp"
 #include "core/errors.hpp"
+#include "core/jacobians/compressed_jacobian.hpp"
 #include "core/jacobians/finite_difference.hpp"
 
 namespace {

@@ -14,11 +14,11 @@
 #include <iostream>
 #include <numbers>
 
-#include "core/orbits/cvode_integrator.hpp"
 #include "core/errors.hpp"
 #include "core/jacobians/jacobian_check.hpp"
-#include "core/solvers/newton.hpp"
+#include "core/orbits/cvode_integrator.hpp"
 #include "core/orbits/ode_orbit.hpp"
+#include "core/solvers/newton.hpp"
 
 namespace backbone::core {
 namespace {

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "core/solvers/eigen_newton.hpp"
 #include "core/errors.hpp"
-#include "core/solvers/kinsol_newton.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/eigen_newton.hpp"
+#include "core/solvers/kinsol_newton.hpp"
 #include "tests/core/test_problems.hpp"
 
 namespace backbone::core {

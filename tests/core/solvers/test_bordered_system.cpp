@@ -7,11 +7,11 @@
 #include <cmath>
 #include <utility>
 
-#include "core/solvers/bordered_system.hpp"
 #include "core/errors.hpp"
 #include "core/jacobians/finite_difference.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/bordered_system.hpp"
+#include "core/solvers/newton.hpp"
 #include "problems/algebraic/algebraic.hpp"
 
 namespace backbone::core {

@@ -6,8 +6,8 @@
 #include <Eigen/SVD>
 #include <cmath>
 
-#include "core/solvers/eigen_newton.hpp"
 #include "core/errors.hpp"
+#include "core/solvers/eigen_newton.hpp"
 #include "core/solvers/kinsol_newton.hpp"
 #include "core/solvers/newton.hpp"
 #include "tests/core/test_problems.hpp"

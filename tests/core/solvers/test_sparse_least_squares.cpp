@@ -7,8 +7,8 @@
 #include <Eigen/SVD>
 #include <random>
 
-#include "core/solvers/eigen_newton.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/eigen_newton.hpp"
 #include "core/solvers/sparse_least_squares.hpp"
 
 namespace {

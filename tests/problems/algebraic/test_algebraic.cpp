@@ -2,8 +2,8 @@
 #include <gtest/gtest.h>
 
 #include "core/errors.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/newton.hpp"
 #include "problems/algebraic/algebraic.hpp"
 
 using namespace backbone;

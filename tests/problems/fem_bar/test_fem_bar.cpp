@@ -239,9 +239,9 @@ TEST(FemBar, ContactConstraintIsNeverViolated) {
 }
 
 // At Courant 1 with the contact onset t = (L + g0/|eps|)/c = 1.1 on the grid, the mode-1 orbit
-// (problems/contact_bar/orbits/README.md 'Mode 1') is exact at the nodes to the release: contact with the
-// exact force EA|eps| on (1.1, 2) (half of it in the onset step, the impulse of a half step).
-// The release at t = 2 is one step late (the predictor uses the free-end reflection across a
+// (problems/contact_bar/orbits/README.md 'Mode 1') is exact at the nodes to the release: contact
+// with the exact force EA|eps| on (1.1, 2) (half of it in the onset step, the impulse of a half
+// step). The release at t = 2 is one step late (the predictor uses the free-end reflection across a
 // change of boundary law), so the return to u0 = eps x at T = 3.1 is first order: the nodal
 // error is the end velocity |eps| c times dt.
 TEST(FemBar, CourantOneReproducesMode1ContactPhaseWhenOnsetIsOnTheGrid) {

@@ -85,8 +85,8 @@ TEST(ContactBarBranchScaling, TinyBranchesGiveTheTableColumnsAndTheClosedForm) {
 }
 
 // Every column of the finite-difference Jacobian is computed by the same operations whatever
-// the thread count (core/jacobians/finite_difference.hpp), so 2 threads must give one thread's matrix bit
-// for bit; a small grid keeps it fast.
+// the thread count (core/jacobians/finite_difference.hpp), so 2 threads must give one thread's
+// matrix bit for bit; a small grid keeps it fast.
 TEST(ContactBarBranchScaling, TwoThreadJacobianIsBitIdentical) {
   const contact_bar::JacobianThreadsTiming t = contact_bar::time_jacobian_threads(10, 1);
   EXPECT_TRUE(t.identical);

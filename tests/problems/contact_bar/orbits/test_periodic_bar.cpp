@@ -1,8 +1,8 @@
 // Known-solution tests of the contact-bar shooting problem (contact_bar/orbits/periodic_bar):
-// the exact mode-1 orbit u0 = eps x, T = (3L + g0/|eps|)/c (its problems/contact_bar/orbits/README.md, 'Mode 1') and the
-// mode-2 tent (closed form derived in family.cpp) are roots of both formulations; the
-// regular Jacobian is regular (nullity 1), the paper's T column vanishes; Newton returns to
-// the family; short branches match the closed forms.
+// the exact mode-1 orbit u0 = eps x, T = (3L + g0/|eps|)/c (its
+// problems/contact_bar/orbits/README.md, 'Mode 1') and the mode-2 tent (closed form derived in
+// family.cpp) are roots of both formulations; the regular Jacobian is regular (nullity 1), the
+// paper's T column vanishes; Newton returns to the family; short branches match the closed forms.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,8 +13,8 @@
 #include "continuation/scaled_problem.hpp"
 #include "core/errors.hpp"
 #include "core/jacobians/finite_difference.hpp"
-#include "core/solvers/newton.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/newton.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"
@@ -295,9 +295,9 @@ TEST(ContactBarOrbit, TestElementsBelowTheUnknownsAreRejected) {
 
 }  // namespace
 
-// Step control over ten decades of energy (problems/contact_bar/orbits/README.md, section 'Jacobian pattern'):
-// mode 1 from end amplitude 1.05 g0 (E = 5.5e-7 J) to E = 1e4 J (1.4e5 g0) with the trace's
-// settings (20 intervals, 40 test elements, ds = ds_max = 0.45, Newton tolerance 3e-9, rank
+// Step control over ten decades of energy (problems/contact_bar/orbits/README.md, section 'Jacobian
+// pattern'): mode 1 from end amplitude 1.05 g0 (E = 5.5e-7 J) to E = 1e4 J (1.4e5 g0) with the
+// trace's settings (20 intervals, 40 test elements, ds = ds_max = 0.45, Newton tolerance 3e-9, rank
 // report with threshold 1e-5 at every point). In units of the gap a step moves u0 by about
 // 0.45 g0 in L2, so the branch would need ~2e5 points: 200 points stay below 0.1 J. With
 // amplitude_units the unit of u0 and of the residual is the orbit's amplitude and steps are

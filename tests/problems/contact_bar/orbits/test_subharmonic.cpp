@@ -52,9 +52,10 @@ TEST(SubharmonicContinuum, ClosedFormMembersArePeriodic) {
     }
 }
 
-// The contact structure (problems/contact_bar/orbits/README.md, 'Subharmonic continuum'): interior members have two contact
-// phases per period of the closed-form durations (the first one split across t = 0 and t = T); at
-// the limits one phase has shrunk to a grazing instant. Durations are exact event times (1e-12).
+// The contact structure (problems/contact_bar/orbits/README.md, 'Subharmonic continuum'): interior
+// members have two contact phases per period of the closed-form durations (the first one split
+// across t = 0 and t = T); at the limits one phase has shrunk to a grazing instant. Durations are
+// exact event times (1e-12).
 TEST(SubharmonicContinuum, ContactPhasesAndGrazingLimits) {
   const bar::Material m;
   const double energy = 1.25e-5;  // s = 5 g0: b = 0.3, each mode-2 phase lasts 1 - 3b = 0.1
@@ -166,7 +167,8 @@ TEST(SubharmonicRepresentation, TwoKnotsHoldTheMembersExactly) {
 }
 
 // One knot cannot hold a member with two kinks off the grid: the residual stays O(1) in units
-// of g0 (above 1e-2), so the count of knots matters (problems/contact_bar/orbits/README.md, 'Representability').
+// of g0 (above 1e-2), so the count of knots matters (problems/contact_bar/orbits/README.md,
+// 'Representability').
 TEST(SubharmonicRepresentation, OneKnotIsNotEnough) {
   const TdbemSolver tdbem(ContactMethod::event);
   OrbitOptions o = on_wall(20, 2);
@@ -203,8 +205,9 @@ TEST(SubharmonicRepresentation, KnotSettingsAreChecked) {
 // residual Jacobian finds two null directions (energy and shape) at N = 20 and 40, with a gap
 // of at least 1e4 between the kept and the dropped singular values.
 // Shapes 0.1 and 0.8: at some other shapes (0.5 = mode 2 itself, 0.25 at N = 40) forward
-// differences see one side of a non-smooth coincidence and report extra candidates (problems/contact_bar/orbits/README.md,
-// 'Subharmonic continuum'). The knots' reference nodes are the nodes nearest the kinks.
+// differences see one side of a non-smooth coincidence and report extra candidates
+// (problems/contact_bar/orbits/README.md, 'Subharmonic continuum'). The knots' reference nodes are
+// the nodes nearest the kinks.
 TEST(SubharmonicRepresentation, VerifiedDimensionIsTwo) {
   const TdbemSolver tdbem(ContactMethod::event);
   for (int n : {20, 40})
@@ -230,8 +233,9 @@ TEST(SubharmonicRepresentation, VerifiedDimensionIsTwo) {
 }
 
 // The contact structure counted from the exact simulation: two phases inside the continuum, one
-// phase plus one grazing instant at either limit (problems/contact_bar/orbits/README.md, 'Subharmonic continuum'), no
-// penetration (min_gap >= 0 to round-off) and the phase through t = 0 counted across t = T.
+// phase plus one grazing instant at either limit (problems/contact_bar/orbits/README.md,
+// 'Subharmonic continuum'), no penetration (min_gap >= 0 to round-off) and the phase through t = 0
+// counted across t = T.
 TEST(SubharmonicContinuum, ContactStructureFromTheExactSimulation) {
   const bar::Material m;
   for (double shape : {0.0, 0.2, 0.5, 0.9, 1.0}) {

@@ -1,5 +1,5 @@
-// Hard cases of the TD-BEM contact bar (problems/contact_bar/solver/README.md, section 'Hard cases'):
-// each with its expectation and an independent oracle (the exact characteristics solver of
+// Hard cases of the TD-BEM contact bar (problems/contact_bar/solver/README.md, section 'Hard
+// cases'): each with its expectation and an independent oracle (the exact characteristics solver of
 // problems/exact_bar, the closed forms of family.hpp). Every case either meets a stated error or
 // stops with a status; none may hang, crash or return NaN silently.
 #include <gtest/gtest.h>
@@ -67,8 +67,9 @@ TEST(HardCases, ContactFreePartShorterThanAStep) {
 }
 
 // Gap -> 0 (1e-12 and 0) and a bar that starts on the wall (u0(L) = g0 with a compressive
-// strain: the subharmonic member of problems/contact_bar/orbits/README.md 'Subharmonic continuum' at shape 0.3). Oracle:
-// the exact solver, u(L, t) over two of its periods, relative to max |u0| (1e-12).
+// strain: the subharmonic member of problems/contact_bar/orbits/README.md 'Subharmonic continuum'
+// at shape 0.3). Oracle: the exact solver, u(L, t) over two of its periods, relative to max |u0|
+// (1e-12).
 TEST(HardCases, VanishingGapAndStartInContactMatchTheExactSolver) {
   std::vector<std::pair<bar::BarSetup, double>> cases;
   cases.emplace_back(mode1_setup(1e-12, -0.01), 3.0);
@@ -103,11 +104,12 @@ TEST(HardCases, CourantNumbersOtherThanOne) {
 }
 
 // 10^4 periods of mode 1, the paper scene (dt = 0.01). Mode 1 is piecewise linear with every
-// kink on a grid point, and the march holds it to round-off for ever (problems/contact_bar/solver/README.md 'Hard cases':
-// step-grid times, round-off closings held where they are, Q re-gauged): after 10^4 periods the
-// energy, u(L) and the projected u (relative to its largest entry) are the start's, and half a
-// period later u(L) is a fresh march's. Bounds 1e-13 relative: above round-off, and orders of
-// magnitude below what a drift of the march would leave.
+// kink on a grid point, and the march holds it to round-off for ever
+// (problems/contact_bar/solver/README.md 'Hard cases': step-grid times, round-off closings held
+// where they are, Q re-gauged): after 10^4 periods the energy, u(L) and the projected u (relative
+// to its largest entry) are the start's, and half a period later u(L) is a fresh march's. Bounds
+// 1e-13 relative: above round-off, and orders of magnitude below what a drift of the march would
+// leave.
 TEST(HardCases, TenThousandPeriodsOfModeOne) {
   const double gap = 1e-3, eps = -0.01, period = 3.1;
   const bar::BarSetup s = mode1_setup(gap, eps);
