@@ -174,7 +174,7 @@ std::string lu_legrand_section(const std::vector<LuLegrandRun>& stored,
       "problems/contact_bar/scenes/paper.ini --branch mode1 --start_offset 0.25 "
       "--energy_max 5e-3 --shooting_elements N`, run in-process, {}, median of {} runs "
       "(one when it takes over 5 s). Lu & Legrand: their stored runs "
-      "(problems/contact_bar/peers/, "
+      "(problems/contact_bar/bench/peers/, "
       "measured on the same kind of machine; not run here), errors over their admissible "
       "points. Error: |omega / omega_exact(E) - 1| with the mode-1 closed form at each "
       "point's own energy, for both.\n\n"
@@ -282,7 +282,7 @@ std::string siconos_section(const core::Table& siconos, const std::vector<Sicono
       "the exact characteristics solution at every step, energy change (E(10) - "
       "E(0)) / E(0) from a second run with the energy on 101 rows. Siconos 4.4: "
       "Moreau-Jean, P1 FEM with consistent mass, theta = 0.5, e = 0, its stored runs "
-      "(problems/contact_bar/peers/; not run here).\n\n"
+      "(problems/contact_bar/bench/peers/; not run here).\n\n"
       "| tool | elements | us/step | max tip error / 2e-3 | energy change |\n"
       "|---|---|---|---|---|\n{}\n"
       "**Where backbone stands:** {}\n\n![Siconos bar](siconos_bar.png)\n",

@@ -1,5 +1,5 @@
 // The contact bar beside its peers: two benchmark cases that put backbone's own runs, measured
-// live, next to the stored measurements of problems/contact_bar/peers/ (README.md there:
+// live, next to the stored measurements of problems/contact_bar/bench/peers/ (README.md there:
 // provenance), each writing a CSV, a work-precision PNG and its section of BENCHMARKS.md
 // (continuation/cli/bench_report.hpp).
 //

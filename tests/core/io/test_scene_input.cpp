@@ -1,5 +1,5 @@
-// The scene reader and the output-folder check against the inputs that used to slip through
-// (issue 12): integers beyond the int range, a directory as the scene, stray words on the
+// The scene reader and the output-folder check against inputs that are easy to get wrong:
+// integers beyond the int range, a directory as the scene, stray words on the
 // command line, a UTF-8 byte-order mark, and output folders that cannot be written. Each is an
 // InputError naming its key before any work, or (the byte-order mark) read correctly.
 #include <gtest/gtest.h>
@@ -61,7 +61,7 @@ std::string input_error(F&& f, const std::string& key) {
   return "";
 }
 
-// 4294967298 = 2^32 + 2 used to be cast to int and read as 2.
+// 4294967298 = 2^32 + 2: a cast to int would read it as 2.
 TEST_F(SceneInput, IntegerAboveIntMaxNamesTheKeyAndTheBound) {
   const Scene s = read_scene(keys(), "", {"--points", "4294967298"}, {});
   EXPECT_EQ(input_error([&] { s.integer("points", 1); }, "points"),
