@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <exception>
+#include <filesystem>
 #include <new>
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -28,10 +29,10 @@ void keep_large_blocks() {
 #endif
 }
 
-void print_usage() {
-  fmt::print("usage: backbone COMMAND [arguments]\n\ncommands:\n");
+void print_usage(const std::string& program) {
+  fmt::print("usage: {} COMMAND [arguments]\n\ncommands:\n", program);
   for (const auto& [name, c] : commands()) fmt::print("  {:<10} {}\n", name, c.summary);
-  fmt::print("\n'backbone COMMAND --help' describes a command and its keys.\n");
+  fmt::print("\n'{} COMMAND --help' describes a command and its keys.\n", program);
 }
 }  // namespace
 
@@ -48,30 +49,32 @@ const std::map<std::string, Command>& commands() {
 
 int main(int argc, char** argv, RegisterPlugins register_plugins) {
   set_plugin_registration(register_plugins);
+  // The executable's own name in its messages (`backbone`, or an outside CLI's).
+  const std::string program = std::filesystem::path(argv[0]).filename().string();
   keep_large_blocks();
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
-    print_usage();
+    print_usage(program);
     if (argc >= 2) return core::exit_ok;
-    fmt::print(stderr, "backbone: a command is required (the list above)\n");
+    fmt::print(stderr, "{}: a command is required (the list above)\n", program);
     return core::exit_bad_input;
   }
   const std::string name = argv[1];
   auto it = commands().find(name);
   if (it == commands().end()) {
-    fmt::print(stderr, "backbone: unknown command '{}' (try 'backbone --help')\n", name);
+    fmt::print(stderr, "{0}: unknown command '{1}' (try '{0} --help')\n", program, name);
     return core::exit_bad_input;
   }
   std::vector<std::string> args(argv + 2, argv + argc);
   try {
     return it->second.run(args);
   } catch (const core::InputError& e) {
-    fmt::print(stderr, "backbone {}: {}\n", name, e.what());
+    fmt::print(stderr, "{} {}: {}\n", program, name, e.what());
     return core::exit_bad_input;
   } catch (const std::bad_alloc&) {
-    fmt::print(stderr, "backbone {}: out of memory\n", name);
+    fmt::print(stderr, "{} {}: out of memory\n", program, name);
     return core::exit_numerical_failure;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "backbone {}: {}\n", name, e.what());
+    fmt::print(stderr, "{} {}: {}\n", program, name, e.what());
     return core::exit_numerical_failure;
   }
 }

@@ -92,8 +92,7 @@ int run_simulate(const std::vector<std::string>& args) {
 }  // namespace
 
 Command simulate_command() {
-  return {"simulate", usage, "time simulation of a scene (contact bar: tdbem, fem, exact)",
-          run_simulate};
+  return {"simulate", usage, "time simulation of a scene (the problem's solvers)", run_simulate};
 }
 
 }  // namespace backbone::drivers
