@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <vector>
 
 #include "continuation/dimension_evidence.hpp"
@@ -153,6 +154,19 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
     rewritten.add_cells(std::move(cells));
   }
   rewritten.write_csv(out / "branch.csv");
+  if (check) {
+    std::map<int, int> counts;  // F's verified dimension -> points
+    for (double d : dimensions)
+      if (std::isfinite(d)) ++counts[static_cast<int>(d)];
+    std::string list;
+    for (const auto& [dimension, points] : counts)
+      list += fmt::format("{}{} at {} point{}", list.empty() ? "" : ", ", dimension, points,
+                          points == 1 ? "" : "s");
+    fmt::print(
+        "dimension of the periodicity residual F alone (branch.csv's dimension column; the "
+        "point lines give the traced curve's): {}\n",
+        list.empty() ? "not checked" : list);
+  }
 }
 
 }  // namespace backbone::contact_bar
