@@ -163,6 +163,49 @@ double first_cell(const std::string& line) {
 
 }  // namespace
 
+void check_saved_files(const std::filesystem::path& dir, const std::string& key) {
+  const auto fail = [&](const std::filesystem::path& file, std::size_t line,
+                        const std::string& what) {
+    throw core::InputError(key, fmt::format("'{}' line {}: {}; not a file of a traced branch",
+                                            file.string(), line + 1, what));
+  };
+  const auto number = [](const std::string& cell) {
+    if (cell.empty()) return false;
+    char* end = nullptr;
+    std::strtod(cell.c_str(), &end);
+    return end == cell.c_str() + cell.size();
+  };
+  for (const char* name : {"branch.csv", "unknowns.csv", "orbits.csv"}) {
+    const std::filesystem::path file = dir / name;
+    if (!std::filesystem::exists(file)) continue;
+    const std::vector<std::string> lines = complete_lines(file, key);
+    const std::string& header = lines.front();
+    if (header.rfind("point,", 0) != 0) fail(file, 0, "the header does not start with 'point,'");
+    const auto cells_in = [](const std::string& line) {
+      return static_cast<std::size_t>(std::count(line.begin(), line.end(), ',')) + 1;
+    };
+    const std::size_t columns = cells_in(header);
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+      if (cells_in(lines[i]) != columns)
+        fail(file, i, fmt::format("{} cells for {} columns", cells_in(lines[i]), columns));
+      std::stringstream row(lines[i]);
+      for (std::string cell; std::getline(row, cell, ',');)
+        if (!number(cell)) fail(file, i, fmt::format("'{}' is not a number", cell));
+    }
+  }
+  const std::filesystem::path states = dir / "state.txt";
+  if (!std::filesystem::exists(states)) return;
+  const std::vector<std::string> lines = complete_lines(states, key);
+  if (lines.front().rfind("point state", 0) != 0)
+    fail(states, 0, "the header is not 'point state'");
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const auto space = lines[i].find(' ');
+    if (space == std::string::npos || !number(lines[i].substr(0, space)) ||
+        space + 1 >= lines[i].size())
+      fail(states, i, "not 'POINT STATE' or 'POINT -'");
+  }
+}
+
 int repair_branch_files(const std::filesystem::path& out, const std::string& key) {
   std::vector<std::filesystem::path> files{out / "branch.csv", out / "unknowns.csv"};
   for (const char* optional : {"orbits.csv", "state.txt"})

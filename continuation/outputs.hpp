@@ -72,6 +72,13 @@ class BranchWriter {
   int points_ = 0;
 };
 
+// Checks, reading only, that the files of a traced branch in `dir` are what BranchWriter
+// writes: each present file has its header, and every complete line (a last line cut by an
+// interruption is allowed) is a row of numbers with the header's count of cells (state.txt: a
+// point index, then a state or `-`). InputError naming `key` and the file and line otherwise,
+// before a resume repairs anything or a start reads a point.
+void check_saved_files(const std::filesystem::path& dir, const std::string& key);
+
 // Makes the files of an interrupted run consistent: drops a line cut by the interruption and
 // every row of a point that is not complete in all of branch.csv, unknowns.csv (and orbits.csv
 // and state.txt when present). Returns the last complete point; InputError naming `key` when there

@@ -144,11 +144,13 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
   const std::string restart_key = t.resume.empty() ? "start" : "resume";
   if (!t.resume.empty()) {
     t.lock = std::make_unique<core::FolderLock>("resume", t.resume);
+    continuation::check_saved_files(t.resume, "resume");
     continuation::repair_branch_files(t.resume, "resume");
     t.restart = continuation::restart_point(t.resume, -1, options, "resume");
     t.restart->record_saved_point = false;  // it is in the files
   } else if (scene.has("start")) {
     const auto [dir, point] = continuation::parse_saved_point(scene.text("start"), "start");
+    continuation::check_saved_files(dir, "start");
     std::error_code same_error;
     if (std::filesystem::equivalent(dir, t.out, same_error))
       throw core::InputError("out", fmt::format("'{}' is the folder --start reads from: its "

@@ -266,6 +266,26 @@ TEST(CommandLineInput, ResumeTakesNoStartAndNeedsItsSummary) {
   EXPECT_EQ(code, 2);
 }
 
+TEST(TraceInput, ADamagedSavedFolderIsRefusedBeforeAnythingIsRepaired) {
+  const fs::path dir = cli::scratch("trace_input", "damaged");
+  ASSERT_EQ(cli::run("trace", small + " --max_points 5", dir).code, 0);
+  const auto read = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  const std::string branch = read(dir / "branch.csv");
+  std::ofstream(dir / "state.txt") << "hello\nworld 1 2 3\n";  // not a state file
+  int code = -1;
+  stdout_of("trace --resume " + dir.string() + " --max_points 8", code);
+  EXPECT_EQ(code, 2);
+  EXPECT_EQ(read(dir / "branch.csv"), branch);  // nothing cut, nothing appended
+  const fs::path out = cli::scratch("trace_input", "from_damaged");
+  const cli::Run start = cli::run("trace", small + " --start " + dir.string() + ":3", out);
+  EXPECT_EQ(start.code, 2) << start.err;
+  EXPECT_NE(start.err.find("start:"), std::string::npos) << start.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST(OutputFolderInput, AFolderThatCannotBeCreatedIsBadInputForEveryCommand) {
   // /proc takes no new folders; bench and reproduce checked nothing before their first case.
   const fs::path proc = "/proc/backbone_test";
