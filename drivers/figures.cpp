@@ -39,6 +39,13 @@ int run_figures(const std::vector<std::string>& args) {
     throw core::InputError("out", fmt::format("'{}' is not a folder of traced branches (backbone "
                                               "reproduce --out DIR writes one)",
                                               out.string()));
+  bool traced = false;
+  for (const auto& entry : std::filesystem::directory_iterator(out))
+    traced = traced || std::filesystem::exists(entry.path() / "branch.csv");
+  if (!traced)
+    throw core::InputError("out", fmt::format("'{}' holds no traced branch (no DIR/*/branch.csv; "
+                                              "backbone reproduce --out DIR writes them)",
+                                              out.string()));
   core::check_output_folder("out", out);
   int status = core::exit_ok;
   for (const auto& plugin : plugins().all())

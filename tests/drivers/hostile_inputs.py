@@ -357,8 +357,8 @@ c("trace_energy_nan", "trace", ["{S}", "--branch", "subharmonic_continuum", "--e
   "energy")
 c("trace_shape_above_one", "trace", ["{S}", "--branch", "subharmonic", "--shape", "2"], "shape")
 c("trace_shape_zero", "trace", ["{S}", "--branch", "subharmonic", "--shape", "0",
-                               "--max_points", "3"], kind="ok",
-  note="help: shape in [0, 1], 0 and 1 the grazing limits (1 is accepted)")
+                               "--max_points", "3"], "shape",
+  note="help: shape in (0, 1]; 0 itself degenerates the two-knot chart")
 c("trace_shape_negative", "trace", ["{S}", "--branch", "subharmonic", "--shape", "-0.5"],
   "shape")
 c("trace_path_rows_bogus", "trace", ["{S}", "--branch", "subharmonic", "--path_rows", "2"],

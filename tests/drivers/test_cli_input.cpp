@@ -286,6 +286,21 @@ TEST(TraceInput, ADamagedSavedFolderIsRefusedBeforeAnythingIsRepaired) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST(TraceInput, AShapeOutsideItsRangeIsBadInput) {
+  for (const char* shape : {"-0.5", "0", "1.5"})
+    cli::expect_bad_input("trace", scene + " --branch subharmonic --shape " + std::string(shape),
+                          "shape", "trace_input_shape");
+}
+
+TEST(FiguresInput, AFolderWithNoTracedBranchIsBadInput) {
+  const fs::path empty = cli::scratch("cli_input", "empty_results");
+  fs::create_directories(empty);
+  const cli::Run r = cli::run("figures", "", empty);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("out:"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(empty));
+}
+
 TEST(OutputFolderInput, AFolderThatCannotBeCreatedIsBadInputForEveryCommand) {
   // /proc takes no new folders; bench and reproduce checked nothing before their first case.
   const fs::path proc = "/proc/backbone_test";

@@ -51,9 +51,10 @@ po::options_description subharmonic_keys() {
        "subharmonic_continuum: the energy of the members [J] (0: that of strain 5 g0 / L, "
        "EA L (5 g0 / L)^2 / 2)")  //
       ("shape", po::value<double>()->default_value(-1),
-       "subharmonic shape in [0, 1] (first contact phase / total contact time; 0 and 1 are "
-       "the grazing limits, 0.5 mode 2). subharmonic: the shape kept along the backbone "
-       "(-1: 0.3); subharmonic_continuum: the first member (-1: 1, a grazing limit)")  //
+       "subharmonic shape in (0, 1] or -1 (first contact phase / total contact time; 1 and "
+       "the limit 0 are the grazing limits, where shape 0 itself degenerates the two-knot "
+       "chart; 0.5 is mode 2). subharmonic: the shape kept along the backbone (-1: 0.3); "
+       "subharmonic_continuum: the first member (-1: 1, a grazing limit)")  //
       ("path_rows", po::value<bool>()->default_value(true),
        "subharmonic branches: append the row that picks the path (shape or energy); false "
        "leaves the periodicity residual F alone, whose solutions form a 2D manifold (for "
@@ -404,9 +405,11 @@ SubharmonicStart subharmonic_start(const core::Scene& scene, const std::string& 
   if (st.energy == 0) st.energy = 0.5 * material.axial_stiffness() * 25 * g0 * g0 / material.length;
   if (st.manifold) st.energy = manifold_seed_energy(scene);
   const double shape_key = scene.number("shape");
-  st.shape = shape_key >= 0 ? shape_key : (st.continuum && !st.manifold ? 1.0 : 0.3);
-  if (!(st.shape > 0 && st.shape <= 1))
-    throw core::InputError("shape", fmt::format("must be in (0, 1] (got {})", st.shape));
+  if (shape_key != -1 && !(shape_key > 0 && shape_key <= 1))
+    throw core::InputError("shape", fmt::format("must be in (0, 1], or -1 for the branch's "
+                                                "default (got {})",
+                                                shape_key));
+  st.shape = shape_key > 0 ? shape_key : (st.continuum && !st.manifold ? 1.0 : 0.3);
   const double ratio = 1 + scene.positive("start_offset");
   st.start_energy = st.continuum ? st.energy
                                  : 0.5 * material.axial_stiffness() *
