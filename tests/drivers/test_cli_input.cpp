@@ -292,6 +292,14 @@ TEST(TraceInput, AShapeOutsideItsRangeIsBadInput) {
                           "shape", "trace_input_shape");
 }
 
+TEST(TraceInput, ADuffingPeriodGuessFarAboveTheLinearPeriodIsBadInput) {
+  // 1e12 s had CVODE integrate until it gave up, with three lines of its errors and exit 1.
+  cli::expect_bad_input(
+      "trace",
+      std::string(BACKBONE_SOURCE_DIR) + "/problems/duffing/scenes/duffing.ini --period_guess 1e12",
+      "period_guess", "trace_input_duffing");
+}
+
 TEST(FiguresInput, AFolderWithNoTracedBranchIsBadInput) {
   const fs::path empty = cli::scratch("cli_input", "empty_results");
   fs::create_directories(empty);

@@ -5,9 +5,12 @@
 //   backbone trace problems/duffing/scenes/duffing.ini --branch backbone --out out/duffing
 #include "continuation/cli/plugin.hpp"
 
+#include <fmt/format.h>
+
 #include <memory>
 #include <numbers>
 
+#include "core/errors.hpp"
 #include "problems/duffing/bench/bench.hpp"
 #include "problems/duffing/duffing.hpp"
 
@@ -23,6 +26,12 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
   const double amplitude = scene.positive("amplitude");
   const double period =
       scene.has("period_guess") ? scene.positive("period_guess") : 2.0 * std::numbers::pi;
+  // The hardening backbone's periods lie below the linear 2 pi; a guess far above it would have
+  // CVODE integrate for thousands of periods before Newton could refuse it.
+  if (period > 20 * std::numbers::pi)
+    throw core::InputError(
+        "period_guess",
+        fmt::format("must be in (0, 20 pi] (the linear period is 2 pi; got {})", period));
   s.guess.resize(2);
   s.guess << amplitude, period;
   s.direction = core::Vector::Unit(2, 0);  // amplitude grows; the first point keeps x0 fixed
