@@ -300,6 +300,19 @@ TEST(TraceInput, ADuffingPeriodGuessFarAboveTheLinearPeriodIsBadInput) {
       "period_guess", "trace_input_duffing");
 }
 
+TEST(TraceInput, ASimulationStepThatCrossesTheBarIsBadInputForTraceToo) {
+  // The scene.ini a trace writes must simulate: dt = 5 s > L/c = 1 s would not.
+  cli::expect_bad_input("trace", small + " --dt 5", "dt", "trace_input_dt_sim");
+}
+
+TEST(SimulateInput, ADamagedOrbitFileIsNamedByTheOrbitKey) {
+  const fs::path traced = cli::scratch("cli_input", "traced_for_orbit");
+  ASSERT_EQ(cli::run("trace", small + " --max_points 4", traced).code, 0);
+  std::ofstream(traced / "orbits.csv") << "point,x,u0\n0,zero,nan\n";
+  cli::expect_bad_input("simulate", scene + " --orbit " + (traced / "orbits.csv:0").string(),
+                        "orbit:", "simulate_input_orbit");
+}
+
 TEST(FiguresInput, AFolderWithNoTracedBranchIsBadInput) {
   const fs::path empty = cli::scratch("cli_input", "empty_results");
   fs::create_directories(empty);

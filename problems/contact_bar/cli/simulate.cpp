@@ -137,7 +137,13 @@ int simulate_scene(const core::Scene& scene, const fs::path& out) {
   if (scene.has("orbit")) {
     // A traced orbit: its own u0 (orbits.csv holds it at its actual knots), v0 = 0, its period.
     const auto [dir, point] = continuation::parse_saved_point(scene.text("orbit"), "orbit");
-    const auto orbit = load_traced_orbit_point(dir, point, 0, setup.material.length);
+    const auto orbit = [&] {
+      try {
+        return load_traced_orbit_point(dir, point, 0, setup.material.length);
+      } catch (const InputError& e) {
+        throw InputError("orbit", fmt::format("'{}': {}", (dir / "orbits.csv").string(), e.what()));
+      }
+    }();
     if (!orbit)
       throw core::InputError("orbit", fmt::format("'{}' has no traced orbit {} (branch.csv and "
                                                   "orbits.csv of a trace)",

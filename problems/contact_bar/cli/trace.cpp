@@ -165,8 +165,13 @@ void check_orbit_ends(const bar::BarSetup& setup, const std::string& what) {
 // The scene's simulation keys (u0, v0, period, dt, probes) fit the bar, so that the scene.ini a
 // trace writes reruns as `backbone simulate` too.
 void check_simulation_keys(const core::Scene& scene) {
-  setup_from_scene(scene);
-  simulation_from_scene(scene, 1.0);
+  const bar::BarSetup setup = setup_from_scene(scene);
+  const bar::SimulationOptions simulation = simulation_from_scene(scene, 1.0);
+  const double transit = setup.material.travel_time();
+  if (simulation.dt > transit * (1 + 1e-12))
+    throw core::InputError("dt", fmt::format("must be <= length / wave_speed = {:g} s (got {:g}): "
+                                             "one step of a simulation may not cross the bar",
+                                             transit, simulation.dt));
 }
 
 // dt = T / steps_per_period must not exceed the bar's travel time L / c, the largest step of
