@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <array>
 #include <climits>
 #include <cstdio>
@@ -311,6 +312,23 @@ TEST(SimulateInput, ADamagedOrbitFileIsNamedByTheOrbitKey) {
   std::ofstream(traced / "orbits.csv") << "point,x,u0\n0,zero,nan\n";
   cli::expect_bad_input("simulate", scene + " --orbit " + (traced / "orbits.csv:0").string(),
                         "orbit:", "simulate_input_orbit");
+}
+
+TEST(TraceOutputs, TheSubharmonicTraceSaysWhichDimensionItsBranchFileHolds) {
+  // The point lines give the traced curve's dimension (F plus the shape row: 1); branch.csv's
+  // dimension column holds F alone's (dimension_check), and the run says so with its counts.
+  const fs::path out = cli::scratch("trace_outputs", "subharmonic");
+  int code = -1;
+  const std::string text = stdout_of(
+      "trace " + scene + " --branch subharmonic --max_points 5 --out " + out.string(), code);
+  ASSERT_EQ(code, 0);
+  const auto dimension = backbone::core::Table::read_csv(out / "branch.csv").column("dimension");
+  const auto twos = std::count(dimension.begin(), dimension.end(), 2.0);
+  EXPECT_NE(text.find("dimension of the periodicity residual F alone (branch.csv's dimension "
+                      "column; the point lines give the traced curve's): 2 at " +
+                      std::to_string(twos) + " points"),
+            std::string::npos)
+      << text;
 }
 
 TEST(FiguresInput, AFolderWithNoTracedBranchIsBadInput) {
