@@ -52,7 +52,7 @@ struct BranchPoint {
   DimensionFlag dimension_flag = DimensionFlag::as_verified;
   double residual = 0;  // ||F(x)||_inf of the problem (not of the augmented system)
   int newton_iterations = 0;
-  double step_size = 0;  // ds used to reach this point (0 for the first point)
+  double step_size = 0;  // the step ds that reached this point (0 for the first point)
   // Sum of the chords between consecutive points, Euclidean in the scaled unknowns
   // x ./ typical_scale() (options.scale_unknowns), the same units for every method.
   double arclength = 0;

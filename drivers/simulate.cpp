@@ -33,29 +33,6 @@ po::options_description driver_keys() {
   return keys;
 }
 
-// The keys of a trace of the same problem that a simulation does not take: a scene.ini written
-// by `trace` holds them and simulates as it is; on the command line they are refused.
-po::options_description trace_only_keys(const cli::ProblemPlugin& plugin,
-                                        const po::options_description& simulate_keys) {
-  po::options_description extra("keys of a trace's scene (unused by simulate)");
-  if (!plugin.can_trace()) return extra;
-  po::options_description trace = plugin.scene_keys();
-  trace.add(cli::continuation_keys(trace));
-  for (const auto& option : trace.options())
-    if (!simulate_keys.find_nothrow(option->long_name(), false)) extra.add(option);
-  return extra;
-}
-
-void refuse_on_command_line(const po::options_description& trace_only,
-                            const std::vector<std::string>& args) {
-  for (const std::string& word : args) {
-    if (word.rfind("--", 0) != 0) continue;
-    const std::string name = word.substr(2, word.find('=') - 2);
-    if (trace_only.find_nothrow(name, false))
-      throw core::InputError(name, "is a key of `backbone trace`; a simulation does not use it");
-  }
-}
-
 int run_simulate(const std::vector<std::string>& args) {
   const bool help = std::any_of(args.begin(), args.end(),
                                 [](const std::string& a) { return a == "--help" || a == "-h"; });
@@ -78,8 +55,12 @@ int run_simulate(const std::vector<std::string>& args) {
   }
   const std::vector<std::string> rest(args.begin() + 1, args.end());
   po::options_description keys = plugin.simulate_keys();
-  const po::options_description trace_only = trace_only_keys(plugin, keys);
-  refuse_on_command_line(trace_only, rest);
+  // A scene.ini written by `trace` holds trace keys: read from the file, refused on the line.
+  const po::options_description trace_only = cli::trace_keys_beyond(plugin, keys);
+  for (const auto& option : trace_only.options())
+    if (cli::given_on_command_line(rest, option->long_name()))
+      throw core::InputError(option->long_name(),
+                             "is a key of `backbone trace`; a simulation does not use it");
   keys.add(trace_only);
   const core::Scene scene = core::read_scene(keys, scene_path, rest, driver_keys());
   const fs::path out(scene.text("out"));

@@ -71,20 +71,6 @@ void print_help(const cli::ProblemPlugin* problem) {
   fmt::print("{}\n", text.str());
 }
 
-// The scene file names the problem; `--problem` on the command line may only repeat it.
-void check_problem_not_overridden(const cli::ProblemPlugin& entry,
-                                  const std::vector<std::string>& rest) {
-  for (std::size_t i = 0; i < rest.size(); ++i) {
-    std::string given;
-    if (rest[i] == "--problem" && i + 1 < rest.size()) given = rest[i + 1];
-    if (rest[i].rfind("--problem=", 0) == 0) given = rest[i].substr(10);
-    if (!given.empty() && given != entry.name)
-      throw core::InputError("problem", fmt::format("is the scene file's ({}); it cannot be "
-                                                    "changed on the command line (got '{}')",
-                                                    entry.name, given));
-  }
-}
-
 // --resume DIR: the run's own resolved scene, its branch and folder in front of the other
 // arguments. Returns DIR (empty without --resume).
 std::filesystem::path take_resume(std::vector<std::string>& args) {
@@ -98,11 +84,10 @@ std::filesystem::path take_resume(std::vector<std::string>& args) {
     throw core::InputError(
         "resume", fmt::format("'{}' holds no summary.txt of a traced branch", resume.string()));
   const std::string branch = core::read_text_value(resume / "summary.txt", "branch");
-  for (const std::string& word : args)
-    if (word == "--start" || word.rfind("--start=", 0) == 0)
-      throw core::InputError("start",
-                             "goes with a scene, not with --resume (which continues "
-                             "the folder's own branch)");
+  if (cli::given_on_command_line(args, "start"))
+    throw core::InputError("start",
+                           "goes with a scene, not with --resume (which continues "
+                           "the folder's own branch)");
   args.erase(args.begin(), args.begin() + 2);
   args.insert(args.begin(),
               {(resume / "scene.ini").string(), "--branch", branch, "--out", resume.string()});
@@ -124,7 +109,11 @@ int run_trace(const std::vector<std::string>& args_in) {
     print_help(&entry);
     return core::exit_ok;
   }
-  check_problem_not_overridden(entry, rest);
+  // The scene file names the problem; `--problem` on the command line may only repeat it.
+  if (const auto given = cli::given_on_command_line(rest, "problem"); given && *given != entry.name)
+    throw core::InputError("problem", fmt::format("is the scene file's ({}); it cannot be changed "
+                                                  "on the command line (got '{}')",
+                                                  entry.name, *given));
   po::options_description keys = entry.scene_keys();
   keys.add(cli::continuation_keys(keys));
   cli::TraceRun t = cli::prepare_trace(entry, core::read_scene(keys, args[0], rest, driver_keys()),

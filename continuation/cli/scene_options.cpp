@@ -238,4 +238,25 @@ SwitchingBranch run_continuation(const core::Problem& problem, const core::Vecto
               : natural_then_arclength(problem, guess, parameter, corrector, options, hooks, start);
 }
 
+std::optional<std::string> given_on_command_line(const std::vector<std::string>& words,
+                                                 const std::string& key) {
+  const std::string flag = "--" + key;
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    if (words[i] == flag) return i + 1 < words.size() ? words[i + 1] : std::string();
+    if (words[i].rfind(flag + "=", 0) == 0) return words[i].substr(flag.size() + 1);
+  }
+  return std::nullopt;
+}
+
+po::options_description trace_keys_beyond(const ProblemPlugin& plugin,
+                                          const po::options_description& keys) {
+  po::options_description extra("keys of a trace's scene (unused here)");
+  if (!plugin.can_trace()) return extra;
+  po::options_description trace = plugin.scene_keys();
+  trace.add(continuation_keys(trace));
+  for (const auto& option : trace.options())
+    if (!keys.find_nothrow(option->long_name(), false)) extra.add(option);
+  return extra;
+}
+
 }  // namespace backbone::cli

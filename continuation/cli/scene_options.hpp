@@ -17,9 +17,12 @@
 
 #include <boost/program_options.hpp>
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "continuation/branch_points/follow.hpp"
+#include "continuation/cli/plugin.hpp"
 #include "continuation/methods/switching.hpp"
 #include "continuation/options.hpp"
 #include "continuation/restart.hpp"
@@ -62,5 +65,15 @@ SwitchingBranch run_continuation(const core::Problem& problem, const core::Vecto
                                  const core::Vector& direction, const RunSettings& settings,
                                  core::Corrector& corrector, const ContinuationHooks& hooks,
                                  const RestartPoint* restart = nullptr);
+
+// The value given for --KEY among command-line words (`--key value` or `--key=value`); empty
+// when the key is not there. For the keys a command refuses or checks before it reads a scene.
+std::optional<std::string> given_on_command_line(const std::vector<std::string>& words,
+                                                 const std::string& key);
+
+// The scene keys of the plugin's trace (its own and the continuation keys) that `keys` lacks:
+// what `simulate` accepts in a scene.ini written by `trace` without using it.
+boost::program_options::options_description trace_keys_beyond(
+    const ProblemPlugin& plugin, const boost::program_options::options_description& keys);
 
 }  // namespace backbone::cli
