@@ -27,26 +27,26 @@ std::string bound_key(const core::Scene& scene, const std::string& observable, c
   return values.count(key) && !values[key].defaulted() ? key : "bound";
 }
 
-// Every bound names an observable of the problem (its observables at the guess), and a fresh
-// start lies inside every bound: a start outside would end the branch at its first point.
-void check_bounds(const core::Scene& scene, const core::Problem& problem, const core::Vector& guess,
-                  const continuation::ContinuationOptions& options, bool restarting) {
-  if (options.bounds.empty()) return;
-  const core::Observables observables = problem.observables(guess);
+// The value of observable `name` at the start; InputError naming `key` when the problem has no
+// observable of that name.
+double observable_at_start(const core::Observables& at_start, const std::string& name,
+                           const std::string& key, const core::Problem& problem) {
   std::vector<std::string> names;
-  for (const auto& [name, value] : observables) names.push_back(name);
+  for (const auto& [observable, value] : at_start) {
+    if (observable == name) return value;
+    names.push_back(observable);
+  }
+  throw core::InputError(key, fmt::format("'{}' is not an observable of {} (its observables: {})",
+                                          name, problem.name(), fmt::join(names, ", ")));
+}
+
+// Every bound names an observable of the problem, and a fresh start lies inside every bound: a
+// start outside would end the branch at its first point.
+void check_bounds(const core::Scene& scene, const core::Problem& problem,
+                  const core::Observables& at_start,
+                  const continuation::ContinuationOptions& options, bool restarting) {
   for (const continuation::Bound& b : options.bounds) {
-    const auto it = std::find(names.begin(), names.end(), b.observable);
-    if (it == names.end())
-      throw core::InputError("bound",
-                             fmt::format("'{}' is not an observable of {} (its "
-                                         "observables: {})",
-                                         b.observable, problem.name(), fmt::join(names, ", ")));
-    if (b.min > b.max)
-      throw core::InputError(
-          bound_key(scene, b.observable, "_max"),
-          fmt::format("the {} window [{:g}, {:g}] is empty", b.observable, b.min, b.max));
-    const double start = observables[static_cast<std::size_t>(it - names.begin())].second;
+    const double start = observable_at_start(at_start, b.observable, "bound", problem);
     if (restarting || !std::isfinite(start)) continue;
     // A start on a bound (within rounding of the guess) is a branch's own end, as at a grazing
     // limit; one beyond it by more is outside the window.
@@ -66,26 +66,17 @@ void check_bounds(const core::Scene& scene, const core::Problem& problem, const 
 
 // The natural methods' parameter: the period of a periodic-orbit problem, or an observable.
 void check_natural_parameter(const RunSettings& run, const core::Problem& problem,
-                             const core::Vector& guess, bool periodic) {
-  using continuation::Method;
-  if (run.options.method == Method::arclength) return;
+                             const core::Observables& at_start, bool periodic) {
+  if (run.options.method == continuation::Method::arclength) return;
   if (periodic && run.natural_parameter == "period") return;
-  std::vector<std::string> names;
-  for (const auto& [name, value] : problem.observables(guess)) names.push_back(name);
-  if (std::find(names.begin(), names.end(), run.natural_parameter) == names.end())
-    throw core::InputError(
-        "natural_parameter",
-        fmt::format("'{}' is not an observable of {} (its observables: {})", run.natural_parameter,
-                    problem.name(), fmt::join(names, ", ")));
+  observable_at_start(at_start, run.natural_parameter, "natural_parameter", problem);
 }
 
 // A resumed run appends rows to the saved branch.csv: its columns must be the ones this run
 // writes (another version, or another problem, wrote other ones).
-void check_saved_columns(const std::filesystem::path& dir, const core::Problem& problem,
-                         const core::Vector& x) {
+void check_saved_columns(const std::filesystem::path& dir, const core::Observables& at_start) {
   continuation::BranchPoint point;
-  point.x = x;
-  point.observables = problem.observables(x);
+  point.observables = at_start;
   continuation::Branch one;
   one.points.push_back(point);
   const std::vector<std::string> expected = continuation::branch_table(one).columns();
@@ -162,7 +153,17 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
   if (t.restart)
     continuation::take_up(*t.restart, restart_key, static_cast<int>(start_direction), problem,
                           options, t.setup.guess, t.direction);
-  if (t.restart && !t.resume.empty()) check_saved_columns(t.resume, problem, t.setup.guess);
+  const core::Observables at_start = problem.observables(t.setup.guess);
+  if (t.restart && !t.resume.empty()) check_saved_columns(t.resume, at_start);
+
+  const int n = problem.num_unknowns(), m = problem.num_equations();
+  if (m != n - 1 && t.corrector->name() == "kinsol")
+    throw core::InputError("newton", fmt::format("kinsol solves square systems only; this {} "
+                                                 "residual has {} equations for {} unknowns "
+                                                 "(use newton = eigen, least squares)",
+                                                 entry.name, m, n));
+  check_bounds(scene, problem, at_start, options, t.restart.has_value());
+  check_natural_parameter(t.run, problem, at_start, t.periodic != nullptr);
   if (t.restart && !t.resume.empty() && !t.restart->note.empty()) {
     // The saved states belong to another run's loop: the folder keeps none of them.
     continuation::forget_saved_states(t.resume);
@@ -171,15 +172,6 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
                "the last point is corrected again and state.txt keeps no other run's states\n",
                t.restart->note);
   }
-
-  const int n = problem.num_unknowns(), m = problem.num_equations();
-  if (m != n - 1 && t.corrector->name() == "kinsol")
-    throw core::InputError("newton", fmt::format("kinsol solves square systems only; this {} "
-                                                 "residual has {} equations for {} unknowns "
-                                                 "(use newton = eigen, least squares)",
-                                                 entry.name, m, n));
-  check_bounds(scene, problem, t.setup.guess, options, t.restart.has_value());
-  check_natural_parameter(t.run, problem, t.setup.guess, t.periodic != nullptr);
   // A consistent overdetermined system (m > n - 1) still has curves of solutions.
   t.expected_dimension = n - std::min(m, n - 1);
   return t;
