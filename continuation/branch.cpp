@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <complex>
 #include <limits>
 
 namespace backbone::continuation {
@@ -59,6 +60,11 @@ core::Table branch_table(const Branch& branch) {
     for (const auto& [key, value] : branch.points.front().observables) names.push_back(key);
   std::vector<std::string> columns{"point"};
   columns.insert(columns.end(), names.begin(), names.end());
+  const bool floquet = !branch.points.empty() && branch.points.front().floquet.has_value();
+  if (floquet)
+    for (const char* c : {"stable", "unstable_multipliers", "max_multiplier_modulus",
+                          "trivial_multiplier_distance", "monodromy_determinant"})
+      columns.push_back(c);
   for (const char* c : {"dimension", "dimension_flag", "nullity", "sigma_zero", "sigma_kept",
                         "residual", "newton_iterations", "step_size", "arclength",
                         "jacobian_evaluations", "residual_evaluations"})
@@ -67,6 +73,11 @@ core::Table branch_table(const Branch& branch) {
   for (const BranchPoint& p : branch.points) {
     std::vector<double> row{static_cast<double>(p.index)};
     for (const std::string& n : names) row.push_back(p.observable(n));
+    if (floquet) {
+      const core::Floquet f = p.floquet ? *p.floquet : core::undecided_floquet(0);
+      row.insert(row.end(), {static_cast<double>(f.stable), static_cast<double>(f.unstable),
+                             f.max_modulus, f.trivial_distance, f.determinant});
+    }
     row.push_back(p.dimension);
     row.push_back(static_cast<double>(p.dimension_flag));
     row.push_back(p.rank ? p.rank->nullity : -1);
@@ -90,6 +101,19 @@ core::Table branch_table(const Branch& branch) {
     row.push_back(static_cast<double>(p.jacobian_evaluations));
     row.push_back(static_cast<double>(p.residual_evaluations));
     table.add_row(row);
+  }
+  return table;
+}
+
+core::Table multiplier_table(const Branch& branch) {
+  core::Table table({"point", "index", "re", "im", "modulus", "trivial"});
+  for (const BranchPoint& p : branch.points) {
+    if (!p.floquet) continue;
+    const core::Floquet& f = *p.floquet;
+    for (std::size_t i = 0; i < f.multipliers.size(); ++i)
+      table.add_row({static_cast<double>(p.index), static_cast<double>(i), f.multipliers[i].real(),
+                     f.multipliers[i].imag(), std::abs(f.multipliers[i]),
+                     f.trivial[i] ? 1.0 : 0.0});
   }
   return table;
 }

@@ -24,6 +24,7 @@
 #include "core/io/table.hpp"
 #include "core/problem.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/stability/floquet.hpp"
 #include "core/types.hpp"
 
 namespace backbone::continuation {
@@ -60,6 +61,9 @@ struct BranchPoint {
   long jacobian_evaluations = 0;
   long residual_evaluations = 0;
   std::optional<core::RankReport> rank;  // when the rank was checked at this point
+  // The orbit's Floquet multipliers, when the problem gives a monodromy (core::FloquetProblem)
+  // and options.stability holds; undecided (stable = -1) where M could not be built.
+  std::optional<core::Floquet> floquet;
   // The loop's state after this point (restart.hpp), what a restart from it needs to continue
   // bit for bit; null when the loop could not go on from it (e.g. a point landed on a bound).
   std::shared_ptr<const LoopState> state;
@@ -131,13 +135,19 @@ struct Branch {
   }
 };
 
-// Columns: point, then every observable by name (in the order of the first point), then
-// dimension, dimension_flag (DimensionFlag: 0 as verified, 1 re-checked along the tangent, 2
+// Columns: point, then every observable by name (in the order of the first point), then, when
+// the first point has multipliers, stable (1, 0, -1 undecided), unstable_multipliers,
+// max_multiplier_modulus (non-trivial ones), trivial_multiplier_distance (largest |mu - 1| of the
+// trivial ones) and monodromy_determinant, then dimension, dimension_flag (DimensionFlag: 0 as verified, 1 re-checked along the tangent, 2
 // below the curve's 1 and unconfirmed), nullity (candidate, -1 when unchecked), sigma_zero and
 // sigma_kept (largest singular value counted as zero and smallest kept, relative to the largest),
 // residual, newton_iterations, step_size, arclength, jacobian_evaluations,
 // residual_evaluations. Repeated runs write it bit for bit: it holds no wall time.
 core::Table branch_table(const Branch& branch);
+
+// multipliers.csv: one row per point and multiplier (points with multipliers only): point, index
+// (by decreasing modulus), re, im, modulus, trivial (1: counted as a trivial multiplier).
+core::Table multiplier_table(const Branch& branch);
 
 // branch_points.csv: one row per located candidate (Branch::branch_points): its observables (the
 // names of template_point first, e.g. a point of the branch, so that an empty list still has

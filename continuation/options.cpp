@@ -80,6 +80,7 @@ void ContinuationOptions::validate() const {
   }
   rank.validate();
   verification.validate();
+  floquet.validate();
   branch_points.validate();
 }
 

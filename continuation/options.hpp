@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "core/rank/rank_report.hpp"
+#include "core/stability/floquet.hpp"
 
 namespace backbone::continuation {
 
@@ -107,6 +108,10 @@ struct ContinuationOptions {
   core::RankOptions rank;
   core::VerifyOptions verification;
   BranchPointOptions branch_points;
+  // Floquet multipliers of every point when the problem is a core::FloquetProblem
+  // (core/stability/floquet.hpp; branch.csv's stability columns, multipliers.csv).
+  bool stability = true;
+  core::FloquetOptions floquet;
 
   void validate() const;  // throws core::InputError naming the field
 };

@@ -133,6 +133,17 @@ void BranchWriter::append(const BranchPoint& point) {
     unknowns.add_row({static_cast<double>(point.index), static_cast<double>(i), point.x[i]});
   unknowns_->write(csv_rows(unknowns, first));
   if (periodic_) orbits_->write(csv_rows(orbit_table(*periodic_, one), first));
+  if (point.floquet) {
+    // Opened with the first point that has multipliers (every point of a branch has, or none).
+    if (!multipliers_) {
+      const bool exists = std::filesystem::exists(out_ / "multipliers.csv");
+      const bool appending = points_ > 0 && exists;
+      multipliers_ = std::make_unique<File>(out_ / "multipliers.csv", appending);
+      multipliers_->write(csv_rows(multiplier_table(one), !appending));
+    } else {
+      multipliers_->write(csv_rows(multiplier_table(one), false));
+    }
+  }
   state_->write(
       fmt::format("{} {}\n", point.index, point.state ? format_state(*point.state) : "-"));
   ++points_;
@@ -175,7 +186,7 @@ void check_saved_files(const std::filesystem::path& dir, const std::string& key)
     std::strtod(cell.c_str(), &end);
     return end == cell.c_str() + cell.size();
   };
-  for (const char* name : {"branch.csv", "unknowns.csv", "orbits.csv"}) {
+  for (const char* name : {"branch.csv", "unknowns.csv", "orbits.csv", "multipliers.csv"}) {
     const std::filesystem::path file = dir / name;
     if (!std::filesystem::exists(file)) continue;
     const std::vector<std::string> lines = complete_lines(file, key);
@@ -208,10 +219,11 @@ void check_saved_files(const std::filesystem::path& dir, const std::string& key)
 
 int repair_branch_files(const std::filesystem::path& out, const std::string& key) {
   std::vector<std::filesystem::path> files{out / "branch.csv", out / "unknowns.csv"};
-  for (const char* optional : {"orbits.csv", "state.txt"})
+  for (const char* optional : {"orbits.csv", "multipliers.csv", "state.txt"})
     if (std::filesystem::exists(out / optional)) files.push_back(out / optional);
   std::vector<std::vector<std::string>> contents;
-  // The writer writes a point to branch.csv, unknowns.csv, orbits.csv, then state.txt: the last
+  // The writer writes a point to branch.csv, unknowns.csv, orbits.csv, multipliers.csv, then
+  // state.txt: the last
   // complete point is the smallest last point over the files, one less when a file holding
   // several rows per point has only part of that point's rows.
   double last = std::numeric_limits<double>::infinity();
@@ -294,11 +306,8 @@ core::Vector read_unknowns(const std::filesystem::path& path, int point, const s
   return x;
 }
 
-namespace {
-
-// The saved points before resumed's first (dir/unknowns.csv), then resumed's own.
 Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
-                    const Branch& resumed) {
+                    const Branch& resumed, const core::FloquetOptions* floquet) {
   Branch whole;
   const int first = resumed.points.empty() ? 0 : resumed.points.front().index;
   if (first > 0) {
@@ -313,6 +322,7 @@ Branch whole_branch(const std::filesystem::path& dir, const core::Problem& probl
       p.x = Eigen::Map<const core::Vector>(values.data(), static_cast<Eigen::Index>(values.size()));
       if (p.x.size() != problem.num_unknowns()) continue;
       p.observables = problem.observables(p.x);
+      if (floquet) p.floquet = core::floquet_at(problem, p.x, *floquet);
       whole.points.push_back(std::move(p));
     }
   }
@@ -322,6 +332,9 @@ Branch whole_branch(const std::filesystem::path& dir, const core::Problem& probl
   whole.message = resumed.message;
   return whole;
 }
+
+namespace {
+
 
 // Rows of `saved` whose `column` is below `below`, then those of `fresh`, in the layout of the
 // one whose columns include the other's (cells of a missing column NaN): a table whose rows are
@@ -362,7 +375,7 @@ void write_after_run(
     const std::filesystem::path& out, const core::Problem& problem, const Branch& branch,
     bool resumed, bool detect,
     const std::function<void(const std::filesystem::path&, const Branch&)>& extra) {
-  if (extra) extra(out, resumed ? whole_branch(out, problem, branch) : branch);
+  if (extra) extra(out, resumed ? whole_branch(out, problem, branch, nullptr) : branch);
   if (!detect) return;
   core::Table rows = branch_point_table(branch, branch.points.front().observables);
   const std::filesystem::path saved = out / "branch_points.csv";

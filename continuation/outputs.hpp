@@ -7,6 +7,8 @@
 //                 (core::PeriodicOrbitProblem::initial_state_samples), for figures
 //   unknowns.csv  `point,index,value`: the point's unknowns x in the problem's own layout
 //                 (read_unknowns)
+//   multipliers.csv  `point,index,re,im,modulus,trivial`: the orbit's Floquet multipliers
+//                 (branch.hpp, multiplier_table), when the points carry them
 //   state.txt     `point state`: the loop's state after the point (restart.hpp, format_state;
 //                 `-` when the loop could not go on from it), what `trace --resume DIR` and
 //                 `--start DIR:K` continue from bit for bit (without it they correct the
@@ -68,7 +70,7 @@ class BranchWriter {
   struct File;
   std::filesystem::path out_;
   const core::PeriodicOrbitProblem* periodic_;
-  std::unique_ptr<File> branch_, orbits_, unknowns_, state_;
+  std::unique_ptr<File> branch_, orbits_, unknowns_, multipliers_, state_;
   int points_ = 0;
 };
 
@@ -93,6 +95,12 @@ void forget_saved_states(const std::filesystem::path& out);
 // The unknowns of point `point` (-1: the last one) of an unknowns.csv. InputError naming `key`
 // when the file cannot be read or has no such point.
 core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key);
+
+// The saved points before resumed's first (dir/unknowns.csv, their observables recomputed, and
+// their multipliers with floquet non-null), then resumed's own: the whole branch as the files
+// of a resumed run hold it.
+Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
+                    const Branch& resumed, const core::FloquetOptions* floquet);
 
 // What trace writes after the run: the problem's extra outputs (`extra`) and, with `detect`,
 // branch_points.csv. After a resume (`resumed`) the branch holds only the resumed points; both

@@ -63,6 +63,14 @@ po::options_description continuation_keys(const po::options_description& problem
       "(candidates; verify then keeps only the real directions)");
   add("verify", po::value<bool>()->default_value(true),
       "re-correct along candidate null directions (verified dimension)");
+  add("stability", po::value<bool>()->default_value(true),
+      "Floquet multipliers of every point when the problem gives its monodromy (branch.csv's "
+      "stable column, multipliers.csv), and the bifurcations of the orbits (bifurcations.csv)");
+  add("floquet_tolerance", po::value<double>()->default_value(1e-6),
+      "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1)");
+  add("floquet_trivial_tolerance", po::value<double>()->default_value(1e-4),
+      "the trivial multipliers (+1 by construction) must lie within this of +1, in (0, 0.5); "
+      "else the point's stability is undecided (-1)");
   add("detect_branch_points", po::value<bool>()->default_value(false),
       "arclength: evaluate the branch-point test function at every point, locate and verify "
       "candidates (trace writes branch_points.csv)");
@@ -155,6 +163,9 @@ RunSettings read_run_settings(const core::Scene& scene) {
   o.max_points = static_cast<int>(scene.integer("max_points", 1));
   o.rank_check_every = static_cast<int>(scene.integer("rank_check_every", 0));
   o.verify = scene.flag("verify");
+  o.stability = scene.flag("stability");
+  o.floquet.tolerance = scene.number("floquet_tolerance");
+  o.floquet.trivial_tolerance = scene.number("floquet_trivial_tolerance");
   o.rank.relative_threshold = scene.positive("rank_threshold");
   if (!(o.rank.relative_threshold < 1))
     throw core::InputError("rank_threshold",

@@ -9,6 +9,7 @@
 
 #include "continuation/branch.hpp"
 #include "continuation/branch_points/follow.hpp"
+#include "continuation/cli/stability_report.hpp"
 #include "continuation/cli/progress.hpp"
 #include "core/errors.hpp"
 #include "core/io/output_folder.hpp"
@@ -291,6 +292,13 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
       t.entry->units);
   continuation::write_after_run(t.out, t.problem(), branch, !t.resume.empty(),
                                 options.branch_points.detect, t.setup.write_extra_outputs);
+  if (options.stability) {
+    const continuation::Branch whole =
+        t.resume.empty() ? branch
+                         : continuation::whole_branch(t.out, t.problem(), branch, &options.floquet);
+    const auto corrector = core::make_corrector(t.run.newton, t.run.newton_options);
+    report_stability(t.problem(), whole, options.floquet, *corrector, t.out);
+  }
   for (const auto& f : continuation::follow_branch_points(
            t.problem(), branch, t.run.follow, *t.follow_corrector, options, hooks, t.out,
            t.setup.write_extra_outputs, t.entry->units)) {

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 
+#include "continuation/scaled_problem.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/stability/floquet.hpp"
 
 namespace backbone::continuation {
 
@@ -93,10 +95,19 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   const bool due = options_.rank_check_every > 0 && index % options_.rank_check_every == 0;
   if (due || (force_rank && options_.rank_check_every > 0))
     check_rank(p, curve_direction, previous);
+  add_floquet(p);
   p.residual_evaluations = counted_.counters().residuals - residuals_at_start_;
   p.jacobian_evaluations = counted_.counters().jacobians - jacobians_at_start_;
   p.seconds = elapsed_seconds();
   return p;
+}
+
+void PointRecorder::add_floquet(BranchPoint& point) const {
+  if (!options_.stability || !dynamic_cast<const core::FloquetProblem*>(&counted_)) return;
+  // The point's unknowns in the base's units (the loops record points in scaled unknowns).
+  const auto* scaled = dynamic_cast<const ScaledProblem*>(&problem_);
+  const core::Vector x = scaled ? scaled->to_unknowns(point.x) : point.x;
+  point.floquet = core::floquet_at(counted_, x, options_.floquet);
 }
 
 const Bound* PointRecorder::violated_bound(const BranchPoint& point, double& value) const {

@@ -53,6 +53,9 @@ class PointRecorder {
   void recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,
                          const core::Matrix* jacobian = nullptr,
                          const core::Vector* previous = nullptr);
+  // The point's multipliers (BranchPoint::floquet) when the problem is a core::FloquetProblem
+  // and options.stability holds.
+  void add_floquet(BranchPoint& point) const;
   // First bound the point violates, or nullptr; `value` receives the bound value crossed.
   const Bound* violated_bound(const BranchPoint& point, double& value) const;
   double elapsed_seconds() const;

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <memory>
+#include <vector>
 
 namespace backbone::core {
 
@@ -33,13 +34,25 @@ using VectorHandle = std::unique_ptr<std::remove_pointer_t<N_Vector>, VectorDele
 using SolverHandle = std::unique_ptr<std::remove_pointer_t<SUNNonlinearSolver>, SolverDeleter>;
 using CvodeHandle = std::unique_ptr<void, CvodeDeleter>;
 
+// What CVODE's user data points to: the right-hand side and, with events, the root functions.
+struct Callbacks {
+  const OdeRightHandSide* rhs = nullptr;
+  const OdeRootFunctions* roots = nullptr;
+};
+
 int rhs_trampoline(sunrealtype t, N_Vector y, N_Vector dy, void* user_data) {
-  const auto* f = static_cast<const OdeRightHandSide*>(user_data);
+  const auto* f = static_cast<const Callbacks*>(user_data)->rhs;
   (*f)(t, N_VGetArrayPointer(y), N_VGetArrayPointer(dy));
   const long n = N_VGetLength(dy);
   const double* d = N_VGetArrayPointer(dy);
   for (long i = 0; i < n; ++i)
     if (!std::isfinite(d[i])) return 1;  // recoverable: CVODE retries with a smaller step
+  return 0;
+}
+
+int root_trampoline(sunrealtype t, N_Vector y, sunrealtype* g, void* user_data) {
+  const auto* roots = static_cast<const Callbacks*>(user_data)->roots;
+  (*roots)(t, N_VGetArrayPointer(y), g);
   return 0;
 }
 
@@ -68,6 +81,7 @@ struct Workspace {
   CvodeHandle memory;
   SolverHandle fixed_point;
   sunindextype size = -1;
+  int roots = 0;  // root functions CVodeRootInit set up last
   void clear() {  // in the order the destructor would use
     fixed_point.reset();
     memory.reset();
@@ -75,6 +89,7 @@ struct Workspace {
     state.reset();
     context.reset();
     size = -1;
+    roots = 0;
   }
 };
 
@@ -102,15 +117,19 @@ std::string create_workspace(Workspace& w, sunindextype n) {
 
 }  // namespace
 
-IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t_end,
-                                const CvodeOptions& options) {
+namespace {
+
+// The calling thread's workspace for y's size, re-initialised at (t0, y) with the options and
+// the root functions (none: root finding off); empty message on success.
+std::string prepare(Workspace& workspace, const Vector& y, double t0, double t_end,
+                    const CvodeOptions& options, const Callbacks& callbacks,
+                    const std::vector<int>& directions) {
   const auto n = static_cast<sunindextype>(y.size());
-  thread_local Workspace workspace;
   if (workspace.size != n) {
     const std::string problem = create_workspace(workspace, n);
     if (!problem.empty()) {
       workspace.clear();
-      return {false, 0, problem};
+      return problem;
     }
   }
   void* mem = workspace.memory.get();
@@ -121,19 +140,47 @@ IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t
   else
     tolerance.setConstant(1e-3 * options.relative_tolerance);
 
-  int flag = CVodeReInit(mem, 0.0, workspace.state.get());
-  if (flag != CV_SUCCESS) return failure("CVodeReInit", flag);
-  flag = CVodeSetUserData(mem, const_cast<OdeRightHandSide*>(&rhs));
-  if (flag != CV_SUCCESS) return failure("CVodeSetUserData", flag);
+  int flag = CVodeReInit(mem, t0, workspace.state.get());
+  if (flag != CV_SUCCESS) return failure("CVodeReInit", flag).message;
+  flag = CVodeSetUserData(mem, const_cast<Callbacks*>(&callbacks));
+  if (flag != CV_SUCCESS) return failure("CVodeSetUserData", flag).message;
   flag = CVodeSVtolerances(mem, options.relative_tolerance, workspace.abs_tol.get());
-  if (flag != CV_SUCCESS) return failure("CVodeSVtolerances", flag);
+  if (flag != CV_SUCCESS) return failure("CVodeSVtolerances", flag).message;
   flag = CVodeSetMaxNumSteps(mem, options.max_steps);
-  if (flag != CV_SUCCESS) return failure("CVodeSetMaxNumSteps", flag);
+  if (flag != CV_SUCCESS) return failure("CVodeSetMaxNumSteps", flag).message;
+  flag = CVodeSetMaxStep(mem, options.max_step > 0 ? options.max_step : 0.0);
+  if (flag != CV_SUCCESS) return failure("CVodeSetMaxStep", flag).message;
   flag = CVodeSetStopTime(mem, t_end);
-  if (flag != CV_SUCCESS) return failure("CVodeSetStopTime", flag);
+  if (flag != CV_SUCCESS) return failure("CVodeSetStopTime", flag).message;
+  const int roots = static_cast<int>(directions.size());
+  if (roots > 0 || workspace.roots > 0) {
+    flag = CVodeRootInit(mem, roots, roots > 0 ? root_trampoline : nullptr);
+    if (flag != CV_SUCCESS) return failure("CVodeRootInit", flag).message;
+    workspace.roots = roots;
+  }
+  if (roots > 0) {
+    std::vector<int> copy = directions;
+    flag = CVodeSetRootDirection(mem, copy.data());
+    if (flag != CV_SUCCESS) return failure("CVodeSetRootDirection", flag).message;
+    // A root function that is zero at t0 (the state a reset left on its surface) is inactive
+    // until it leaves zero: that is the behaviour wanted, not a warning.
+    flag = CVodeSetNoInactiveRootWarn(mem);
+    if (flag != CV_SUCCESS) return failure("CVodeSetNoInactiveRootWarn", flag).message;
+  }
+  return {};
+}
 
+}  // namespace
+
+IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t_end,
+                                const CvodeOptions& options) {
+  thread_local Workspace workspace;
+  const Callbacks callbacks{&rhs, nullptr};
+  const std::string problem = prepare(workspace, y, 0.0, t_end, options, callbacks, {});
+  if (!problem.empty()) return {false, 0, problem};
+  void* mem = workspace.memory.get();
   sunrealtype t = 0;
-  flag = CVode(mem, t_end, workspace.state.get(), &t, CV_NORMAL);
+  const int flag = CVode(mem, t_end, workspace.state.get(), &t, CV_NORMAL);
   IntegrationResult result;
   long steps = 0;
   CVodeGetNumSteps(mem, &steps);
@@ -143,7 +190,41 @@ IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t
         fmt::format("cvode: CVode failed at t = {} of {} ({})", t, t_end, flag_name(flag));
     return result;
   }
-  y = Eigen::Map<Vector>(N_VGetArrayPointer(workspace.state.get()), n);
+  y = Eigen::Map<Vector>(N_VGetArrayPointer(workspace.state.get()), y.size());
+  result.ok = true;
+  return result;
+}
+
+SegmentResult integrate_to_event(const OdeRightHandSide& rhs, const OdeRootFunctions& roots,
+                                 const std::vector<int>& directions, Vector& y, double t0,
+                                 double t_end, const CvodeOptions& options) {
+  thread_local Workspace workspace;
+  const Callbacks callbacks{&rhs, &roots};
+  SegmentResult result;
+  const std::string problem = prepare(workspace, y, t0, t_end, options, callbacks, directions);
+  if (!problem.empty()) {
+    result.message = problem;
+    return result;
+  }
+  void* mem = workspace.memory.get();
+  sunrealtype t = t0;
+  const int flag = CVode(mem, t_end, workspace.state.get(), &t, CV_NORMAL);
+  long steps = 0;
+  CVodeGetNumSteps(mem, &steps);
+  result.steps = steps;
+  result.t = t;
+  if (flag < 0) {
+    result.message =
+        fmt::format("cvode: CVode failed at t = {} of {} ({})", t, t_end, flag_name(flag));
+    return result;
+  }
+  y = Eigen::Map<Vector>(N_VGetArrayPointer(workspace.state.get()), y.size());
+  if (flag == CV_ROOT_RETURN) {
+    std::vector<int> found(directions.size(), 0);
+    CVodeGetRootInfo(mem, found.data());
+    for (std::size_t k = 0; k < found.size(); ++k)
+      if (found[k] != 0) result.roots.push_back(static_cast<int>(k));
+  }
   result.ok = true;
   return result;
 }

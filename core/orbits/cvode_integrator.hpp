@@ -20,6 +20,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "core/types.hpp"
 
@@ -29,6 +30,7 @@ struct CvodeOptions {
   double relative_tolerance = 1e-13;
   Vector absolute_tolerance;  // one per component; empty: 1e-3 * relative_tolerance each
   long max_steps = 1000000;
+  double max_step = 0;  // largest step size; 0: no limit
 };
 
 struct IntegrationResult {
@@ -43,5 +45,25 @@ using OdeRightHandSide = std::function<void(double t, const double* y, double* d
 // Integrates from t = 0 to t_end > 0; y holds the initial state on entry, y(t_end) on return.
 IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t_end,
                                 const CvodeOptions& options);
+
+// Root functions g_k(t, y), k < directions.size(), written into g.
+using OdeRootFunctions = std::function<void(double t, const double* y, double* g)>;
+
+struct SegmentResult : IntegrationResult {
+  double t = 0;           // where the segment ended: t_end, or the first root found
+  std::vector<int> roots;  // the root functions that vanished at t (empty: t = t_end)
+};
+
+// Integrates from t0 to t_end > t0 with CVODE's root finding on g (directions[k]: +1 only
+// rising zeros of g_k, -1 only falling ones, 0 both), stopping at the first root: y holds y(t),
+// t the root, roots which functions vanished there. A function that is zero at t0 is not reported
+// until it has left zero. CVODE finds a zero by a change of sign over a step, or a value of
+// exactly 0 at a step's end: a zero at t_end is reported (t = t_end, roots not empty), while a
+// zero the solution touches without crossing, or crosses twice within one step, is not; callers
+// that must not lose one add the derivative of g_k as a root function of its own (its zero is the
+// extremum between the two crossings; hybrid_orbit.cpp).
+SegmentResult integrate_to_event(const OdeRightHandSide& rhs, const OdeRootFunctions& roots,
+                                 const std::vector<int>& directions, Vector& y, double t0,
+                                 double t_end, const CvodeOptions& options);
 
 }  // namespace backbone::core

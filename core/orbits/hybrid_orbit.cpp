@@ -1,0 +1,473 @@
+#include "core/orbits/hybrid_orbit.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/errors.hpp"
+#include "core/orbits/cvode_integrator.hpp"
+
+namespace backbone::core {
+
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// Central-difference step for a value z: cbrt(eps) max(|z|, 1), rounded so that z + h is exact.
+double central_step(double z) {
+  const double h0 = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max(std::abs(z), 1.0);
+  volatile double moved = z + h0;
+  return moved - z;
+}
+
+// A segment is integrated again with steps below (time to the lost crossing) / this, at most
+// max_redo times, before the shot is refused.
+constexpr double redo_divisor = 8;
+constexpr int max_redo = 12;
+
+HybridShot failed(HybridShot::Failure why, std::string message) {
+  HybridShot s;
+  s.failure = why;
+  s.message = std::move(message);
+  return s;
+}
+
+}  // namespace
+
+void HybridOrbitOptions::validate() const {
+  if (!(relative_tolerance > 0 && relative_tolerance < 1e-3))
+    throw InputError("rtol", fmt::format("must be in (0, 1e-3) (got {})", relative_tolerance));
+  if (!(max_steps > 0))
+    throw InputError("max_steps", fmt::format("must be > 0 (got {})", max_steps));
+  if (!(max_events > 0 && max_events <= 1000000))
+    throw InputError("max_events", fmt::format("must be in [1, 1e6] (got {})", max_events));
+}
+
+HybridOrbitProblem::HybridOrbitProblem(int n, std::vector<std::string> parameter_names,
+                                       HybridOrbitOptions options)
+    : n_(n), names_(std::move(parameter_names)), options_(options) {
+  if (n < 1) throw InputError("dimension", fmt::format("must be >= 1 (got {})", n));
+  if (names_.empty()) throw InputError("parameters", "a hybrid orbit problem needs a parameter");
+  parameters_ = Vector::Zero(static_cast<Eigen::Index>(names_.size()));
+  options_.validate();
+}
+
+void HybridOrbitProblem::field_jacobian(double t, const double* y, const Vector& p,
+                                        Matrix& J) const {
+  J.resize(n_, n_);
+  Vector shifted = Eigen::Map<const Vector>(y, n_), plus(n_), minus(n_);
+  for (int j = 0; j < n_; ++j) {
+    const double h = central_step(y[j]);
+    shifted[j] = y[j] + h;
+    field(t, shifted.data(), p, plus.data());
+    shifted[j] = y[j] - h;
+    field(t, shifted.data(), p, minus.data());
+    shifted[j] = y[j];
+    J.col(j) = (plus - minus) / (2 * h);
+  }
+}
+
+void HybridOrbitProblem::reset(int, const double* y, const Vector&, double* y_plus) const {
+  std::copy(y, y + n_, y_plus);
+}
+
+double HybridOrbitProblem::phase_condition(const double* y0, const Vector& p) const {
+  Vector f(n_);
+  field(0.0, y0, p, f.data());
+  return f[0];
+}
+
+FloquetStructure HybridOrbitProblem::floquet_structure() const {
+  return {forced() ? 0 : 1, false};
+}
+
+std::vector<std::string> HybridOrbitProblem::grazing_observables() const {
+  return num_events() > 0 ? std::vector<std::string>{event_speed_name()}
+                          : std::vector<std::string>{};
+}
+
+void HybridOrbitProblem::set_parameter(const std::string& name, double value) {
+  const auto it = std::find(names_.begin(), names_.end(), name);
+  if (it == names_.end())
+    throw InputError(name, fmt::format("is not a parameter of {} (its parameters: {})", this->name(),
+                                       fmt::join(names_, ", ")));
+  if (!std::isfinite(value)) throw InputError(name, fmt::format("must be finite (got {})", value));
+  parameters_[it - names_.begin()] = value;
+  forget_last_shot();
+}
+
+void HybridOrbitProblem::set_free_parameter(const std::string& name) {
+  const auto it = std::find(names_.begin(), names_.end(), name);
+  if (it == names_.end())
+    throw InputError("continuation_parameter",
+                     fmt::format("'{}' is not a parameter of {} (its parameters: {})", name,
+                                 this->name(), fmt::join(names_, ", ")));
+  free_ = static_cast<int>(it - names_.begin());
+  forget_last_shot();
+}
+
+void HybridOrbitProblem::set_forcing_periods(int m) {
+  if (!(m >= 1 && m <= 64))
+    throw InputError("forcing_periods", fmt::format("must be in [1, 64] (got {})", m));
+  periods_ = m;
+  forget_last_shot();
+}
+
+int HybridOrbitProblem::num_unknowns() const {
+  return n_ + (forced() ? 0 : 1) + 1;
+}
+
+int HybridOrbitProblem::num_equations() const {
+  return n_ + (forced() ? 0 : 1);
+}
+
+Vector HybridOrbitProblem::parameters_at(const Vector& x) const {
+  Vector p = parameters_;
+  p[free_] = x[x.size() - 1];
+  return p;
+}
+
+double HybridOrbitProblem::period_at(const Vector& x) const {
+  return forced() ? periods_ * forcing_period(parameters_at(x)) : x[n_];
+}
+
+void HybridOrbitProblem::event_gradient(int k, double t, const Vector& y, const Vector& p,
+                                        Vector& n, double& dh_dt) const {
+  n.resize(n_);
+  Vector shifted = y;
+  for (int j = 0; j < n_; ++j) {
+    const double h = central_step(y[j]);
+    shifted[j] = y[j] + h;
+    const double plus = event(k, t, shifted.data(), p);
+    shifted[j] = y[j] - h;
+    const double minus = event(k, t, shifted.data(), p);
+    shifted[j] = y[j];
+    n[j] = (plus - minus) / (2 * h);
+  }
+  const double h = central_step(t);
+  dh_dt = (event(k, t + h, y.data(), p) - event(k, t - h, y.data(), p)) / (2 * h);
+}
+
+HybridShot HybridOrbitProblem::shoot(const Vector& x) const {
+  {
+    const std::lock_guard<std::mutex> lock(last_mutex_);
+    if (last_x_.size() == x.size() && last_x_ == x) return last_shot_;
+  }
+  HybridShot shot = shoot_uncached(x, -1);
+  const std::lock_guard<std::mutex> lock(last_mutex_);
+  last_x_ = x;
+  last_shot_ = shot;
+  return shot;
+}
+
+void HybridOrbitProblem::forget_last_shot() const {
+  const std::lock_guard<std::mutex> lock(last_mutex_);
+  last_x_.resize(0);
+}
+
+HybridShot HybridOrbitProblem::shoot_without(const Vector& x, int suppressed) const {
+  return shoot_uncached(x, suppressed);
+}
+
+HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, int suppressed) const {
+  const int n = n_, K = num_events();
+  if (x.size() != num_unknowns() || !x.allFinite())
+    return failed(HybridShot::Failure::period, "the unknowns are not finite");
+  const Vector p = parameters_at(x);
+  const double T = period_at(x);
+  if (!(T > 0) || !std::isfinite(T))
+    return failed(HybridShot::Failure::period,
+                  fmt::format("the period is not finite and > 0 (got {})", T));
+  const int free = free_;
+  const double dp = central_step(p[free]);
+  Vector p_plus = p, p_minus = p;
+  p_plus[free] += dp;
+  p_minus[free] -= dp;
+
+  // Y = [y | Phi (column-major) | psi].
+  const int size = n + n * n + n;
+  Vector Y = Vector::Zero(size);
+  Y.head(n) = x.head(n);
+  Eigen::Map<Matrix>(Y.data() + n, n, n).setIdentity();
+  CvodeOptions cvode;
+  cvode.relative_tolerance = options_.relative_tolerance;
+  cvode.max_steps = options_.max_steps;
+  cvode.absolute_tolerance = Vector::Constant(size, 1e-3 * options_.relative_tolerance);
+  const double amplitude = std::max(x.head(n).lpNorm<Eigen::Infinity>(), 1e-300);
+  cvode.absolute_tolerance.head(n).setConstant(1e-3 * options_.relative_tolerance * amplitude);
+
+  // Each right-hand side call works in its own copies (concurrent shots share nothing).
+  const OdeRightHandSide rhs = [this, n, p, p_plus, p_minus, dp, A = Matrix(n, n),
+                                fp = Vector(n), fm = Vector(n)](double t, const double* s,
+                                                               double* ds) mutable {
+    field(t, s, p, ds);
+    field_jacobian(t, s, p, A);
+    const Eigen::Map<const Matrix> Phi(s + n, n, n);
+    const Eigen::Map<const Vector> psi(s + n + n * n, n);
+    Eigen::Map<Matrix>(ds + n, n, n).noalias() = A * Phi;
+    field(t, s, p_plus, fp.data());
+    field(t, s, p_minus, fm.data());
+    Eigen::Map<Vector>(ds + n + n * n, n).noalias() = A * psi + (fp - fm) / (2 * dp);
+  };
+  // Roots 0..K-1: the events; K..2K-1: their companions, dh/dt along the flow (header).
+  const double time_step = central_step(T);
+  const OdeRootFunctions roots = [this, n, K, p, time_step, suppressed, f = Vector(n), ahead = Vector(n),
+                                  behind = Vector(n)](double t, const double* s,
+                                                      double* g) mutable {
+    field(t, s, p, f.data());
+    const Eigen::Map<const Vector> y(s, n);
+    ahead = y + time_step * f;
+    behind = y - time_step * f;
+    for (int k = 0; k < K; ++k) {
+      // A switched-off event never vanishes.
+      g[k] = k == suppressed ? 1.0 : event(k, t, s, p);
+      g[K + k] = (event(k, t + time_step, ahead.data(), p) -
+                  event(k, t - time_step, behind.data(), p)) /
+                 (2 * time_step);
+    }
+  };
+  std::vector<int> directions(2 * K);
+  for (int k = 0; k < K; ++k) {
+    directions[k] = event_direction(k);
+    directions[K + k] = -event_direction(k);
+  }
+
+  HybridShot shot;
+  shot.period = T;
+  shot.extremum.assign(K, -std::numeric_limits<double>::infinity());
+  double t = 0;
+  int redo = 0;
+  Vector f_minus(n), f_plus(n), normal, y_plus(n), g_plus(n), g_minus(n), shifted(n);
+  Matrix G(n, n);
+  while (true) {
+    const Vector start = Y;
+    const double t_start = t;
+    const SegmentResult seg = integrate_to_event(rhs, roots, directions, Y, t, T, cvode);
+    if (!seg.ok) return failed(HybridShot::Failure::integration, seg.message);
+    t = seg.t;
+    if (seg.roots.empty()) break;
+    // An extremum of h_k on the far side of its surface: a crossing was stepped over.
+    bool lost = false;
+    for (int r : seg.roots) {
+      if (r < K) continue;
+      const int k = r - K;
+      const double h = event(k, t, Y.data(), p), h0 = event(k, t_start, start.data(), p);
+      const int dir = event_direction(k);
+      if (k == suppressed) continue;
+      if ((dir > 0 && h > 0) || (dir < 0 && h < 0) || (dir == 0 && h * h0 < 0)) lost = true;
+    }
+    if (lost) {
+      if (++redo > max_redo)
+        return failed(HybridShot::Failure::lost_event,
+                      fmt::format("an event crossed twice within a step near t = {}", t));
+      Y = start;
+      cvode.max_step = (t - t_start) / redo_divisor;
+      t = t_start;
+      continue;
+    }
+    cvode.max_step = 0;
+    for (int r : seg.roots) {
+      if (r < K) continue;
+      const int k = r - K;
+      const double signed_h = (event_direction(k) < 0 ? -1.0 : 1.0) * event(k, t, Y.data(), p);
+      shot.extremum[k] = std::max(shot.extremum[k], signed_h);
+    }
+    for (int r : seg.roots) {
+      if (r >= K) continue;
+      const int k = r;
+      if (static_cast<int>(shot.events.size()) >= options_.max_events)
+        return failed(HybridShot::Failure::too_many_events,
+                      fmt::format("more than {} events in a period (max_events)",
+                                  options_.max_events));
+      const Vector y_minus = Y.head(n);
+      field(t, y_minus.data(), p, f_minus.data());
+      double dh_dt = 0;
+      event_gradient(k, t, y_minus, p, normal, dh_dt);
+      const double D = dh_dt + normal.dot(f_minus);
+      const double speed = std::abs(D) / std::max(normal.norm(), 1e-300);
+      if (!(speed > 0) || !std::isfinite(speed))
+        return failed(HybridShot::Failure::grazing,
+                      fmt::format("event {} is met tangentially at t = {} (grazing)", k, t));
+      reset(k, y_minus.data(), p, y_plus.data());
+      if (!y_plus.allFinite())
+        return failed(HybridShot::Failure::reset,
+                      fmt::format("reset {} returned NaN or Inf at t = {}", k, t));
+      // G = dg/dy and g_p, h_p by central differences.
+      shifted = y_minus;
+      for (int j = 0; j < n; ++j) {
+        const double h = central_step(y_minus[j]);
+        shifted[j] = y_minus[j] + h;
+        reset(k, shifted.data(), p, g_plus.data());
+        shifted[j] = y_minus[j] - h;
+        reset(k, shifted.data(), p, g_minus.data());
+        shifted[j] = y_minus[j];
+        G.col(j) = (g_plus - g_minus) / (2 * h);
+      }
+      reset(k, y_minus.data(), p_plus, g_plus.data());
+      reset(k, y_minus.data(), p_minus, g_minus.data());
+      const Vector g_p = (g_plus - g_minus) / (2 * dp);
+      const double h_p =
+          (event(k, t, y_minus.data(), p_plus) - event(k, t, y_minus.data(), p_minus)) / (2 * dp);
+      field(t, y_plus.data(), p, f_plus.data());
+      const Vector w = f_plus - G * f_minus;
+      const Matrix S = G + w * normal.transpose() / D;
+      Eigen::Map<Matrix> Phi(Y.data() + n, n, n);
+      Eigen::Map<Vector> psi(Y.data() + n + n * n, n);
+      Phi = (S * Phi).eval();
+      psi = (S * psi + g_p + w * (h_p / D)).eval();
+      Y.head(n) = y_plus;
+      shot.events.push_back({k, t, y_minus, y_plus, speed});
+    }
+    if (!(t < T)) break;
+  }
+  shot.end = Y.head(n);
+  shot.monodromy = Eigen::Map<const Matrix>(Y.data() + n, n, n);
+  shot.parameter_column = Y.tail(n);
+  shot.ok = shot.end.allFinite() && shot.monodromy.allFinite();
+  if (!shot.ok) return failed(HybridShot::Failure::integration, "the orbit became NaN or Inf");
+  return shot;
+}
+
+EvalStatus HybridOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
+  const HybridShot shot = shoot(x);
+  if (!shot.ok) return EvalStatus::failed;
+  r.resize(num_equations());
+  r.head(n_) = shot.end - x.head(n_);
+  if (!forced()) r[n_] = phase_condition(x.data(), parameters_at(x));
+  return EvalStatus::ok;
+}
+
+EvalStatus HybridOrbitProblem::compute_jacobian(const Vector& x, Matrix& J) const {
+  const HybridShot shot = shoot(x);
+  if (!shot.ok) return EvalStatus::failed;
+  const int n = n_;
+  const Vector p = parameters_at(x);
+  J = Matrix::Zero(num_equations(), num_unknowns());
+  J.topLeftCorner(n, n) = shot.monodromy - Matrix::Identity(n, n);
+  Vector f_end(n);
+  field(shot.period, shot.end.data(), p, f_end.data());
+  const int last = num_unknowns() - 1;
+  if (forced()) {
+    // y(T(p); p): the period moves with the parameter when the forcing does.
+    const double h = central_step(p[free_]);
+    Vector plus = p, minus = p;
+    plus[free_] += h;
+    minus[free_] -= h;
+    const double dT_dp = periods_ * (forcing_period(plus) - forcing_period(minus)) / (2 * h);
+    J.col(last) = shot.parameter_column + f_end * dT_dp;
+    return EvalStatus::ok;
+  }
+  J.block(0, n, n, 1) = f_end;
+  J.block(0, last, n, 1) = shot.parameter_column;
+  Vector y = x.head(n);
+  for (int j = 0; j < n; ++j) {
+    const double h = central_step(y[j]);
+    y[j] = x[j] + h;
+    const double plus = phase_condition(y.data(), p);
+    y[j] = x[j] - h;
+    const double minus = phase_condition(y.data(), p);
+    y[j] = x[j];
+    J(n, j) = (plus - minus) / (2 * h);
+  }
+  const double h = central_step(p[free_]);
+  Vector plus = p, minus = p;
+  plus[free_] += h;
+  minus[free_] -= h;
+  J(n, last) = (phase_condition(y.data(), plus) - phase_condition(y.data(), minus)) / (2 * h);
+  return EvalStatus::ok;
+}
+
+EvalStatus HybridOrbitProblem::monodromy(const Vector& x, Matrix& M) const {
+  const HybridShot shot = shoot(x);
+  if (!shot.ok) return EvalStatus::failed;
+  M = shot.monodromy;
+  return EvalStatus::ok;
+}
+
+Observables HybridOrbitProblem::observables(const Vector& x) const {
+  Observables o;
+  o.emplace_back("period", period_at(x));
+  const Vector p = parameters_at(x);
+  for (std::size_t i = 0; i < names_.size(); ++i) o.emplace_back(names_[i], p[i]);
+  const HybridShot shot = shoot(x);
+  double speed = nan;
+  for (const HybridEvent& e : shot.events) speed = std::isnan(speed) ? e.speed : std::min(speed, e.speed);
+  o.emplace_back(event_count_name(), shot.ok ? static_cast<double>(shot.events.size()) : nan);
+  o.emplace_back(event_speed_name(), shot.ok ? speed : nan);
+  return o;
+}
+
+void HybridOrbitProblem::check_guess(const Vector& x) const {
+  if (x.size() != num_unknowns())
+    throw InputError("guess", fmt::format("has {} entries for {} unknowns", x.size(),
+                                          num_unknowns()));
+  if (!x.allFinite()) throw InputError("guess", "contains NaN or Inf");
+  const Vector p = parameters_at(x);
+  if (forced()) {
+    const double T = forcing_period(p);
+    if (!(T > 0) || !std::isfinite(T))
+      throw InputError("forcing_period",
+                       fmt::format("must be finite and > 0 (got {} at the guess)", T));
+  } else if (!(x[n_] > 0) || !std::isfinite(x[n_])) {
+    throw InputError("period", fmt::format("must be finite and > 0 (got {})", x[n_]));
+  }
+  const HybridShot shot = shoot(x);
+  if (shot.failure == HybridShot::Failure::reset) throw InputError("reset", shot.message);
+  if (shot.failure == HybridShot::Failure::integration)
+    throw InputError("field", fmt::format("the guess's orbit cannot be integrated: {}",
+                                          shot.message));
+  if (!shot.ok) return;  // a numerical failure: the corrector may still move off it
+  for (int k = 0; k < num_events(); ++k) {
+    if (!event_required(k)) continue;
+    const bool fired = std::any_of(shot.events.begin(), shot.events.end(),
+                                   [k](const HybridEvent& e) { return e.which == k; });
+    if (!fired)
+      throw InputError("event", fmt::format("event {} never fires over the guess's period {} "
+                                            "(the orbit from the guess does not reach its "
+                                            "surface)",
+                                            k, shot.period));
+  }
+}
+
+std::unique_ptr<Problem> HybridOrbitProblem::grazing_problem(const std::string& observable,
+                                                             const Vector& x) const {
+  if (observable != event_speed_name() || num_events() == 0) return nullptr;
+  const HybridShot shot = shoot(x);
+  if (!shot.ok || shot.events.empty()) return nullptr;
+  const auto slowest = std::min_element(
+      shot.events.begin(), shot.events.end(),
+      [](const HybridEvent& a, const HybridEvent& b) { return a.speed < b.speed; });
+  return std::make_unique<GrazingOrbitProblem>(*this, slowest->which);
+}
+
+GrazingOrbitProblem::GrazingOrbitProblem(const HybridOrbitProblem& base, int event)
+    : base_(base), event_(event) {}
+
+EvalStatus GrazingOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
+  const HybridShot shot = base_.shoot_without(x, event_);
+  if (!shot.ok || !std::isfinite(shot.extremum[event_])) return EvalStatus::failed;
+  const int n = base_.state_size();
+  r.resize(num_equations());
+  r.head(n) = shot.end - x.head(n);
+  if (!base_.forced()) r[n] = base_.phase_condition(x.data(), base_.parameters_at(x));
+  r[num_equations() - 1] = shot.extremum[event_];
+  return EvalStatus::ok;
+}
+
+Observables GrazingOrbitProblem::observables(const Vector& x) const {
+  const HybridShot shot = base_.shoot_without(x, event_);
+  Observables o;
+  o.emplace_back("period", base_.period_at(x));
+  const Vector p = base_.parameters_at(x);
+  for (std::size_t i = 0; i < base_.parameter_names().size(); ++i)
+    o.emplace_back(base_.parameter_names()[i], p[static_cast<Eigen::Index>(i)]);
+  o.emplace_back(base_.event_count_name(),
+                 shot.ok ? static_cast<double>(shot.events.size() + 1) : nan);
+  o.emplace_back(base_.event_speed_name(), 0.0);
+  return o;
+}
+
+}  // namespace backbone::core
