@@ -30,6 +30,11 @@ FollowSelection parse_follow(const std::string& text) {
   if (text == "none") return s;
   if (text == "all") {
     s.kind = FollowSelection::Kind::all;
+    s.doublings = true;
+    return s;
+  }
+  if (text == "doubling") {
+    s.doublings = true;
     return s;
   }
   try {
@@ -44,7 +49,8 @@ FollowSelection parse_follow(const std::string& text) {
   }
   throw core::InputError(
       "follow",
-      fmt::format("must be none, all or a row K >= 1 of branch_points.csv (got '{}')", text));
+      fmt::format("must be none, all, doubling or a row K >= 1 of branch_points.csv (got '{}')",
+                  text));
 }
 
 std::optional<AttachedStart> attached_start(const core::Problem& problem,

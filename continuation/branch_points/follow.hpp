@@ -44,11 +44,14 @@ struct FollowSelection {
   enum class Kind { none, all, one };
   Kind kind = Kind::none;
   int k = 0;  // with Kind::one
+  // Also switch at every period doubling of the orbits (bifurcations.csv; "all" or "doubling",
+  // the latter without branch points).
+  bool doublings = false;
   bool selects(int one_based) const {
     return kind == Kind::all || (kind == Kind::one && one_based == k);
   }
 };
-// "none", "all" or a positive integer; InputError naming `follow` otherwise.
+// "none", "all", "doubling" or a positive integer; InputError naming `follow` otherwise.
 FollowSelection parse_follow(const std::string& text);
 
 // Where a followed branch starts: the guess (unknowns), the direction hint, the probe chosen.

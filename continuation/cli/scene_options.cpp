@@ -78,9 +78,11 @@ po::options_description continuation_keys(const po::options_description& problem
       "locate and verify branch-point candidates on a second thread while the trace goes on "
       "(problems with core::Problem::clone; the same rows either way)");
   add("follow", po::value<std::string>()->default_value("none"),
-      "arclength: none, all or K: switch onto the family attached at every verified (or the K-th, "
-      "1-based row of branch_points.csv) branch point and trace it towards growing energy into "
-      "DIR/branch_point_K/ (implies detect_branch_points)");
+      "arclength: none, all, doubling or K: switch onto the family attached at every verified "
+      "(or the K-th, 1-based row of branch_points.csv) branch point and trace it towards growing "
+      "energy into DIR/branch_point_K/ (implies detect_branch_points); all and doubling also "
+      "switch at every period doubling of the orbits onto the branch of twice the period, into "
+      "DIR/period_doubling_K/");
   add("follow_max_points", po::value<long>()->default_value(30),
       "points of each followed branch (>= 1; with the energy bound)");
   add("max_turn_degrees", po::value<double>()->default_value(20),

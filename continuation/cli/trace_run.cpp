@@ -10,6 +10,7 @@
 #include "continuation/branch.hpp"
 #include "continuation/branch_points/follow.hpp"
 #include "continuation/cli/stability_report.hpp"
+#include "continuation/orbit_bifurcations/doubling.hpp"
 #include "continuation/cli/progress.hpp"
 #include "core/errors.hpp"
 #include "core/io/output_folder.hpp"
@@ -264,6 +265,42 @@ void TraceReport::on_point(const continuation::BranchPoint& p) {
   progress_.update(p);
 }
 
+namespace {
+
+// Every period doubling of `found` followed onto the branch of twice the period, into
+// out/period_doubling_K/ (K: 1-based among the period doublings), with its own stability.
+bool follow_doublings(TraceRun& t, const std::vector<continuation::OrbitBifurcation>& found,
+                      core::Corrector& corrector, const continuation::ContinuationHooks& hooks) {
+  bool complete = true;
+  int k = 0;
+  for (const continuation::OrbitBifurcation& b : found) {
+    if (b.type != "period_doubling") continue;
+    const std::filesystem::path dir = t.out / fmt::format("period_doubling_{}", ++k);
+    std::filesystem::remove_all(dir);
+    continuation::ContinuationOptions o = t.options();
+    o.max_points = t.run.follow.max_points;
+    std::unique_ptr<continuation::BranchWriter> writer;
+    continuation::ContinuationHooks h = hooks;
+    h.on_point = [&](const continuation::BranchPoint& p) {
+      if (!writer) writer = std::make_unique<continuation::BranchWriter>(dir, nullptr);
+      writer->append(p);
+    };
+    const continuation::DoubledBranch d =
+        continuation::follow_period_doubling(t.problem(), b, corrector, o, h);
+    fmt::print("  followed period doubling {}: {} points ({})\n", k, d.branch.points.size(),
+               d.message);
+    if (d.branch.points.empty() || d.branch.ended_early()) complete = false;
+    if (d.branch.points.empty()) continue;
+    continuation::plot_branch(dir, core::Table::read_csv(dir / "branch.csv"),
+                              fmt::format("{} / period doubling {}", t.entry->name, k),
+                              t.entry->units);
+    report_stability(*d.problem, d.branch, o.floquet, corrector, dir);
+  }
+  return complete;
+}
+
+}  // namespace
+
 bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
                               const continuation::ContinuationHooks& hooks) {
   bool followed_complete = true;
@@ -297,7 +334,9 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
         t.resume.empty() ? branch
                          : continuation::whole_branch(t.out, t.problem(), branch, &options.floquet);
     const auto corrector = core::make_corrector(t.run.newton, t.run.newton_options);
-    report_stability(t.problem(), whole, options.floquet, *corrector, t.out);
+    const auto found = report_stability(t.problem(), whole, options.floquet, *corrector, t.out);
+    if (selection.doublings)
+      followed_complete = follow_doublings(t, found, *corrector, hooks) && followed_complete;
   }
   for (const auto& f : continuation::follow_branch_points(
            t.problem(), branch, t.run.follow, *t.follow_corrector, options, hooks, t.out,

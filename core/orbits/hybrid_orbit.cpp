@@ -55,6 +55,29 @@ HybridOrbitProblem::HybridOrbitProblem(int n, std::vector<std::string> parameter
   options_.validate();
 }
 
+HybridOrbitProblem::HybridOrbitProblem(const HybridOrbitProblem& other)
+    : Problem(other),
+      n_(other.n_),
+      names_(other.names_),
+      parameters_(other.parameters_),
+      free_(other.free_),
+      periods_(other.periods_),
+      options_(other.options_) {}
+
+std::unique_ptr<Problem> HybridOrbitProblem::doubled_problem() const {
+  std::unique_ptr<Problem> copy = clone();
+  auto* hybrid = dynamic_cast<HybridOrbitProblem*>(copy.get());
+  if (!hybrid) return nullptr;
+  if (forced()) hybrid->set_forcing_periods(2 * periods_);
+  return copy;
+}
+
+Vector HybridOrbitProblem::doubled_unknowns(const Vector& x) const {
+  Vector doubled = x;
+  if (!forced()) doubled[n_] *= 2;
+  return doubled;
+}
+
 void HybridOrbitProblem::field_jacobian(double t, const double* y, const Vector& p,
                                         Matrix& J) const {
   J.resize(n_, n_);
@@ -85,7 +108,7 @@ FloquetStructure HybridOrbitProblem::floquet_structure() const {
 }
 
 std::vector<std::string> HybridOrbitProblem::grazing_observables() const {
-  return num_events() > 0 ? std::vector<std::string>{event_speed_name()}
+  return num_events() > 0 ? std::vector<std::string>{event_speed_name(), event_gap_name()}
                           : std::vector<std::string>{};
 }
 
@@ -156,7 +179,7 @@ HybridShot HybridOrbitProblem::shoot(const Vector& x) const {
     const std::lock_guard<std::mutex> lock(last_mutex_);
     if (last_x_.size() == x.size() && last_x_ == x) return last_shot_;
   }
-  HybridShot shot = shoot_uncached(x, -1);
+  HybridShot shot = shoot_uncached(x, {});
   const std::lock_guard<std::mutex> lock(last_mutex_);
   last_x_ = x;
   last_shot_ = shot;
@@ -168,11 +191,18 @@ void HybridOrbitProblem::forget_last_shot() const {
   last_x_.resize(0);
 }
 
-HybridShot HybridOrbitProblem::shoot_without(const Vector& x, int suppressed) const {
+bool HybridOrbitProblem::Suppression::covers(int k, double t, double period) const {
+  if (k != event) return false;
+  for (const double s : {t, t + period, t - period})
+    if (s >= from && s <= to) return true;
+  return false;
+}
+
+HybridShot HybridOrbitProblem::shoot_without(const Vector& x, const Suppression& suppressed) const {
   return shoot_uncached(x, suppressed);
 }
 
-HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, int suppressed) const {
+HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, const Suppression& suppressed) const {
   const int n = n_, K = num_events();
   if (x.size() != num_unknowns() || !x.allFinite())
     return failed(HybridShot::Failure::period, "the unknowns are not finite");
@@ -214,7 +244,7 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, int suppressed) c
   };
   // Roots 0..K-1: the events; K..2K-1: their companions, dh/dt along the flow (header).
   const double time_step = central_step(T);
-  const OdeRootFunctions roots = [this, n, K, p, time_step, suppressed, f = Vector(n), ahead = Vector(n),
+  const OdeRootFunctions roots = [this, n, K, p, T, time_step, suppressed, f = Vector(n), ahead = Vector(n),
                                   behind = Vector(n)](double t, const double* s,
                                                       double* g) mutable {
     field(t, s, p, f.data());
@@ -222,8 +252,10 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, int suppressed) c
     ahead = y + time_step * f;
     behind = y - time_step * f;
     for (int k = 0; k < K; ++k) {
-      // A switched-off event never vanishes.
-      g[k] = k == suppressed ? 1.0 : event(k, t, s, p);
+      // A switched-off event stays on its near side (no change of sign at the window's ends,
+      // where the orbit is away from the surface).
+      g[k] = suppressed.covers(k, t, T) ? -(event_direction(k) < 0 ? -1.0 : 1.0)
+                                        : event(k, t, s, p);
       g[K + k] = (event(k, t + time_step, ahead.data(), p) -
                   event(k, t - time_step, behind.data(), p)) /
                  (2 * time_step);
@@ -238,6 +270,7 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, int suppressed) c
   HybridShot shot;
   shot.period = T;
   shot.extremum.assign(K, -std::numeric_limits<double>::infinity());
+  shot.extremum_time.assign(K, nan);
   double t = 0;
   int redo = 0;
   Vector f_minus(n), f_plus(n), normal, y_plus(n), g_plus(n), g_minus(n), shifted(n);
@@ -256,7 +289,7 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, int suppressed) c
       const int k = r - K;
       const double h = event(k, t, Y.data(), p), h0 = event(k, t_start, start.data(), p);
       const int dir = event_direction(k);
-      if (k == suppressed) continue;
+      if (suppressed.covers(k, t, T)) continue;
       if ((dir > 0 && h > 0) || (dir < 0 && h < 0) || (dir == 0 && h * h0 < 0)) lost = true;
     }
     if (lost) {
@@ -273,7 +306,10 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, int suppressed) c
       if (r < K) continue;
       const int k = r - K;
       const double signed_h = (event_direction(k) < 0 ? -1.0 : 1.0) * event(k, t, Y.data(), p);
-      shot.extremum[k] = std::max(shot.extremum[k], signed_h);
+      if ((suppressed.event < 0 || suppressed.covers(k, t, T)) && signed_h > shot.extremum[k]) {
+        shot.extremum[k] = signed_h;
+        shot.extremum_time[k] = t;
+      }
     }
     for (int r : seg.roots) {
       if (r >= K) continue;
@@ -397,6 +433,10 @@ Observables HybridOrbitProblem::observables(const Vector& x) const {
   for (const HybridEvent& e : shot.events) speed = std::isnan(speed) ? e.speed : std::min(speed, e.speed);
   o.emplace_back(event_count_name(), shot.ok ? static_cast<double>(shot.events.size()) : nan);
   o.emplace_back(event_speed_name(), shot.ok ? speed : nan);
+  double gap = nan;
+  for (const double e : shot.extremum)
+    if (std::isfinite(e)) gap = std::isnan(gap) ? -e : std::min(gap, -e);
+  o.emplace_back(event_gap_name(), shot.ok ? gap : nan);
   return o;
 }
 
@@ -434,31 +474,56 @@ void HybridOrbitProblem::check_guess(const Vector& x) const {
 
 std::unique_ptr<Problem> HybridOrbitProblem::grazing_problem(const std::string& observable,
                                                              const Vector& x) const {
-  if (observable != event_speed_name() || num_events() == 0) return nullptr;
+  if (num_events() == 0) return nullptr;
   const HybridShot shot = shoot(x);
-  if (!shot.ok || shot.events.empty()) return nullptr;
-  const auto slowest = std::min_element(
-      shot.events.begin(), shot.events.end(),
-      [](const HybridEvent& a, const HybridEvent& b) { return a.speed < b.speed; });
-  return std::make_unique<GrazingOrbitProblem>(*this, slowest->which);
+  if (!shot.ok) return nullptr;
+  int event = -1;
+  double time = nan;
+  const HybridEvent* slowest = nullptr;
+  if (observable == event_speed_name()) {
+    if (shot.events.empty()) return nullptr;
+    slowest = &*std::min_element(
+        shot.events.begin(), shot.events.end(),
+        [](const HybridEvent& a, const HybridEvent& b) { return a.speed < b.speed; });
+    event = slowest->which;
+    time = slowest->time;
+  } else if (observable == event_gap_name()) {
+    for (int k = 0; k < num_events(); ++k)
+      if (std::isfinite(shot.extremum[k]) && (event < 0 || shot.extremum[k] > shot.extremum[event]))
+        event = k;
+    if (event < 0) return nullptr;
+    time = shot.extremum_time[event];
+  } else {
+    return nullptr;
+  }
+  // Half-way to the nearest other event (over the period's wrap), a quarter period without one.
+  double half_gap = shot.period / 4;
+  for (const HybridEvent& e : shot.events) {
+    if (&e == slowest) continue;
+    const double gap = std::abs(e.time - time);
+    half_gap = std::min(half_gap, 0.5 * std::min(gap, shot.period - gap));
+  }
+  return std::make_unique<GrazingOrbitProblem>(*this,
+                                               Suppression{event, time - half_gap, time + half_gap});
 }
 
-GrazingOrbitProblem::GrazingOrbitProblem(const HybridOrbitProblem& base, int event)
-    : base_(base), event_(event) {}
+GrazingOrbitProblem::GrazingOrbitProblem(const HybridOrbitProblem& base,
+                                         HybridOrbitProblem::Suppression window)
+    : base_(base), window_(window) {}
 
 EvalStatus GrazingOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
-  const HybridShot shot = base_.shoot_without(x, event_);
-  if (!shot.ok || !std::isfinite(shot.extremum[event_])) return EvalStatus::failed;
+  const HybridShot shot = base_.shoot_without(x, window_);
+  if (!shot.ok || !std::isfinite(shot.extremum[window_.event])) return EvalStatus::failed;
   const int n = base_.state_size();
   r.resize(num_equations());
   r.head(n) = shot.end - x.head(n);
   if (!base_.forced()) r[n] = base_.phase_condition(x.data(), base_.parameters_at(x));
-  r[num_equations() - 1] = shot.extremum[event_];
+  r[num_equations() - 1] = shot.extremum[window_.event];
   return EvalStatus::ok;
 }
 
 Observables GrazingOrbitProblem::observables(const Vector& x) const {
-  const HybridShot shot = base_.shoot_without(x, event_);
+  const HybridShot shot = base_.shoot_without(x, window_);
   Observables o;
   o.emplace_back("period", base_.period_at(x));
   const Vector p = base_.parameters_at(x);
@@ -467,6 +532,7 @@ Observables GrazingOrbitProblem::observables(const Vector& x) const {
   o.emplace_back(base_.event_count_name(),
                  shot.ok ? static_cast<double>(shot.events.size() + 1) : nan);
   o.emplace_back(base_.event_speed_name(), 0.0);
+  o.emplace_back(base_.event_gap_name(), 0.0);
   return o;
 }
 

@@ -86,6 +86,7 @@ struct HybridShot {
   // Per event k: the largest value of h_k (times its direction, +1 for direction 0) at the
   // extrema between its crossings, the companion roots; -inf when there is none.
   std::vector<double> extremum;
+  std::vector<double> extremum_time;  // where each was reached (NaN: none)
   double period = 0;
 };
 
@@ -122,10 +123,14 @@ class HybridOrbitProblem : public Problem, public FloquetProblem {
 
   // --- names of the observables ---
   // Default observables: period, every parameter by name, then event_count_name() (events per
-  // period) and event_speed_name() (the smallest event speed; NaN without events).
+  // period), event_speed_name() (the smallest event speed; NaN without events) and
+  // event_gap_name() (the smallest gap between crossings; NaN without extrema).
   Observables observables(const Vector& x) const override;
   virtual std::string event_count_name() const { return "events_per_period"; }
   virtual std::string event_speed_name() const { return "event_speed"; }
+  // The smallest distance -h_k at the extrema of h_k between crossings (NaN without any): 0 where
+  // the orbit touches a surface it does not cross.
+  virtual std::string event_gap_name() const { return "event_gap"; }
   std::vector<std::string> grazing_observables() const override;
 
   // --- parameters and layout ---
@@ -152,11 +157,23 @@ class HybridOrbitProblem : public Problem, public FloquetProblem {
   // is returned again for the same x (observables, monodromy and Jacobian after a residual).
   HybridShot shoot(const Vector& x) const;
   EvalStatus monodromy(const Vector& x, Matrix& M) const override;
-  // The same shot with event `suppressed` switched off (its surface is crossed freely; its
-  // extrema still recorded in HybridShot::extremum). Not cached.
-  HybridShot shoot_without(const Vector& x, int suppressed) const;
-  // The grazing orbits of the event whose speed (event_speed_name()) is the smallest at x: a
-  // GrazingOrbitProblem; nullptr for another name or without events.
+  // An event switched off within a window of time: there its surface is crossed freely, and its
+  // extrema are still recorded (HybridShot::extremum counts only those in the window).
+  struct Suppression {
+    int event = -1;  // -1: none
+    double from = 0, to = 0;
+    bool covers(int k, double t, double period) const;  // t, t +- period in [from, to]
+  };
+  // The shot with `suppressed`. Not cached.
+  HybridShot shoot_without(const Vector& x, const Suppression& suppressed) const;
+  // A copy (clone()) with forcing_periods() doubled for a forced system; an autonomous one's copy
+  // as it is, the period being an unknown (doubled_unknowns doubles it). nullptr when the
+  // subclass has no clone().
+  std::unique_ptr<Problem> doubled_problem() const override;
+  Vector doubled_unknowns(const Vector& x) const override;
+  // Grazing orbits (GrazingOrbitProblem): for event_speed_name(), of the slowest event at x; for
+  // event_gap_name(), of the extremum with the smallest gap; nullptr for another name or
+  // without events.
   std::unique_ptr<Problem> grazing_problem(const std::string& observable,
                                            const Vector& x) const override;
   // Before any work: InputError when the guess cannot start a branch: a forcing period that is
@@ -166,13 +183,15 @@ class HybridOrbitProblem : public Problem, public FloquetProblem {
   void check_guess(const Vector& x) const;
 
  protected:
+  // A copy has the settings and no cached shot (a subclass's clone() uses it).
+  HybridOrbitProblem(const HybridOrbitProblem& other);
   EvalStatus compute_residual(const Vector& x, Vector& r) const override;
   EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override;
   // A subclass that changes the system after construction calls this (the cache is stale).
   void forget_last_shot() const;
 
  private:
-  HybridShot shoot_uncached(const Vector& x, int suppressed) const;
+  HybridShot shoot_uncached(const Vector& x, const Suppression& suppressed) const;
   void event_gradient(int k, double t, const Vector& y, const Vector& p, Vector& n,
                       double& dh_dt) const;
 
@@ -187,15 +206,17 @@ class HybridOrbitProblem : public Problem, public FloquetProblem {
   mutable HybridShot last_shot_;
 };
 
-// The orbits of a HybridOrbitProblem that graze the surface of one event: with that event off,
-// the periodic orbit whose extremum of h_k lies on the surface. Same unknowns as the base, one
+// The orbits of a HybridOrbitProblem that graze the surface of one event: with that event off
+// in a window of time around the grazing (from half-way to the orbit's neighbouring events, so
+// that its other impacts still happen), the periodic orbit whose extremum of h_k in the window
+// lies on the surface. Same unknowns as the base, one
 // more equation, h_k at its extremum (the companion root, hybrid_orbit.hpp's header); a smooth
 // problem where the base has no saltation matrix, so that a corrector converges to the grazing
 // orbit itself. Finite-difference Jacobian. Observables: the base's, with that event counted
 // once and its speed 0.
 class GrazingOrbitProblem : public Problem {
  public:
-  GrazingOrbitProblem(const HybridOrbitProblem& base, int event);
+  GrazingOrbitProblem(const HybridOrbitProblem& base, HybridOrbitProblem::Suppression window);
   int num_unknowns() const override { return base_.num_unknowns(); }
   int num_equations() const override { return base_.num_equations() + 1; }
   std::string name() const override { return base_.name() + " grazing"; }
@@ -207,7 +228,7 @@ class GrazingOrbitProblem : public Problem {
 
  private:
   const HybridOrbitProblem& base_;
-  int event_;
+  HybridOrbitProblem::Suppression window_;
 };
 
 }  // namespace backbone::core

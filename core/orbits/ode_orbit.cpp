@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -187,6 +188,50 @@ EvalStatus OdeOrbitProblem::shoot(const Vector& x, Vector& r, Matrix& J) const {
   last_.formulation = formulation();
   last_.jacobian = J;
   return EvalStatus::ok;
+}
+
+EvalStatus OdeOrbitProblem::monodromy(const Vector& x, Matrix& M) const {
+  const int d = dimension_, n = 2 * d;
+  const double period = x[period_index()];
+  if (!(period > 0) || !std::isfinite(period) || !x.head(d).allFinite())
+    return EvalStatus::failed;
+  const Vector q0 = x.head(d);
+  // State [q | v | A (2d x 2d, column-major)], tolerances as in flow().
+  const int size = n + n * n;
+  const double floor = 1e-3 * options_.relative_tolerance;
+  Matrix stiffness_matrix(d, d);
+  acceleration_jacobian(q0.data(), stiffness_matrix);
+  const double stiffness =
+      std::max(stiffness_matrix.cwiseAbs().rowwise().sum().maxCoeff(), smallest_scale);
+  CvodeOptions cvode;
+  cvode.relative_tolerance = options_.relative_tolerance;
+  cvode.max_steps = options_.max_steps;
+  cvode.absolute_tolerance = Vector::Constant(size, floor);
+  cvode.absolute_tolerance.head(d).setConstant(floor * std::max(q0.norm(), smallest_scale));
+  cvode.absolute_tolerance.segment(d, d).setConstant(floor * velocity_scale(q0));
+  Vector y = Vector::Zero(size);
+  y.head(d) = q0;
+  Eigen::Map<Matrix>(y.data() + n, n, n).setIdentity();
+  // The A blocks: q rows are velocities' integrals (scale 1), v rows grow with sqrt(stiffness).
+  for (int j = 0; j < n; ++j)
+    cvode.absolute_tolerance.segment(n + j * n + d, d).setConstant(floor * std::sqrt(stiffness));
+  const OdeRightHandSide rhs = [this, d, n, K = Matrix(d, d)](double, const double* s,
+                                                              double* ds) mutable {
+    for (int i = 0; i < d; ++i) ds[i] = s[d + i];
+    acceleration(s, ds + d);
+    acceleration_jacobian(s, K);
+    const Eigen::Map<const Matrix> A(s + n, n, n);
+    Eigen::Map<Matrix> dA(ds + n, n, n);
+    dA.topRows(d) = A.bottomRows(d);
+    dA.bottomRows(d).noalias() = K * A.topRows(d);
+  };
+  if (!integrate_ode(rhs, y, 0.5 * period, cvode).ok) return EvalStatus::failed;
+  const Matrix A = Eigen::Map<const Matrix>(y.data() + n, n, n);
+  Vector R = Vector::Ones(n);
+  R.tail(d).setConstant(-1);
+  Eigen::PartialPivLU<Matrix> lu(A);
+  M = R.asDiagonal() * lu.solve(Matrix(R.asDiagonal() * A));
+  return M.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 
 void OdeOrbitProblem::forget_last_shot() const {

@@ -27,6 +27,7 @@
 #include <mutex>
 
 #include "core/orbits/periodic_orbit.hpp"
+#include "core/stability/floquet.hpp"
 
 namespace backbone::core {
 
@@ -44,7 +45,7 @@ struct ResidualScale {
 
 // A conservative mechanical system q'' = a(q), q in R^d, as a periodic-orbit problem:
 // unknowns [q0 | T] (v0 = 0), both shooting formulations of PeriodicOrbitProblem.
-class OdeOrbitProblem : public PeriodicOrbitProblem {
+class OdeOrbitProblem : public PeriodicOrbitProblem, public FloquetProblem {
  public:
   static constexpr int max_dimension_keeping_jacobian = 2;
   explicit OdeOrbitProblem(int dimension, OdeOrbitOptions options = {});
@@ -68,6 +69,14 @@ class OdeOrbitProblem : public PeriodicOrbitProblem {
 
   // Divisor of the residual at x for the current formulation (see above), with its gradient.
   virtual ResidualScale residual_scale(const Vector& x) const;
+
+  // Monodromy of the full state (q, v), 2d x 2d, from half a period: the system is reversible
+  // (v -> -v, R = diag(I, -I)) and the orbit from rest is at rest again at T/2, so with
+  // A = d(q, v)(T/2) / d(q0, v0), M = R A^-1 R A (core/README.md, section 'Stability'). One flow
+  // of T/2 with the 2d x 2d variational equations.
+  EvalStatus monodromy(const Vector& x, Matrix& M) const override;
+  // Conservative: two multipliers at +1 (time shift and energy), M symplectic.
+  FloquetStructure floquet_structure() const override { return {2, true}; }
 
  protected:
   // For d <= max_dimension_keeping_jacobian both integrate the variational equations alongside

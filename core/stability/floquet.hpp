@@ -100,6 +100,11 @@ class FloquetProblem {
                                                    const Vector& x) const {
     return nullptr;
   }
+  // The same system with orbits of twice the period, for the switch at a period doubling
+  // (continuation/orbit_bifurcations/doubling.hpp), or nullptr (the default: no switch).
+  virtual std::unique_ptr<Problem> doubled_problem() const { return nullptr; }
+  // An orbit x of this problem as an orbit of doubled_problem() (its unknowns).
+  virtual Vector doubled_unknowns(const Vector& x) const { return x; }
 };
 
 // The multipliers of the orbit x of `problem` when it is a FloquetProblem (nullopt otherwise);

@@ -99,7 +99,10 @@ boost::program_options::options_description scene_keys() {
        "1 / |1 - omega^2|)")  //
       ("grazing_velocity", po::value<double>()->default_value(4e-3),
        "stop the branch where the impact velocity falls to this (> 0); the grazing orbit "
-       "beyond is extrapolated from orbits at a half, a quarter and an eighth of it")  //
+       "beyond is corrected from there")  //
+      ("grazing_gap", po::value<double>()->default_value(1e-3),
+       "stop the branch where the orbit's closest approach to the wall between impacts falls to "
+       "this (> 0); the grazing orbit beyond is corrected from there")  //
       ("continuation_parameter", po::value<std::string>()->default_value("wall"),
        "the parameter the branch moves: wall, restitution or frequency")  //
       ("rtol", po::value<double>()->default_value(1e-12),

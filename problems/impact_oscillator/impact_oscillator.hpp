@@ -22,6 +22,7 @@
 
 #include <array>
 #include <complex>
+#include <memory>
 #include <optional>
 
 #include <boost/program_options.hpp>
@@ -35,6 +36,9 @@ class ImpactOscillator : public core::HybridOrbitProblem {
   // Parameters frequency 2.8, restitution 0.8, wall 0 unless set (set_parameter).
   explicit ImpactOscillator(core::HybridOrbitOptions options = {});
   std::string name() const override { return "impact_oscillator"; }
+  std::unique_ptr<core::Problem> clone() const override {
+    return std::make_unique<ImpactOscillator>(*this);
+  }
   void field(double t, const double* y, const core::Vector& p, double* dy) const override;
   void field_jacobian(double t, const double* y, const core::Vector& p,
                       core::Matrix& J) const override;
@@ -47,6 +51,7 @@ class ImpactOscillator : public core::HybridOrbitProblem {
   core::FloquetStructure floquet_structure() const override;
   std::string event_count_name() const override { return "impacts_per_period"; }
   std::string event_speed_name() const override { return "impact_velocity"; }
+  std::string event_gap_name() const override { return "wall_gap"; }
 };
 
 // The period-1 orbit with one impact per forcing period (README.md, 'The period-1 orbit').

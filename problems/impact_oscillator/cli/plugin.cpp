@@ -39,6 +39,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
     throw core::InputError("wall_max",
                            fmt::format("must be above wall = {} (got {})", sigma, wall_max));
   const double grazing_velocity = scene.positive("grazing_velocity");
+  const double grazing_gap = scene.positive("grazing_gap");
   const std::string free =
       scene.choice("continuation_parameter", {"wall", "restitution", "frequency"});
 
@@ -57,11 +58,12 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
   s.guess << orbit->start, problem->parameters()[problem->free_parameter()];
   problem->check_guess(s.guess);
   s.direction = core::Vector::Unit(3, 2);  // the free parameter grows
-  s.branch_options = [wall_min, wall_max, free, grazing_velocity](cli::ContinuationOptions& continuation,
+  s.branch_options = [wall_min, wall_max, free, grazing_velocity, grazing_gap](cli::ContinuationOptions& continuation,
                                                 core::NewtonOptions&) {
     if (free == "wall") continuation.bounds.push_back({"wall", wall_min, wall_max});
-    continuation.bounds.push_back(
-        {"impact_velocity", grazing_velocity, std::numeric_limits<double>::infinity()});
+    const double inf = std::numeric_limits<double>::infinity();
+    continuation.bounds.push_back({"impact_velocity", grazing_velocity, inf});
+    continuation.bounds.push_back({"wall_gap", grazing_gap, inf});
   };
   s.describe_point = [exact = problem.get()](const cli::BranchPoint& point) {
     const auto oracle = period_one_orbit(point.observable("frequency"),
