@@ -290,7 +290,11 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, const Suppression
       const double h = event(k, t, Y.data(), p), h0 = event(k, t_start, start.data(), p);
       const int dir = event_direction(k);
       if (suppressed.covers(k, t, T)) continue;
-      if ((dir > 0 && h > 0) || (dir < 0 && h < 0) || (dir == 0 && h * h0 < 0)) lost = true;
+      // Lost only when the segment started on the near side (a segment that starts on the
+      // surface, after an event, may reach beyond it: a switch without a jump).
+      if ((dir > 0 && h0 < 0 && h > 0) || (dir < 0 && h0 > 0 && h < 0) ||
+          (dir == 0 && h * h0 < 0))
+        lost = true;
     }
     if (lost) {
       if (++redo > max_redo)
