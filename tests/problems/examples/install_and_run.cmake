@@ -10,7 +10,9 @@
 #    that prefix (searched first by find_package), so it sees the installed package only,
 # 3. builds it and runs its CLI: `--help`, `trace` on the example's scene (exit 0: the branch
 #    reached its bound), `inspect` on the last traced point, and for the pendulum
-#    `bench --case period_error` (exit 0: every period within 1e-9 of the exact one).
+#    `bench --case period_error` (exit 0: every period within 1e-9 of the exact one); the
+#    bilinear oscillator (a forced hybrid problem) writes its multipliers and refuses a forcing
+#    frequency <= 0.
 # Any failing step fails the test with the step's output.
 cmake_minimum_required(VERSION 3.25)
 foreach(required BACKBONE_BINARY_DIR EXAMPLES_DIR)
@@ -83,3 +85,22 @@ run_step("minimal: trace" ${cli} trace ${EXAMPLES_DIR}/minimal/scenes/fold.ini
          --out ${work}/out/fold)
 run_step("minimal: inspect" ${cli} inspect ${work}/out/fold/scene.ini
          --orbit ${work}/out/fold/orbits.csv:5)
+
+# A forced hybrid problem with events, traced with the stability of its orbits.
+build_example(bilinear)
+set(cli ${work}/bilinear/bilinear_backbone)
+run_step("bilinear: trace" ${cli} trace ${EXAMPLES_DIR}/bilinear/scenes/bilinear.ini
+         --out ${work}/out/bilinear)
+foreach(written branch.csv multipliers.csv bifurcations.csv)
+  if(NOT EXISTS ${work}/out/bilinear/${written})
+    message(FATAL_ERROR "bilinear: trace wrote no ${written}")
+  endif()
+endforeach()
+# A forcing frequency <= 0 is refused before any work: exit 2, nothing written.
+execute_process(COMMAND ${cli} trace ${EXAMPLES_DIR}/bilinear/scenes/bilinear.ini --frequency -1
+                        --out ${work}/out/bilinear_bad
+                RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE out)
+if(NOT status EQUAL 2 OR EXISTS ${work}/out/bilinear_bad)
+  message(FATAL_ERROR "bilinear: --frequency -1 gave exit ${status} (expected 2, nothing written):\n${out}")
+endif()
+message(STATUS "bilinear: --frequency -1 refused: ok")
