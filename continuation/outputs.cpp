@@ -30,18 +30,45 @@ core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch&
   return t;
 }
 
+std::string stability_datablocks(const core::Table& table, const std::string& x,
+                                 const std::string& y, const std::string& prefix) {
+  const std::vector<double> xs = table.column(x), ys = table.column(y),
+                            kinds = table.column("stable");
+  std::string blocks[3];  // undecided (-1), unstable (0), stable (1)
+  for (std::size_t i = 0; i + 1 < xs.size() || (xs.size() == 1 && i == 0); ++i) {
+    const int kind = std::clamp(static_cast<int>(kinds[i]), -1, 1) + 1;
+    const std::size_t next = std::min(i + 1, xs.size() - 1);
+    blocks[kind] += fmt::format("{:.17g},{:.17g}\n{:.17g},{:.17g}\n\n", xs[i], ys[i], xs[next],
+                                ys[next]);
+  }
+  std::string text;
+  const char* names[3] = {"undecided", "unstable", "stable"};
+  for (int k = 0; k < 3; ++k)
+    // An empty block would make gnuplot stop the plot: a point of NaN stands for none.
+    // The first line is a header: render_png reads every data source's first row as one.
+    text += fmt::format("${}{} << EOD\nx,y\n{}EOD\n", prefix, names[k],
+                        blocks[k].empty() ? "nan,nan\n" : blocks[k]);
+  return text;
+}
+
 std::string branch_plot_script(const std::filesystem::path& csv, const core::Table& table,
                                const std::string& title,
-                               const std::map<std::string, std::string>& units) {
+                               const std::map<std::string, std::string>& units,
+                               const std::pair<std::string, std::string>& axes) {
   const auto& columns = table.columns();
   const auto column_of = [&](const std::string& name) {
     for (std::size_t i = 0; i < columns.size(); ++i)
       if (columns[i] == name) return static_cast<int>(i) + 1;
     return 0;
   };
-  int x = column_of("energy"), y = column_of("frequency");
-  const bool log_x = x > 0 && y > 0;
-  if (!log_x) {
+  int x = column_of(axes.first), y = column_of(axes.second);
+  const bool chosen = x > 0 && y > 0;
+  if (!chosen) {
+    x = column_of("energy");
+    y = column_of("frequency");
+  }
+  const bool log_x = !chosen && x > 0 && y > 0;
+  if (!chosen && !log_x) {
     x = 2;
     y = 3;
   }
@@ -53,17 +80,27 @@ std::string branch_plot_script(const std::filesystem::path& csv, const core::Tab
   };
   // The header is read by `set key autotitle columnhead` (core::render_png): no `skip`, which
   // would drop the first point as well.
-  return fmt::format(
-      "set key top left\nset grid\n{}set xlabel '{}' noenhanced\nset ylabel '{}' noenhanced\n"
-      "set title '{}' noenhanced\n"
-      "plot {} using {}:{} with linespoints pt 7 ps 0.6 title 'branch'\n",
-      log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", label(x), label(y), title,
-      core::gnuplot_quote(csv), x, y);
+  const std::string frame =
+      fmt::format("set key top left\nset grid\n{}set xlabel '{}' noenhanced\n"
+                  "set ylabel '{}' noenhanced\nset title '{}' noenhanced\n",
+                  log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", label(x), label(y),
+                  title);
+  const int stable = column_of("stable");
+  if (stable == 0)
+    return frame + fmt::format("plot {} using {}:{} with linespoints pt 7 ps 0.6 title 'branch'\n",
+                              core::gnuplot_quote(csv), x, y);
+  return frame + stability_datablocks(table, columns[x - 1], columns[y - 1], "") +
+         fmt::format("plot $stable with lines lw 2 lc rgb '#1f77b4' title 'stable', "
+                     "$unstable with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable', "
+                     "$undecided with lines lw 1 dt 3 lc rgb 'gray40' title 'undecided', "
+                     "{} using {}:{} with points pt 7 ps 0.5 lc rgb 'black' title 'points'\n",
+                     core::gnuplot_quote(csv), x, y);
 }
 
 void plot_branch(const std::filesystem::path& out, const core::Table& table,
-                 const std::string& title, const std::map<std::string, std::string>& units) {
-  const std::string script = branch_plot_script(out / "branch.csv", table, title, units);
+                 const std::string& title, const std::map<std::string, std::string>& units,
+                 const std::pair<std::string, std::string>& axes) {
+  const std::string script = branch_plot_script(out / "branch.csv", table, title, units, axes);
   if (script.empty()) return;
   core::PlotResult r = core::render_png(out / "branch.png", script);
   if (!r.ok) fmt::print(stderr, "figure skipped: {}\n", r.message);

@@ -29,6 +29,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "continuation/branch.hpp"
 #include "continuation/options.hpp"
@@ -40,16 +41,28 @@ namespace backbone::continuation {
 
 core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch& branch);
 
-// out/branch.png from the rows of out/branch.csv (`table`), every point: frequency against
-// energy (log axis) when the problem reports them, else the first two observables; axis labels
-// carry the units the problem gives (ProblemPlugin::units). A figure that cannot be drawn (no
-// gnuplot) is reported on stderr, not an error. branch_plot_script is its gnuplot text (empty
-// when the table has too few columns).
+// out/branch.png from the rows of out/branch.csv (`table`), every point: `axes` (x, y columns)
+// when the table has both, else frequency against energy (log axis) when the problem reports
+// them, else the first two observables; axis labels carry the units the problem gives
+// (ProblemPlugin::units). With a `stable` column the line is solid where the orbits are stable,
+// dashed where unstable, dotted where undecided. A figure that cannot be drawn (no gnuplot) is
+// reported on stderr, not an error. branch_plot_script is its gnuplot text (empty when the
+// table has too few columns).
 void plot_branch(const std::filesystem::path& out, const core::Table& table,
-                 const std::string& title, const std::map<std::string, std::string>& units = {});
+                 const std::string& title, const std::map<std::string, std::string>& units = {},
+                 const std::pair<std::string, std::string>& axes = {});
 std::string branch_plot_script(const std::filesystem::path& csv, const core::Table& table,
                                const std::string& title,
-                               const std::map<std::string, std::string>& units = {});
+                               const std::map<std::string, std::string>& units = {},
+                               const std::pair<std::string, std::string>& axes = {});
+
+// Gnuplot data blocks $<prefix>stable, $<prefix>unstable and $<prefix>undecided
+// (comma-separated, as core::render_png reads, each with a header line): the segments of a
+// branch table's (x, y) columns by the `stable` column of their points, each run of one kind
+// drawn through the first point of the next run, so that the line is unbroken where the kind
+// changes; a block without segments holds one NaN point. The table must have a stable column.
+std::string stability_datablocks(const core::Table& table, const std::string& x,
+                                 const std::string& y, const std::string& prefix);
 
 class BranchWriter {
  public:

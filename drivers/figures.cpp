@@ -39,11 +39,17 @@ int run_figures(const std::vector<std::string>& args) {
     throw core::InputError("out", fmt::format("'{}' is not a folder of traced branches (backbone "
                                               "reproduce --out DIR writes one)",
                                               out.string()));
+  // A branch one or two folders down (a problem may group its branches: DIR/PROBLEM/*/).
   bool traced = false;
-  for (const auto& entry : std::filesystem::directory_iterator(out))
+  for (const auto& entry : std::filesystem::directory_iterator(out)) {
     traced = traced || std::filesystem::exists(entry.path() / "branch.csv");
+    if (entry.is_directory())
+      for (const auto& inner : std::filesystem::directory_iterator(entry.path()))
+        traced = traced || std::filesystem::exists(inner.path() / "branch.csv");
+  }
   if (!traced)
-    throw core::InputError("out", fmt::format("'{}' holds no traced branch (no DIR/*/branch.csv; "
+    throw core::InputError("out", fmt::format("'{}' holds no traced branch (no DIR/*/branch.csv "
+                                              "or DIR/*/*/branch.csv; "
                                               "backbone reproduce --out DIR writes them)",
                                               out.string()));
   core::check_output_folder("out", out);

@@ -110,6 +110,8 @@ struct ProblemPlugin {
 
   // Units of the observables (branch.csv columns) for axis labels and docs: {"energy", "J"}.
   std::map<std::string, std::string> units;
+  // The observables branch.png draws (x, y); empty: frequency against energy when both exist.
+  std::pair<std::string, std::string> branch_axes;
 
   std::vector<ProblemJob> bench_cases;
   std::vector<ProblemJob> figures;  // run(out): reads the traced branches in out, draws

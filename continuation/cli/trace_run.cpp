@@ -292,8 +292,9 @@ bool follow_doublings(TraceRun& t, const std::vector<continuation::OrbitBifurcat
     if (d.branch.points.empty() || d.branch.ended_early()) complete = false;
     if (d.branch.points.empty()) continue;
     continuation::plot_branch(dir, core::Table::read_csv(dir / "branch.csv"),
-                              fmt::format("{} / period doubling {}", t.entry->name, k),
-                              t.entry->units);
+                              fmt::format("{} / period doubling {} ({} points)", t.entry->name,
+                                          k, d.branch.points.size()),
+                              t.entry->units, t.entry->branch_axes);
     report_stability(*d.problem, d.branch, o.floquet, corrector, dir);
   }
   return complete;
@@ -326,7 +327,7 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
   report.points_in_files = table.rows();
   continuation::plot_branch(
       t.out, table, fmt::format("{} / {} ({} points)", t.entry->name, t.branch_name, table.rows()),
-      t.entry->units);
+      t.entry->units, t.entry->branch_axes);
   continuation::write_after_run(t.out, t.problem(), branch, !t.resume.empty(),
                                 options.branch_points.detect, t.setup.write_extra_outputs);
   if (options.stability) {

@@ -19,7 +19,7 @@ constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 // test functions' signs are noise closer to the root than that.
 constexpr double bracket_tolerance = 1e-10;
 constexpr int max_location_steps = 80;
-constexpr double grazing_fraction = 0.05;
+constexpr double grazing_fraction = 0.5;
 
 double observable_of(const core::Observables& list, const std::string& name) {
   for (const auto& [key, value] : list)
@@ -161,15 +161,20 @@ std::optional<OrbitBifurcation> locate_grazing(const core::Problem& problem,
   const auto& points = branch.points;
   // A branch that ended on its point budget did not stop at the grazing.
   if (points.size() < 2 || branch.reason == StopReason::max_points) return std::nullopt;
-  double largest = 0;
+  double largest = 0, smallest = std::numeric_limits<double>::infinity();
   for (const BranchPoint& p : points) {
     const double g = p.observable(name);
-    if (std::isfinite(g)) largest = std::max(largest, g);
+    if (std::isfinite(g)) {
+      largest = std::max(largest, g);
+      smallest = std::min(smallest, g);
+    }
   }
   const BranchPoint& last = points.back();
   const double g_end = last.observable(name);
   const double g_before = points[points.size() - 2].observable(name);
-  if (!(g_end > 0 && g_end < grazing_fraction * largest && g_end < g_before)) return std::nullopt;
+  if (!(g_end > 0 && g_end <= smallest && g_end < grazing_fraction * largest &&
+        g_end < g_before))
+    return std::nullopt;
   const auto grazing = orbit.grazing_problem(name, last.x);
   if (!grazing) return std::nullopt;
   OrbitBifurcation b;

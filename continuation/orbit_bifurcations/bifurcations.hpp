@@ -17,8 +17,8 @@
 // Grazing: a problem naming grazing observables (core::FloquetProblem::grazing_observables, an
 // event speed that is 0 where the orbit meets a switching surface tangentially) has no
 // saltation matrix at the grazing orbit, so the branch cannot reach it. When such an observable g
-// falls towards 0 at the end of the branch (below 5 % of its largest value on the branch, and
-// falling), the problem's grazing problem (FloquetProblem::grazing_problem: the orbit with that
+// falls towards 0 at the end of a branch that did not stop on its point budget (its smallest
+// value on the branch, below half its largest, and falling), the problem's grazing problem (FloquetProblem::grazing_problem: the orbit with that
 // event off whose extremum lies on the surface, a smooth system) is corrected from the branch's
 // last point: the located grazing orbit itself. Its multipliers are reported from the branch's
 // last point (on the impacting side they grow like 1 / g).

@@ -11,8 +11,10 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include "core/errors.hpp"
+#include "problems/impact_oscillator/figures.hpp"
 #include "problems/impact_oscillator/impact_oscillator.hpp"
 
 namespace backbone::impact_oscillator {
@@ -86,6 +88,22 @@ void register_plugin(cli::PluginRegistry& registry) {
   p.scene_keys = &scene_keys;
   p.branches = {"period1"};
   p.setup = &setup_trace;
+  p.branch_axes = {"wall", "impact_velocity"};
+  p.figures = figure_jobs();
+  const std::string scene = "problems/impact_oscillator/scenes/impact.ini";
+  const std::string folder = "{out}/impact_oscillator/";
+  // Per restitution: up from sigma = 0 to the grazing, then down to -0.2 from the same first
+  // point, switching onto the period-2 branch at the period doubling.
+  for (const auto& [name, r] : {std::pair{"dissipative", "0.8"}, std::pair{"elastic", "1"}}) {
+    p.reproduce.push_back({fmt::format("impact_{}_up", name),
+                           "trace",
+                           {scene, "--restitution", r, "--out", folder + name + "_up"}});
+    p.reproduce.push_back({fmt::format("impact_{}_down", name),
+                           "trace",
+                           {scene, "--restitution", r, "--start", folder + name + "_up:0",
+                            "--direction", "-1", "--follow", "doubling", "--out",
+                            folder + name + "_down"}});
+  }
   registry.add(std::move(p));
 }
 
