@@ -44,6 +44,13 @@ std::vector<std::pair<std::string, fs::path>> branches_of(const fs::path& out, c
   return found;
 }
 
+// A folder without the impact oscillator's branches: nothing to draw, not a failure (figures
+// draws every problem's figures from whatever was traced).
+int skipped(const fs::path& out) {
+  fmt::print("[figures] no impact oscillator branches in {}: skipped\n", folder(out).string());
+  return 0;
+}
+
 void report(const core::PlotResult& r, const fs::path& png) {
   if (r.ok)
     fmt::print("[figures] wrote {}\n", png.string());
@@ -52,6 +59,7 @@ void report(const core::PlotResult& r, const fs::path& png) {
 }
 
 int draw_diagram(const fs::path& out) {
+  if (!fs::is_directory(folder(out))) return skipped(out);
   std::string data, plots;
   int panel = 0;
   std::string script = "set multiplot layout 1,2\nset grid\nset key bottom left\n"
@@ -114,6 +122,7 @@ std::string multiplier_block(const fs::path& dir, int point, const std::string& 
 }
 
 int draw_multipliers(const fs::path& out) {
+  if (!fs::is_directory(folder(out))) return skipped(out);
   const Case& c = cases[0];
   const fs::path up = folder(out) / fmt::format("{}_up", c.name);
   const fs::path down = folder(out) / fmt::format("{}_down", c.name);
@@ -162,6 +171,7 @@ int draw_multipliers(const fs::path& out) {
 }
 
 int write_summary(const fs::path& out) {
+  if (!fs::is_directory(folder(out))) return skipped(out);
   Table summary({"restitution", "points", "worst_det_error", "worst_velocity_error",
                  "multiplier_0_at_zero", "multiplier_1_at_zero", "doubling_wall",
                  "doubling_wall_closed_form", "doubling_velocity", "doubling_velocity_closed_form",

@@ -1,0 +1,83 @@
+// `backbone trace` on problems that give their orbits' monodromy: the stability files, and bad
+// input of a forced hybrid problem refused before any work (exit 2, one line naming the key,
+// nothing written).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+
+#include "core/io/table.hpp"
+#include "tests/drivers/cli_run.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string impact =
+    std::string(BACKBONE_SOURCE_DIR) + "/problems/impact_oscillator/scenes/impact.ini";
+const std::string duffing =
+    std::string(BACKBONE_SOURCE_DIR) + "/problems/duffing/scenes/duffing.ini";
+
+}  // namespace
+
+TEST(StabilityInput, ForcingFrequencyMustBePositive) {
+  cli::expect_bad_input("trace", impact + " --frequency 0", "frequency", "stability_cli");
+  cli::expect_bad_input("trace", impact + " --frequency -2.8", "frequency", "stability_cli");
+}
+
+TEST(StabilityInput, ResonantForcingFrequencyIsRefused) {
+  cli::expect_bad_input("trace", impact + " --frequency 3", "frequency", "stability_cli");
+}
+
+TEST(StabilityInput, RestitutionOutsideItsRangeIsRefused) {
+  cli::expect_bad_input("trace", impact + " --restitution 0", "restitution", "stability_cli");
+  cli::expect_bad_input("trace", impact + " --restitution 1.5", "restitution", "stability_cli");
+  cli::expect_bad_input("trace", impact + " --restitution nan", "restitution", "stability_cli");
+}
+
+// The wall above the orbit's reach: no impact ever happens (the event never fires).
+TEST(StabilityInput, WallBeyondTheGrazingHasNoOrbit) {
+  cli::expect_bad_input("trace", impact + " --wall 0.5 --wall_max 1", "wall", "stability_cli");
+}
+
+TEST(StabilityInput, WindowAroundTheStartIsChecked) {
+  cli::expect_bad_input("trace", impact + " --wall_min 0.1", "wall_min", "stability_cli");
+  cli::expect_bad_input("trace", impact + " --wall_max -0.1", "wall_max", "stability_cli");
+  cli::expect_bad_input("trace", impact + " --continuation_parameter mass",
+                        "continuation_parameter", "stability_cli");
+}
+
+TEST(StabilityInput, FloquetTolerancesAreChecked) {
+  cli::expect_bad_input("trace", impact + " --floquet_tolerance 0", "floquet_tolerance",
+                        "stability_cli");
+  cli::expect_bad_input("trace", duffing + " --floquet_trivial_tolerance 2",
+                        "floquet_trivial_tolerance", "stability_cli");
+  cli::expect_bad_input("trace", impact + " --follow doubles", "follow", "stability_cli");
+}
+
+// A branch with multipliers writes them, with the stability columns, and its bifurcations.
+TEST(StabilityFiles, ImpactOscillatorBranchWritesItsMultipliersAndBifurcations) {
+  const fs::path out = cli::scratch("stability_cli", "impact_up");
+  const cli::Run r = cli::run("trace", impact + " --max_points 60", out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const backbone::core::Table branch = backbone::core::Table::read_csv(out / "branch.csv");
+  const backbone::core::Table multipliers =
+      backbone::core::Table::read_csv(out / "multipliers.csv");
+  // Two multipliers per point (the state is (x, v)), each point's stable flag decided.
+  EXPECT_EQ(multipliers.rows(), 2 * branch.rows());
+  for (const double s : branch.column("stable")) EXPECT_TRUE(s == 0 || s == 1);
+  const backbone::core::Table found = backbone::core::Table::read_csv(out / "bifurcations.csv");
+  ASSERT_EQ(found.rows(), 1u);
+  EXPECT_EQ(found.text_column("type")[0], "grazing");
+  EXPECT_TRUE(fs::exists(out / "branch.png"));
+}
+
+// Stability off: the same branch without the files or columns.
+TEST(StabilityFiles, StabilityOffWritesNoMultipliers) {
+  const fs::path out = cli::scratch("stability_cli", "duffing_off");
+  const cli::Run r = cli::run("trace", duffing + " --stability false --max_points 5", out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(out / "multipliers.csv"));
+  const backbone::core::Table branch = backbone::core::Table::read_csv(out / "branch.csv");
+  EXPECT_EQ(std::count(branch.columns().begin(), branch.columns().end(), "stable"), 0);
+}
