@@ -92,10 +92,12 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   p.newton_iterations = newton_iterations;
   p.step_size = ds;
   p.arclength = arclength;
+  // Before the rank report, whose probes evaluate elsewhere: a problem that keeps its last
+  // shot (HybridOrbitProblem) then has the monodromy of x at hand.
+  add_floquet(p);
   const bool due = options_.rank_check_every > 0 && index % options_.rank_check_every == 0;
   if (due || (force_rank && options_.rank_check_every > 0))
     check_rank(p, curve_direction, previous);
-  add_floquet(p);
   p.residual_evaluations = counted_.counters().residuals - residuals_at_start_;
   p.jacobian_evaluations = counted_.counters().jacobians - jacobians_at_start_;
   p.seconds = elapsed_seconds();
