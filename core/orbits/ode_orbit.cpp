@@ -73,7 +73,7 @@ double OdeOrbitProblem::velocity_scale(const Vector& q0) const {
 }
 
 bool OdeOrbitProblem::flow(const Vector& q0, double t, Vector& q, Vector& v, Matrix* dq_dq0,
-                           Matrix* dv_dq0) const {
+                           Matrix* dv_dq0, Matrix* full) const {
   const int d = dimension_;
   if (q0.size() != d)
     throw std::invalid_argument(
@@ -83,18 +83,21 @@ bool OdeOrbitProblem::flow(const Vector& q0, double t, Vector& q, Vector& v, Mat
     v = Vector::Zero(d);
     if (dq_dq0) *dq_dq0 = Matrix::Identity(d, d);
     if (dv_dq0) *dv_dq0 = Matrix::Zero(d, d);
+    if (full) *full = Matrix::Identity(2 * d, 2 * d);
     return true;
   }
   if (!(t > 0) || !std::isfinite(t)) return false;
-  const bool sensitivities = dq_dq0 != nullptr || dv_dq0 != nullptr;
+  // Columns of the variational state: none, those of q0, or those of (q0, v0).
+  const int k = full ? 2 * d : (dq_dq0 != nullptr || dv_dq0 != nullptr ? d : 0);
 
-  // State y = [q | v | dq/dq0 | dv/dq0], the d x d blocks column-major. Absolute tolerances a
-  // factor 1e-3 below rtol times each component's scale on the orbit (amplitude, speed, 1 and
-  // the frequency sqrt(|da/dq|)), so that the relative tolerance governs even near zero
-  // crossings. The variational components take part in the error test: left out (CVODES'
-  // default for sensitivities), they drift where they grow fast, and the measured pendulum
-  // backbone (tests/outside_problem) then stalls near the separatrix on a poor Jacobian.
-  const int size = sensitivities ? 2 * d + 2 * d * d : 2 * d;
+  // State y = [q | v | Q | V], Q = dq/d(start) and V = dv/d(start) d x k, column-major, starting
+  // at Q = [I 0], V = [0 I]. Absolute tolerances a factor 1e-3 below rtol times each
+  // component's scale on the orbit (amplitude, speed, 1 and the frequency sqrt(|da/dq|)), so
+  // that the relative tolerance governs even near zero crossings. The variational components
+  // take part in the error test: left out (CVODES' default for sensitivities), they drift where
+  // they grow fast, and the measured pendulum backbone (tests/outside_problem) then stalls near
+  // the separatrix on a poor Jacobian.
+  const int size = 2 * d + 2 * d * k;
   const double floor = 1e-3 * options_.relative_tolerance;
   const double amplitude = std::max(q0.norm(), smallest_scale);
   CvodeOptions cvode;
@@ -105,34 +108,42 @@ bool OdeOrbitProblem::flow(const Vector& q0, double t, Vector& q, Vector& v, Mat
   cvode.absolute_tolerance.segment(d, d).setConstant(floor * velocity_scale(q0));
   Vector y = Vector::Zero(size);
   y.head(d) = q0;
-  if (sensitivities) {
+  if (k > 0) {
     Matrix stiffness_matrix(d, d);
     acceleration_jacobian(q0.data(), stiffness_matrix);
     const double stiffness =
         std::max(stiffness_matrix.cwiseAbs().rowwise().sum().maxCoeff(), smallest_scale);
-    Eigen::Map<Matrix>(y.data() + 2 * d, d, d).setIdentity();
-    cvode.absolute_tolerance.segment(2 * d, d * d).setConstant(floor);
-    cvode.absolute_tolerance.tail(d * d).setConstant(floor * std::sqrt(stiffness));
+    Eigen::Map<Matrix>(y.data() + 2 * d, d, k).leftCols(d).setIdentity();
+    if (k == 2 * d) Eigen::Map<Matrix>(y.data() + 2 * d + d * k, d, k).rightCols(d).setIdentity();
+    cvode.absolute_tolerance.segment(2 * d, d * k).setConstant(floor);
+    cvode.absolute_tolerance.tail(d * k).setConstant(floor * std::sqrt(stiffness));
   }
 
   // The workspace lives in this call's copy of the lambda: concurrent flows share nothing.
-  const OdeRightHandSide rhs = [this, d, sensitivities, stiffness = Matrix(d, d)](
+  const OdeRightHandSide rhs = [this, d, k, stiffness = Matrix(d, d)](
                                    double, const double* s, double* ds) mutable {
     for (int i = 0; i < d; ++i) ds[i] = s[d + i];
     acceleration(s, ds + d);
-    if (!sensitivities) return;
+    if (k == 0) return;
     acceleration_jacobian(s, stiffness);
-    const Eigen::Map<const Matrix> dq(s + 2 * d, d, d);
-    const Eigen::Map<const Matrix> dv(s + 2 * d + d * d, d, d);
-    Eigen::Map<Matrix>(ds + 2 * d, d, d) = dv;
-    Eigen::Map<Matrix>(ds + 2 * d + d * d, d, d).noalias() = stiffness * dq;
+    const Eigen::Map<const Matrix> dq(s + 2 * d, d, k);
+    const Eigen::Map<const Matrix> dv(s + 2 * d + d * k, d, k);
+    Eigen::Map<Matrix>(ds + 2 * d, d, k) = dv;
+    Eigen::Map<Matrix>(ds + 2 * d + d * k, d, k).noalias() = stiffness * dq;
   };
   const IntegrationResult result = integrate_ode(rhs, y, t, cvode);
   if (!result.ok) return false;
   q = y.head(d);
   v = y.segment(d, d);
-  if (dq_dq0) *dq_dq0 = Eigen::Map<const Matrix>(y.data() + 2 * d, d, d);
-  if (dv_dq0) *dv_dq0 = Eigen::Map<const Matrix>(y.data() + 2 * d + d * d, d, d);
+  if (k == 0) return true;
+  const Eigen::Map<const Matrix> Q(y.data() + 2 * d, d, k), V(y.data() + 2 * d + d * k, d, k);
+  if (dq_dq0) *dq_dq0 = Q.leftCols(d);
+  if (dv_dq0) *dv_dq0 = V.leftCols(d);
+  if (full) {
+    full->resize(2 * d, 2 * d);
+    full->topRows(d) = Q;
+    full->bottomRows(d) = V;
+  }
   return true;
 }
 
@@ -159,11 +170,11 @@ EvalStatus OdeOrbitProblem::shoot(const Vector& x, Vector& r, Matrix& J) const {
   if (!(period > 0) || !x.head(d).allFinite()) return EvalStatus::failed;
   const Vector q0 = x.head(d);
   Vector q, v, raw;
-  Matrix dq_dq0, dv_dq0;
+  Matrix dq_dq0, dv_dq0, A;
   J.resize(d, d + 1);
   if (formulation() == ShootingFormulation::half_period_velocity) {
     // r = v(T/2): dr/dq0 = dv/dq0 (T/2), dr/dT = a(q(T/2)) / 2.
-    if (!flow(q0, 0.5 * period, q, v, &dq_dq0, &dv_dq0)) return EvalStatus::failed;
+    if (!flow(q0, 0.5 * period, q, v, &dq_dq0, &dv_dq0, &A)) return EvalStatus::failed;
     Vector a(d);
     acceleration(q.data(), a.data());
     J.leftCols(d) = dv_dq0;
@@ -171,7 +182,7 @@ EvalStatus OdeOrbitProblem::shoot(const Vector& x, Vector& r, Matrix& J) const {
     raw = v;
   } else {
     // r = q0 - q(T): dr/dq0 = I - dq/dq0 (T), dr/dT = -v(T).
-    if (!flow(q0, period, q, v, &dq_dq0, &dv_dq0)) return EvalStatus::failed;
+    if (!flow(q0, period, q, v, &dq_dq0, &dv_dq0, &A)) return EvalStatus::failed;
     J.leftCols(d) = Matrix::Identity(d, d) - dq_dq0;
     J.col(d) = -v;
     raw = q0 - q;
@@ -183,54 +194,42 @@ EvalStatus OdeOrbitProblem::shoot(const Vector& x, Vector& r, Matrix& J) const {
   const double s2 = scale.value * scale.value;
   for (int j = 0; j < d; ++j)
     for (int i = 0; i < d; ++i) J(i, j) -= raw[i] * scale.gradient[j] / s2;
+  const Matrix M = monodromy_from(A, formulation());
   const std::lock_guard<std::mutex> lock(last_mutex_);
   last_.x = x;
   last_.formulation = formulation();
   last_.jacobian = J;
+  last_.residual = r;
+  last_.monodromy = M.allFinite() ? M : Matrix();
   return EvalStatus::ok;
 }
 
+Matrix OdeOrbitProblem::monodromy_from(const Matrix& A, ShootingFormulation formulation) const {
+  if (formulation == ShootingFormulation::displacement_periodicity) return A;  // A = d y(T) / d y0
+  // Reversibility (the header): M = R A^-1 R A with A over half the period.
+  const int d = dimension_;
+  Vector R = Vector::Ones(2 * d);
+  R.tail(d).setConstant(-1);
+  Eigen::PartialPivLU<Matrix> lu(A);
+  return R.asDiagonal() * lu.solve(Matrix(R.asDiagonal() * A));
+}
+
 EvalStatus OdeOrbitProblem::monodromy(const Vector& x, Matrix& M) const {
-  const int d = dimension_, n = 2 * d;
+  {
+    const std::lock_guard<std::mutex> lock(last_mutex_);
+    if (last_.x.size() == x.size() && last_.x == x && last_.monodromy.size() > 0) {
+      M = last_.monodromy;
+      return EvalStatus::ok;
+    }
+  }
+  const int d = dimension_;
   const double period = x[period_index()];
   if (!(period > 0) || !std::isfinite(period) || !x.head(d).allFinite())
     return EvalStatus::failed;
-  const Vector q0 = x.head(d);
-  // State [q | v | A (2d x 2d, column-major)], tolerances as in flow().
-  const int size = n + n * n;
-  const double floor = 1e-3 * options_.relative_tolerance;
-  Matrix stiffness_matrix(d, d);
-  acceleration_jacobian(q0.data(), stiffness_matrix);
-  const double stiffness =
-      std::max(stiffness_matrix.cwiseAbs().rowwise().sum().maxCoeff(), smallest_scale);
-  CvodeOptions cvode;
-  cvode.relative_tolerance = options_.relative_tolerance;
-  cvode.max_steps = options_.max_steps;
-  cvode.absolute_tolerance = Vector::Constant(size, floor);
-  cvode.absolute_tolerance.head(d).setConstant(floor * std::max(q0.norm(), smallest_scale));
-  cvode.absolute_tolerance.segment(d, d).setConstant(floor * velocity_scale(q0));
-  Vector y = Vector::Zero(size);
-  y.head(d) = q0;
-  Eigen::Map<Matrix>(y.data() + n, n, n).setIdentity();
-  // The A blocks: q rows are velocities' integrals (scale 1), v rows grow with sqrt(stiffness).
-  for (int j = 0; j < n; ++j)
-    cvode.absolute_tolerance.segment(n + j * n + d, d).setConstant(floor * std::sqrt(stiffness));
-  const OdeRightHandSide rhs = [this, d, n, K = Matrix(d, d)](double, const double* s,
-                                                              double* ds) mutable {
-    for (int i = 0; i < d; ++i) ds[i] = s[d + i];
-    acceleration(s, ds + d);
-    acceleration_jacobian(s, K);
-    const Eigen::Map<const Matrix> A(s + n, n, n);
-    Eigen::Map<Matrix> dA(ds + n, n, n);
-    dA.topRows(d) = A.bottomRows(d);
-    dA.bottomRows(d).noalias() = K * A.topRows(d);
-  };
-  if (!integrate_ode(rhs, y, 0.5 * period, cvode).ok) return EvalStatus::failed;
-  const Matrix A = Eigen::Map<const Matrix>(y.data() + n, n, n);
-  Vector R = Vector::Ones(n);
-  R.tail(d).setConstant(-1);
-  Eigen::PartialPivLU<Matrix> lu(A);
-  M = R.asDiagonal() * lu.solve(Matrix(R.asDiagonal() * A));
+  Vector q, v;
+  Matrix A;
+  if (!flow(x.head(d), 0.5 * period, q, v, nullptr, nullptr, &A)) return EvalStatus::failed;
+  M = monodromy_from(A, ShootingFormulation::half_period_velocity);
   return M.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 
@@ -245,6 +244,13 @@ EvalStatus OdeOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
   // 2d^2 components). Up to d = 2 every residual carries them (one flow per Newton iteration);
   // beyond, a residual is a bare flow and the Jacobian its own.
   if (dimension_ <= max_dimension_keeping_jacobian) {
+    {
+      const std::lock_guard<std::mutex> lock(last_mutex_);
+      if (last_.formulation == formulation() && last_.x.size() == x.size() && last_.x == x) {
+        r = last_.residual;
+        return EvalStatus::ok;
+      }
+    }
     Matrix J;
     return shoot(x, r, J);
   }

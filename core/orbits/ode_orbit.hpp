@@ -62,28 +62,32 @@ class OdeOrbitProblem : public PeriodicOrbitProblem, public FloquetProblem {
   // energy(x) stays pure virtual (PeriodicOrbitProblem): the potential at q0. It must read
   // x.head(d) only (flow calls it with T = 0 for the velocity scale of the tolerances).
 
-  // Flow from (q0, 0) over time t >= 0; with sensitivities (d x d each) when non-null.
+  // Flow from (q0, 0) over time t >= 0; with sensitivities (d x d each) when non-null, and the
+  // derivative of the full state (q, v)(t) with respect to (q0, v0) (2d x 2d) when `full` is.
   // Returns false when CVODE fails (or t < 0); q0 must have d entries.
   bool flow(const Vector& q0, double t, Vector& q, Vector& v, Matrix* dq_dq0 = nullptr,
-            Matrix* dv_dq0 = nullptr) const;
+            Matrix* dv_dq0 = nullptr, Matrix* full = nullptr) const;
 
   // Divisor of the residual at x for the current formulation (see above), with its gradient.
   virtual ResidualScale residual_scale(const Vector& x) const;
 
   // Monodromy of the full state (q, v), 2d x 2d, from half a period: the system is reversible
   // (v -> -v, R = diag(I, -I)) and the orbit from rest is at rest again at T/2, so with
-  // A = d(q, v)(T/2) / d(q0, v0), M = R A^-1 R A (core/README.md, section 'Stability'). One flow
-  // of T/2 with the 2d x 2d variational equations.
+  // A = d(q, v)(T/2) / d(q0, v0), M = R A^-1 R A (core/README.md, section 'Stability'). For
+  // d <= max_dimension_keeping_jacobian the last shot integrates A with the orbit and keeps M
+  // (free after the residual that accepted x; the paper formulation's shot over T gives M
+  // itself); else one flow of T/2 with the 2d x 2d variational equations.
   EvalStatus monodromy(const Vector& x, Matrix& M) const override;
   // Conservative: two multipliers at +1 (time shift and energy), M symplectic.
   FloquetStructure floquet_structure() const override { return {2, true}; }
 
  protected:
   // For d <= max_dimension_keeping_jacobian both integrate the variational equations alongside
-  // the orbit and keep the Jacobian of the last point, so Newton's jacobian(x) after the
-  // residual(x) that accepted x costs nothing: one flow per Newton iteration instead of a flow
-  // and a flow with sensitivities (measured: 1.55x a flow at d = 1, 1.74x at d = 2, 3.9x at
-  // d = 4, where a residual is a bare flow again).
+  // the orbit (all 2d columns, for the monodromy) and keep the residual, the Jacobian and the
+  // monodromy of the last point, so Newton's jacobian(x) after the residual(x) that accepted x,
+  // a second residual(x) and monodromy(x) cost nothing: one flow per Newton iteration instead of
+  // a flow and a flow with sensitivities (measured: 1.55x a flow at d = 1, 1.74x at d = 2, 3.9x
+  // at d = 4, where a residual is a bare flow again).
   EvalStatus compute_residual(const Vector& x, Vector& r) const override;
   EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override;
   // A subclass whose vector field or energy can change after construction (a parameter setter)
@@ -93,6 +97,8 @@ class OdeOrbitProblem : public PeriodicOrbitProblem, public FloquetProblem {
  private:
   // Residual and analytic Jacobian at x from one flow with sensitivities; remembers J at x.
   EvalStatus shoot(const Vector& x, Vector& r, Matrix& J) const;
+  // The monodromy from the shot's A (over T/2 for the regular formulation, T for the paper's).
+  Matrix monodromy_from(const Matrix& A, ShootingFormulation formulation) const;
   // Speed scale of the orbit from rest at q0: sqrt(2 energy), floored away from zero.
   double velocity_scale(const Vector& q0) const;
 
@@ -103,6 +109,8 @@ class OdeOrbitProblem : public PeriodicOrbitProblem, public FloquetProblem {
     Vector x;
     ShootingFormulation formulation = ShootingFormulation::half_period_velocity;
     Matrix jacobian;
+    Vector residual;
+    Matrix monodromy;  // empty when it was not finite
   };
   mutable std::mutex last_mutex_;
   mutable LastShot last_;
