@@ -48,7 +48,7 @@ double test_of(Kind k, const core::Floquet& f) {
     case Kind::period_doubling:
       return f.period_doubling_test;
     case Kind::torus:
-      return f.outside.complex;
+      return f.torus_test;
   }
   return nan;
 }
@@ -103,7 +103,7 @@ OrbitBifurcation locate(const core::Problem& problem, core::Corrector& corrector
   Sample lo{true, 0.0, pa.x, *pa.floquet}, hi{true, 1.0, pb.x, *pb.floquet};
   const int count_lo = count_of(kind, lo.floquet.outside);
   double f_lo = test_of(kind, lo.floquet), f_hi = test_of(kind, hi.floquet);
-  const bool signed_test = kind != Kind::torus && f_lo * f_hi < 0;
+  const bool signed_test = f_lo * f_hi < 0;
   enum class End { none, lower, upper } replaced = End::none;  // Illinois: which end moved last
   Sample best = hi;
   bool located = false;

@@ -7,12 +7,15 @@
 //   fold              a real multiplier crosses +1 (test: prod (mu - 1), a sign change);
 //   period_doubling   a real multiplier crosses -1, or a conservative pair collides there
 //                     (test: prod (mu + 1), a sign change);
-//   torus             a complex pair leaves the circle (Neimark-Sacker; in a conservative
-//                     problem a Krein collision): located by bisection on the count.
+//   torus             a complex pair leaves the circle (Neimark-Sacker; test: the largest
+//                     complex |mu| less 1, a sign change; in a conservative problem a Krein
+//                     collision, where the pair leaves from the circle and the test does not
+//                     change sign: located by bisection on the count).
 // A point between the two is corrected on the hyperplane through x_a + s (x_b - x_a) normal to
-// x_b - x_a; s is found by the Illinois variant of regula falsi on the test (bisection on the
-// count for a torus) until the bracket is below 1e-13 of the chord or the test is exactly 0.
-// The multipliers are computed again at the located orbit.
+// x_b - x_a; s is found by the Illinois variant of regula falsi on the test where it changes
+// sign, by bisection on the count elsewhere, until the bracket is below 1e-10 of the orbit's
+// size (max(1, |x|), in the unknowns: the test's sign is noise closer than that) or the test is
+// exactly 0. The multipliers are computed again at the located orbit.
 //
 // Grazing: a problem naming grazing observables (core::FloquetProblem::grazing_observables, an
 // event speed that is 0 where the orbit meets a switching surface tangentially) has no

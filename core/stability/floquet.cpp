@@ -36,7 +36,7 @@ Floquet undecided_floquet(int size) {
   f.multipliers.assign(size, {nan, nan});
   f.trivial.assign(size, false);
   f.max_modulus = f.trivial_distance = f.determinant = f.pairing_error = nan;
-  f.period_doubling_test = f.fold_test = nan;
+  f.period_doubling_test = f.fold_test = f.torus_test = nan;
   return f;
 }
 
@@ -70,6 +70,7 @@ Floquet analyse_monodromy(const Matrix& M, const FloquetStructure& structure,
   }
 
   f.max_modulus = nan;
+  f.torus_test = nan;
   // Over a real M's non-trivial multipliers, closed under conjugation: the products are real.
   std::complex<double> doubling = 1, fold = 1;
   for (int i = 0; i < n; ++i) {
@@ -80,6 +81,8 @@ Floquet analyse_monodromy(const Matrix& M, const FloquetStructure& structure,
     const double weight = std::max(1.0, modulus);
     doubling *= (mu + 1.0) / weight;
     fold *= (mu - 1.0) / weight;
+    if (std::abs(mu.imag()) > real_share * modulus)
+      f.torus_test = std::isnan(f.torus_test) ? modulus - 1 : std::max(f.torus_test, modulus - 1);
     if (modulus > 1 + options.tolerance) {
       ++f.unstable;
       if (std::abs(mu.imag()) > real_share * modulus)

@@ -73,6 +73,10 @@ struct Floquet {
   // +1 (fold), over the non-trivial multipliers: prod (mu + 1) and prod (mu - 1), each factor
   // normalised by max(1, |mu|) so that a product stays of order one.
   double period_doubling_test = 0, fold_test = 0;
+  // The largest modulus of a complex non-trivial multiplier, less 1 (NaN: none is complex): its
+  // sign changes where a pair leaves the circle off the real axis (a torus). A conservative pair
+  // that collides on the circle and leaves it (Krein) goes from 0 to positive instead.
+  double torus_test = 0;
 };
 
 // Eigenvalues of M with the trivial ones identified (the structure's count, nearest to +1) and
