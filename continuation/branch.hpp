@@ -138,11 +138,12 @@ struct Branch {
 // Columns: point, then every observable by name (in the order of the first point), then, when
 // the first point has multipliers, stable (1, 0, -1 undecided), unstable_multipliers,
 // max_multiplier_modulus (non-trivial ones), trivial_multiplier_distance (largest |mu - 1| of the
-// trivial ones) and monodromy_determinant, then dimension, dimension_flag (DimensionFlag: 0 as verified, 1 re-checked along the tangent, 2
-// below the curve's 1 and unconfirmed), nullity (candidate, -1 when unchecked), sigma_zero and
-// sigma_kept (largest singular value counted as zero and smallest kept, relative to the largest),
-// residual, newton_iterations, step_size, arclength, jacobian_evaluations,
-// residual_evaluations. Repeated runs write it bit for bit: it holds no wall time.
+// trivial ones) and monodromy_determinant, then dimension, dimension_flag (DimensionFlag: 0 as
+// verified, 1 re-checked along the tangent, 2 below the curve's 1 and unconfirmed), nullity
+// (candidate, -1 when unchecked), sigma_zero and sigma_kept (largest singular value counted as zero
+// and smallest kept, relative to the largest), residual, newton_iterations, step_size, arclength,
+// jacobian_evaluations, residual_evaluations. Repeated runs write it bit for bit: it holds no wall
+// time.
 core::Table branch_table(const Branch& branch);
 
 // multipliers.csv: one row per point and multiplier (points with multipliers only): point, index

@@ -38,8 +38,8 @@ std::string stability_datablocks(const core::Table& table, const std::string& x,
   for (std::size_t i = 0; i + 1 < xs.size() || (xs.size() == 1 && i == 0); ++i) {
     const int kind = std::clamp(static_cast<int>(kinds[i]), -1, 1) + 1;
     const std::size_t next = std::min(i + 1, xs.size() - 1);
-    blocks[kind] += fmt::format("{:.17g},{:.17g}\n{:.17g},{:.17g}\n\n", xs[i], ys[i], xs[next],
-                                ys[next]);
+    blocks[kind] +=
+        fmt::format("{:.17g},{:.17g}\n{:.17g},{:.17g}\n\n", xs[i], ys[i], xs[next], ys[next]);
   }
   std::string text;
   const char* names[3] = {"undecided", "unstable", "stable"};
@@ -80,21 +80,21 @@ std::string branch_plot_script(const std::filesystem::path& csv, const core::Tab
   };
   // The header is read by `set key autotitle columnhead` (core::render_png): no `skip`, which
   // would drop the first point as well.
-  const std::string frame =
-      fmt::format("set key top left\nset grid\n{}set xlabel '{}' noenhanced\n"
-                  "set ylabel '{}' noenhanced\nset title '{}' noenhanced\n",
-                  log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", label(x), label(y),
-                  title);
+  const std::string frame = fmt::format(
+      "set key top left\nset grid\n{}set xlabel '{}' noenhanced\n"
+      "set ylabel '{}' noenhanced\nset title '{}' noenhanced\n",
+      log_x ? "set logscale x\nset format x '10^{%L}'\n" : "", label(x), label(y), title);
   const int stable = column_of("stable");
   if (stable == 0)
     return frame + fmt::format("plot {} using {}:{} with linespoints pt 7 ps 0.6 title 'branch'\n",
-                              core::gnuplot_quote(csv), x, y);
+                               core::gnuplot_quote(csv), x, y);
   return frame + stability_datablocks(table, columns[x - 1], columns[y - 1], "") +
-         fmt::format("plot $stable with lines lw 2 lc rgb '#1f77b4' title 'stable', "
-                     "$unstable with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable', "
-                     "$undecided with lines lw 1 dt 3 lc rgb 'gray40' title 'undecided', "
-                     "{} using {}:{} with points pt 7 ps 0.5 lc rgb 'black' title 'points'\n",
-                     core::gnuplot_quote(csv), x, y);
+         fmt::format(
+             "plot $stable with lines lw 2 lc rgb '#1f77b4' title 'stable', "
+             "$unstable with lines lw 2 dt 2 lc rgb '#d62728' title 'unstable', "
+             "$undecided with lines lw 1 dt 3 lc rgb 'gray40' title 'undecided', "
+             "{} using {}:{} with points pt 7 ps 0.5 lc rgb 'black' title 'points'\n",
+             core::gnuplot_quote(csv), x, y);
 }
 
 void plot_branch(const std::filesystem::path& out, const core::Table& table,
@@ -371,7 +371,6 @@ Branch whole_branch(const std::filesystem::path& dir, const core::Problem& probl
 }
 
 namespace {
-
 
 // Rows of `saved` whose `column` is below `below`, then those of `fresh`, in the layout of the
 // one whose columns include the other's (cells of a missing column NaN): a table whose rows are

@@ -8,10 +8,11 @@
 
 namespace backbone::cli {
 
-std::vector<continuation::OrbitBifurcation> report_stability(
-    const core::Problem& problem, const continuation::Branch& whole,
-    const core::FloquetOptions& floquet, core::Corrector& corrector,
-    const std::filesystem::path& out) {
+std::vector<continuation::OrbitBifurcation> report_stability(const core::Problem& problem,
+                                                             const continuation::Branch& whole,
+                                                             const core::FloquetOptions& floquet,
+                                                             core::Corrector& corrector,
+                                                             const std::filesystem::path& out) {
   if (whole.points.empty() || !whole.points.front().floquet) return {};
   int counts[3] = {0, 0, 0};  // undecided, unstable, stable
   double trivial = 0, determinant = 0, pairing = 0;
@@ -26,16 +27,18 @@ std::vector<continuation::OrbitBifurcation> report_stability(
       pairing = std::max(pairing, f.pairing_error);
     }
   }
-  fmt::print("stability: {} stable, {} unstable, {} undecided points (|mu| > 1 + {:g} counts as "
-             "unstable; multipliers.csv)\n",
-             counts[2], counts[1], counts[0], floquet.tolerance);
+  fmt::print(
+      "stability: {} stable, {} unstable, {} undecided points (|mu| > 1 + {:g} counts as "
+      "unstable; multipliers.csv)\n",
+      counts[2], counts[1], counts[0], floquet.tolerance);
   if (orbit && orbit->floquet_structure().trivial > 0)
     fmt::print("  trivial multipliers ({} at +1): worst |mu - 1| = {:.2e} (tolerance {:g})\n",
                orbit->floquet_structure().trivial, trivial, floquet.trivial_tolerance);
   if (conservative)
-    fmt::print("  conservative structure: worst |det M - 1| = {:.2e}, worst pairing "
-               "min_j |mu_i mu_j - 1| = {:.2e}\n",
-               determinant, pairing);
+    fmt::print(
+        "  conservative structure: worst |det M - 1| = {:.2e}, worst pairing "
+        "min_j |mu_i mu_j - 1| = {:.2e}\n",
+        determinant, pairing);
   std::fflush(stdout);
   const auto found = continuation::detect_orbit_bifurcations(
       problem, whole, corrector, floquet, [](const continuation::OrbitBifurcation& b) {

@@ -19,9 +19,10 @@
 namespace backbone::cli {
 
 // Nothing (an empty list, no file) when the branch's points carry no multipliers.
-std::vector<continuation::OrbitBifurcation> report_stability(
-    const core::Problem& problem, const continuation::Branch& whole,
-    const core::FloquetOptions& floquet, core::Corrector& corrector,
-    const std::filesystem::path& out);
+std::vector<continuation::OrbitBifurcation> report_stability(const core::Problem& problem,
+                                                             const continuation::Branch& whole,
+                                                             const core::FloquetOptions& floquet,
+                                                             core::Corrector& corrector,
+                                                             const std::filesystem::path& out);
 
 }  // namespace backbone::cli

@@ -9,9 +9,9 @@
 
 #include "continuation/branch.hpp"
 #include "continuation/branch_points/follow.hpp"
+#include "continuation/cli/progress.hpp"
 #include "continuation/cli/stability_report.hpp"
 #include "continuation/orbit_bifurcations/doubling.hpp"
-#include "continuation/cli/progress.hpp"
 #include "core/errors.hpp"
 #include "core/io/output_folder.hpp"
 #include "core/io/scene_ini.hpp"
@@ -292,8 +292,8 @@ bool follow_doublings(TraceRun& t, const std::vector<continuation::OrbitBifurcat
     if (d.branch.points.empty() || d.branch.ended_early()) complete = false;
     if (d.branch.points.empty()) continue;
     continuation::plot_branch(dir, core::Table::read_csv(dir / "branch.csv"),
-                              fmt::format("{} / period doubling {} ({} points)", t.entry->name,
-                                          k, d.branch.points.size()),
+                              fmt::format("{} / period doubling {} ({} points)", t.entry->name, k,
+                                          d.branch.points.size()),
                               t.entry->units, t.entry->branch_axes);
     report_stability(*d.problem, d.branch, o.floquet, corrector, dir);
   }

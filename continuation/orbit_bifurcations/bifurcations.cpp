@@ -126,8 +126,8 @@ OrbitBifurcation locate(const core::Problem& problem, core::Corrector& corrector
       located = true;
       break;
     }
-    const bool with_lo = signed_test ? (f_m * f_lo > 0)
-                                     : (count_of(kind, m.floquet.outside) == count_lo);
+    const bool with_lo =
+        signed_test ? (f_m * f_lo > 0) : (count_of(kind, m.floquet.outside) == count_lo);
     // An end kept twice in a row has its test value halved (Illinois), so that regula falsi
     // does not creep up from one side.
     if (with_lo) {
@@ -172,8 +172,7 @@ std::optional<OrbitBifurcation> locate_grazing(const core::Problem& problem,
   const BranchPoint& last = points.back();
   const double g_end = last.observable(name);
   const double g_before = points[points.size() - 2].observable(name);
-  if (!(g_end > 0 && g_end <= smallest && g_end < grazing_fraction * largest &&
-        g_end < g_before))
+  if (!(g_end > 0 && g_end <= smallest && g_end < grazing_fraction * largest && g_end < g_before))
     return std::nullopt;
   const auto grazing = orbit.grazing_problem(name, last.x);
   if (!grazing) return std::nullopt;
@@ -184,9 +183,9 @@ std::optional<OrbitBifurcation> locate_grazing(const core::Problem& problem,
   b.location_steps = 1;
   // A correction that stalls within 1e-8 has reached the noise of the shots near grazing.
   const core::NewtonSummary summary = corrector.solve(*grazing, b.x);
-  b.located = summary.converged() || (summary.status == core::NewtonStatus::stalled &&
-                                      summary.final_residual() >= 0 &&
-                                      summary.final_residual() <= 1e-8);
+  b.located =
+      summary.converged() || (summary.status == core::NewtonStatus::stalled &&
+                              summary.final_residual() >= 0 && summary.final_residual() <= 1e-8);
   b.observables = grazing->observables(b.x);
   b.floquet = last.floquet ? *last.floquet : core::undecided_floquet(0);
   b.test_value = 0;
@@ -228,8 +227,10 @@ std::vector<OrbitBifurcation> detect_orbit_bifurcations(
       }
     if (!any)
       for (const std::string& name : unlocated)
-        fmt::print(stderr, "backbone: {} falls towards 0 at the end of the branch, but no grazing "
-                           "orbit was corrected from its last point\n", name);
+        fmt::print(stderr,
+                   "backbone: {} falls towards 0 at the end of the branch, but no grazing "
+                   "orbit was corrected from its last point\n",
+                   name);
   }
   return found;
 }
@@ -265,16 +266,16 @@ core::Table bifurcation_table(const std::vector<OrbitBifurcation>& found,
       row.push_back(has ? b.floquet.multipliers[k].real() : nan);
       row.push_back(has ? b.floquet.multipliers[k].imag() : nan);
     }
-    row.insert(row.end(), {b.located ? 1.0 : 0.0, static_cast<double>(b.after_point),
-                           b.test_value, static_cast<double>(b.location_steps)});
+    row.insert(row.end(), {b.located ? 1.0 : 0.0, static_cast<double>(b.after_point), b.test_value,
+                           static_cast<double>(b.location_steps)});
     table.add_row(b.type, row);
   }
   return table;
 }
 
 std::string bifurcation_line(const OrbitBifurcation& b) {
-  std::string line = fmt::format("{}{} after point {}:", b.type, b.located ? "" : " (not located)",
-                                 b.after_point);
+  std::string line =
+      fmt::format("{}{} after point {}:", b.type, b.located ? "" : " (not located)", b.after_point);
   for (const auto& [key, value] : b.observables) line += fmt::format(" {} {:.12g}", key, value);
   line += "  multipliers";
   for (const auto& mu : b.floquet.multipliers)

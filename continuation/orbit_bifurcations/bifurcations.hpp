@@ -21,14 +21,16 @@
 // event speed that is 0 where the orbit meets a switching surface tangentially) has no
 // saltation matrix at the grazing orbit, so the branch cannot reach it. When such an observable g
 // falls towards 0 at the end of a branch that did not stop on its point budget (its smallest
-// value on the branch, below half its largest, and falling), the problem's grazing problem (FloquetProblem::grazing_problem: the orbit with that
-// event off whose extremum lies on the surface, a smooth system) is corrected from the branch's
-// last point: the located grazing orbit itself. Its multipliers are reported from the branch's
-// last point (on the impacting side they grow like 1 / g).
+// value on the branch, below half its largest, and falling), the problem's grazing problem
+// (FloquetProblem::grazing_problem: the orbit with that event off whose extremum lies on the
+// surface, a smooth system) is corrected from the branch's last point: the located grazing orbit
+// itself. Its multipliers are reported from the branch's last point (on the impacting side they
+// grow like 1 / g).
 //
 //   auto found = detect_orbit_bifurcations(problem, branch, *corrector, options.floquet,
 //                                          [](const OrbitBifurcation& b) { print(b); });
-//   bifurcation_table(found, branch.points.front().observables).write_csv(out / "bifurcations.csv");
+//   bifurcation_table(found, branch.points.front().observables).write_csv(out /
+//   "bifurcations.csv");
 #pragma once
 
 #include <functional>
@@ -44,14 +46,14 @@
 namespace backbone::continuation {
 
 struct OrbitBifurcation {
-  std::string type;       // fold, period_doubling, torus, grazing
-  int after_point = 0;    // between this point of the branch and the next (grazing: the last)
-  bool located = false;   // the location converged (else x is the best bracket end)
-  core::Vector x;         // the located orbit (problem's unknowns)
+  std::string type;      // fold, period_doubling, torus, grazing
+  int after_point = 0;   // between this point of the branch and the next (grazing: the last)
+  bool located = false;  // the location converged (else x is the best bracket end)
+  core::Vector x;        // the located orbit (problem's unknowns)
   core::Observables observables;
-  core::Floquet floquet;  // recomputed at x (grazing: at the nearest corrected orbit)
-  double test_value = 0;  // the test function at x (grazing: g, 0 by construction)
-  int location_steps = 0; // corrected points spent
+  core::Floquet floquet;   // recomputed at x (grazing: at the nearest corrected orbit)
+  double test_value = 0;   // the test function at x (grazing: g, 0 by construction)
+  int location_steps = 0;  // corrected points spent
 };
 
 // Detects and locates the bifurcations of branch (whose points carry multipliers), in order;

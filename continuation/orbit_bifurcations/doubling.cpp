@@ -12,9 +12,8 @@
 
 namespace backbone::continuation {
 
-DoubledBranch follow_period_doubling(const core::Problem& problem,
-                                     const OrbitBifurcation& doubling, core::Corrector& corrector,
-                                     const ContinuationOptions& options,
+DoubledBranch follow_period_doubling(const core::Problem& problem, const OrbitBifurcation& doubling,
+                                     core::Corrector& corrector, const ContinuationOptions& options,
                                      const ContinuationHooks& hooks) {
   DoubledBranch d;
   const auto* orbit = dynamic_cast<const core::FloquetProblem*>(&problem);

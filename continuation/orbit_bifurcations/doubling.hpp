@@ -35,9 +35,8 @@ struct DoubledBranch {
 
 // hooks.on_point sees every point of the doubled branch (BranchWriter). Never throws on
 // numerical failure.
-DoubledBranch follow_period_doubling(const core::Problem& problem,
-                                     const OrbitBifurcation& doubling, core::Corrector& corrector,
-                                     const ContinuationOptions& options,
+DoubledBranch follow_period_doubling(const core::Problem& problem, const OrbitBifurcation& doubling,
+                                     core::Corrector& corrector, const ContinuationOptions& options,
                                      const ContinuationHooks& hooks = {});
 
 }  // namespace backbone::continuation

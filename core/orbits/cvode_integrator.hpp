@@ -50,7 +50,7 @@ IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t
 using OdeRootFunctions = std::function<void(double t, const double* y, double* g)>;
 
 struct SegmentResult : IntegrationResult {
-  double t = 0;           // where the segment ended: t_end, or the first root found
+  double t = 0;            // where the segment ended: t_end, or the first root found
   std::vector<int> roots;  // the root functions that vanished at t (empty: t = t_end)
 };
 

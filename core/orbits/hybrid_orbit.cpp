@@ -115,8 +115,8 @@ std::vector<std::string> HybridOrbitProblem::grazing_observables() const {
 void HybridOrbitProblem::set_parameter(const std::string& name, double value) {
   const auto it = std::find(names_.begin(), names_.end(), name);
   if (it == names_.end())
-    throw InputError(name, fmt::format("is not a parameter of {} (its parameters: {})", this->name(),
-                                       fmt::join(names_, ", ")));
+    throw InputError(name, fmt::format("is not a parameter of {} (its parameters: {})",
+                                       this->name(), fmt::join(names_, ", ")));
   if (!std::isfinite(value)) throw InputError(name, fmt::format("must be finite (got {})", value));
   parameters_[it - names_.begin()] = value;
   forget_last_shot();
@@ -202,7 +202,8 @@ HybridShot HybridOrbitProblem::shoot_without(const Vector& x, const Suppression&
   return shoot_uncached(x, suppressed);
 }
 
-HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, const Suppression& suppressed) const {
+HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x,
+                                              const Suppression& suppressed) const {
   const int n = n_, K = num_events();
   if (x.size() != num_unknowns() || !x.allFinite())
     return failed(HybridShot::Failure::period, "the unknowns are not finite");
@@ -230,9 +231,8 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, const Suppression
   cvode.absolute_tolerance.head(n).setConstant(1e-3 * options_.relative_tolerance * amplitude);
 
   // Each right-hand side call works in its own copies (concurrent shots share nothing).
-  const OdeRightHandSide rhs = [this, n, p, p_plus, p_minus, dp, A = Matrix(n, n),
-                                fp = Vector(n), fm = Vector(n)](double t, const double* s,
-                                                               double* ds) mutable {
+  const OdeRightHandSide rhs = [this, n, p, p_plus, p_minus, dp, A = Matrix(n, n), fp = Vector(n),
+                                fm = Vector(n)](double t, const double* s, double* ds) mutable {
     field(t, s, p, ds);
     field_jacobian(t, s, p, A);
     const Eigen::Map<const Matrix> Phi(s + n, n, n);
@@ -244,9 +244,9 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, const Suppression
   };
   // Roots 0..K-1: the events; K..2K-1: their companions, dh/dt along the flow (header).
   const double time_step = central_step(T);
-  const OdeRootFunctions roots = [this, n, K, p, T, time_step, suppressed, f = Vector(n), ahead = Vector(n),
-                                  behind = Vector(n)](double t, const double* s,
-                                                      double* g) mutable {
+  const OdeRootFunctions roots = [this, n, K, p, T, time_step, suppressed, f = Vector(n),
+                                  ahead = Vector(n), behind = Vector(n)](double t, const double* s,
+                                                                         double* g) mutable {
     field(t, s, p, f.data());
     const Eigen::Map<const Vector> y(s, n);
     ahead = y + time_step * f;
@@ -254,11 +254,11 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, const Suppression
     for (int k = 0; k < K; ++k) {
       // A switched-off event stays on its near side (no change of sign at the window's ends,
       // where the orbit is away from the surface).
-      g[k] = suppressed.covers(k, t, T) ? -(event_direction(k) < 0 ? -1.0 : 1.0)
-                                        : event(k, t, s, p);
-      g[K + k] = (event(k, t + time_step, ahead.data(), p) -
-                  event(k, t - time_step, behind.data(), p)) /
-                 (2 * time_step);
+      g[k] =
+          suppressed.covers(k, t, T) ? -(event_direction(k) < 0 ? -1.0 : 1.0) : event(k, t, s, p);
+      g[K + k] =
+          (event(k, t + time_step, ahead.data(), p) - event(k, t - time_step, behind.data(), p)) /
+          (2 * time_step);
     }
   };
   std::vector<int> directions(2 * K);
@@ -292,8 +292,7 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, const Suppression
       if (suppressed.covers(k, t, T)) continue;
       // Lost only when the segment started on the near side (a segment that starts on the
       // surface, after an event, may reach beyond it: a switch without a jump).
-      if ((dir > 0 && h0 < 0 && h > 0) || (dir < 0 && h0 > 0 && h < 0) ||
-          (dir == 0 && h * h0 < 0))
+      if ((dir > 0 && h0 < 0 && h > 0) || (dir < 0 && h0 > 0 && h < 0) || (dir == 0 && h * h0 < 0))
         lost = true;
     }
     if (lost) {
@@ -319,9 +318,9 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x, const Suppression
       if (r >= K) continue;
       const int k = r;
       if (static_cast<int>(shot.events.size()) >= options_.max_events)
-        return failed(HybridShot::Failure::too_many_events,
-                      fmt::format("more than {} events in a period (max_events)",
-                                  options_.max_events));
+        return failed(
+            HybridShot::Failure::too_many_events,
+            fmt::format("more than {} events in a period (max_events)", options_.max_events));
       const Vector y_minus = Y.head(n);
       field(t, y_minus.data(), p, f_minus.data());
       double dh_dt = 0;
@@ -434,7 +433,8 @@ Observables HybridOrbitProblem::observables(const Vector& x) const {
   for (std::size_t i = 0; i < names_.size(); ++i) o.emplace_back(names_[i], p[i]);
   const HybridShot shot = shoot(x);
   double speed = nan;
-  for (const HybridEvent& e : shot.events) speed = std::isnan(speed) ? e.speed : std::min(speed, e.speed);
+  for (const HybridEvent& e : shot.events)
+    speed = std::isnan(speed) ? e.speed : std::min(speed, e.speed);
   o.emplace_back(event_count_name(), shot.ok ? static_cast<double>(shot.events.size()) : nan);
   o.emplace_back(event_speed_name(), shot.ok ? speed : nan);
   double gap = nan;
@@ -446,8 +446,8 @@ Observables HybridOrbitProblem::observables(const Vector& x) const {
 
 void HybridOrbitProblem::check_guess(const Vector& x) const {
   if (x.size() != num_unknowns())
-    throw InputError("guess", fmt::format("has {} entries for {} unknowns", x.size(),
-                                          num_unknowns()));
+    throw InputError("guess",
+                     fmt::format("has {} entries for {} unknowns", x.size(), num_unknowns()));
   if (!x.allFinite()) throw InputError("guess", "contains NaN or Inf");
   const Vector p = parameters_at(x);
   if (forced()) {
@@ -461,8 +461,8 @@ void HybridOrbitProblem::check_guess(const Vector& x) const {
   const HybridShot shot = shoot(x);
   if (shot.failure == HybridShot::Failure::reset) throw InputError("reset", shot.message);
   if (shot.failure == HybridShot::Failure::integration)
-    throw InputError("field", fmt::format("the guess's orbit cannot be integrated: {}",
-                                          shot.message));
+    throw InputError("field",
+                     fmt::format("the guess's orbit cannot be integrated: {}", shot.message));
   if (!shot.ok) return;  // a numerical failure: the corrector may still move off it
   for (int k = 0; k < num_events(); ++k) {
     if (!event_required(k)) continue;
@@ -507,8 +507,8 @@ std::unique_ptr<Problem> HybridOrbitProblem::grazing_problem(const std::string& 
     const double gap = std::abs(e.time - time);
     half_gap = std::min(half_gap, 0.5 * std::min(gap, shot.period - gap));
   }
-  return std::make_unique<GrazingOrbitProblem>(*this,
-                                               Suppression{event, time - half_gap, time + half_gap});
+  return std::make_unique<GrazingOrbitProblem>(
+      *this, Suppression{event, time - half_gap, time + half_gap});
 }
 
 GrazingOrbitProblem::GrazingOrbitProblem(const HybridOrbitProblem& base,

@@ -66,11 +66,11 @@ struct HybridOrbitOptions {
 
 // One event of a shot orbit.
 struct HybridEvent {
-  int which = 0;      // event index k
-  double time = 0;    // in [0, T]
-  Vector before;      // y-
-  Vector after;       // y+ = g_k(y-)
-  double speed = 0;   // D / |n|: the speed at which the orbit meets the surface (> 0)
+  int which = 0;     // event index k
+  double time = 0;   // in [0, T]
+  Vector before;     // y-
+  Vector after;      // y+ = g_k(y-)
+  double speed = 0;  // D / |n|: the speed at which the orbit meets the surface (> 0)
 };
 
 // What one shot from y0 over the period found.
@@ -78,10 +78,10 @@ struct HybridShot {
   enum class Failure { none, period, integration, reset, grazing, too_many_events, lost_event };
   bool ok = false;
   Failure failure = Failure::none;
-  std::string message;     // why not
-  Vector end;              // y(T)
-  Matrix monodromy;        // Phi(T) = dy(T)/dy0, n x n
-  Vector parameter_column; // dy(T)/dp_free at fixed T
+  std::string message;      // why not
+  Vector end;               // y(T)
+  Matrix monodromy;         // Phi(T) = dy(T)/dy0, n x n
+  Vector parameter_column;  // dy(T)/dp_free at fixed T
   std::vector<HybridEvent> events;
   // Per event k: the largest value of h_k (times its direction, +1 for direction 0) at the
   // extrema between its crossings, the companion roots; -inf when there is none.

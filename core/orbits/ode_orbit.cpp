@@ -120,8 +120,8 @@ bool OdeOrbitProblem::flow(const Vector& q0, double t, Vector& q, Vector& v, Mat
   }
 
   // The workspace lives in this call's copy of the lambda: concurrent flows share nothing.
-  const OdeRightHandSide rhs = [this, d, k, stiffness = Matrix(d, d)](
-                                   double, const double* s, double* ds) mutable {
+  const OdeRightHandSide rhs = [this, d, k, stiffness = Matrix(d, d)](double, const double* s,
+                                                                      double* ds) mutable {
     for (int i = 0; i < d; ++i) ds[i] = s[d + i];
     acceleration(s, ds + d);
     if (k == 0) return;
@@ -224,8 +224,7 @@ EvalStatus OdeOrbitProblem::monodromy(const Vector& x, Matrix& M) const {
   }
   const int d = dimension_;
   const double period = x[period_index()];
-  if (!(period > 0) || !std::isfinite(period) || !x.head(d).allFinite())
-    return EvalStatus::failed;
+  if (!(period > 0) || !std::isfinite(period) || !x.head(d).allFinite()) return EvalStatus::failed;
   Vector q, v;
   Matrix A;
   if (!flow(x.head(d), 0.5 * period, q, v, nullptr, nullptr, &A)) return EvalStatus::failed;

@@ -63,12 +63,12 @@ struct Floquet {
   // be built or its eigenvalues not computed, or the trivial multipliers are not within
   // trivial_tolerance of +1).
   int stable = -1;
-  int unstable = 0;              // non-trivial multipliers with |mu| > 1 + tolerance
-  double max_modulus = 0;        // largest |mu| among the non-trivial ones (NaN: none, or no M)
-  double trivial_distance = 0;   // largest |mu - 1| among the trivial ones (0: none)
-  double determinant = 0;        // det M
-  double pairing_error = 0;      // conservative problems: max_i min_j |mu_i mu_j - 1|, else NaN
-  OutsideCounts outside;         // where the unstable ones lie
+  int unstable = 0;             // non-trivial multipliers with |mu| > 1 + tolerance
+  double max_modulus = 0;       // largest |mu| among the non-trivial ones (NaN: none, or no M)
+  double trivial_distance = 0;  // largest |mu - 1| among the trivial ones (0: none)
+  double determinant = 0;       // det M
+  double pairing_error = 0;     // conservative problems: max_i min_j |mu_i mu_j - 1|, else NaN
+  OutsideCounts outside;        // where the unstable ones lie
   // Test functions whose sign changes where a real multiplier crosses -1 (period doubling) or
   // +1 (fold), over the non-trivial multipliers: prod (mu + 1) and prod (mu - 1), each factor
   // normalised by max(1, |mu|) so that a product stays of order one.

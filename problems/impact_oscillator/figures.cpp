@@ -38,8 +38,9 @@ std::vector<std::pair<std::string, fs::path>> branches_of(const fs::path& out, c
   std::vector<std::pair<std::string, fs::path>> found;
   const fs::path up = folder(out) / fmt::format("{}_up", c.name);
   const fs::path down = folder(out) / fmt::format("{}_down", c.name);
-  for (const auto& [name, dir] : {std::pair{std::string("up"), up}, std::pair{std::string("down"), down},
-                                  std::pair{std::string("period2"), down / "period_doubling_1"}})
+  for (const auto& [name, dir] :
+       {std::pair{std::string("up"), up}, std::pair{std::string("down"), down},
+        std::pair{std::string("period2"), down / "period_doubling_1"}})
     if (fs::exists(dir / "branch.csv")) found.emplace_back(name, dir);
   return found;
 }
@@ -62,8 +63,9 @@ int draw_diagram(const fs::path& out) {
   if (!fs::is_directory(folder(out))) return skipped(out);
   std::string data, plots;
   int panel = 0;
-  std::string script = "set multiplot layout 1,2\nset grid\nset key bottom left\n"
-                       "set xlabel 'wall sigma'\nset ylabel 'impact velocity'\n";
+  std::string script =
+      "set multiplot layout 1,2\nset grid\nset key bottom left\n"
+      "set xlabel 'wall sigma'\nset ylabel 'impact velocity'\n";
   bool any = false;
   for (const Case& c : cases) {
     const auto branches = branches_of(out, c);
@@ -144,27 +146,29 @@ int draw_multipliers(const fs::path& out) {
     for (std::size_t i = 0; i < b.rows(); ++i)
       if (b.text_column("type")[i] == "period_doubling")
         for (int k = 0; k < 2; ++k)
-          data += fmt::format("{:.17g},{:.17g}\n",
-                              b.column(fmt::format("multiplier_{}_re", k))[i],
+          data += fmt::format("{:.17g},{:.17g}\n", b.column(fmt::format("multiplier_{}_re", k))[i],
                               b.column(fmt::format("multiplier_{}_im", k))[i]);
     data += "nan,nan\nEOD\n";
-    plots += "$doubling using 're':'im' with points pt 9 ps 1.8 lc rgb '#d62728' "
-             "title 'period doubling', ";
+    plots +=
+        "$doubling using 're':'im' with points pt 9 ps 1.8 lc rgb '#d62728' "
+        "title 'period doubling', ";
   }
   const fs::path period2 = down / "period_doubling_1";
   if (fs::exists(period2 / "multipliers.csv")) {
     data += multiplier_block(period2, 0, "period2");
-    plots += "$period2 using 're':'im' with points pt 11 ps 1.6 lc rgb '#2ca02c' "
-             "title 'period 2, first point', ";
+    plots +=
+        "$period2 using 're':'im' with points pt 11 ps 1.6 lc rgb '#2ca02c' "
+        "title 'period 2, first point', ";
   }
   plots.resize(plots.size() - 2);
-  const std::string script = data +
-                             "set size ratio -1\nset grid\nset key outside right\n"
-                             "set xlabel 'Re mu'\nset ylabel 'Im mu'\nset xrange [-3.5:1.5]\n"
-                             "set yrange [-1.5:1.5]\nset parametric\nset trange [0:2*pi]\n"
-                             "set title 'Floquet multipliers, omega 2.8, r = 0.8'\n"
-                             "plot cos(t), sin(t) with lines lc rgb 'gray50' title 'unit circle', " +
-                             plots + "\n";
+  const std::string script =
+      data +
+      "set size ratio -1\nset grid\nset key outside right\n"
+      "set xlabel 'Re mu'\nset ylabel 'Im mu'\nset xrange [-3.5:1.5]\n"
+      "set yrange [-1.5:1.5]\nset parametric\nset trange [0:2*pi]\n"
+      "set title 'Floquet multipliers, omega 2.8, r = 0.8'\n"
+      "plot cos(t), sin(t) with lines lc rgb 'gray50' title 'unit circle', " +
+      plots + "\n";
   const fs::path png = folder(out) / "multipliers.png";
   report(core::render_png(png, script, {1100, 650}), png);
   return 0;
@@ -259,8 +263,7 @@ std::vector<cli::ProblemJob> figure_jobs() {
            "impact_oscillator/multipliers.png: multipliers in the complex plane with the unit "
            "circle",
            &draw_multipliers},
-          {"impact_summary",
-           "impact_oscillator/summary.csv: the branches against the closed form",
+          {"impact_summary", "impact_oscillator/summary.csv: the branches against the closed form",
            &write_summary}};
 }
 

@@ -84,7 +84,8 @@ std::optional<PeriodOneOrbit> period_one_orbit(double omega, double r, double si
 
 boost::program_options::options_description scene_keys() {
   namespace po = boost::program_options;
-  po::options_description keys("impact_oscillator (x'' + x = cos(omega t), v -> -r v at x = sigma)");
+  po::options_description keys(
+      "impact_oscillator (x'' + x = cos(omega t), v -> -r v at x = sigma)");
   keys.add_options()  //
       ("frequency", po::value<double>()->default_value(2.8),
        "forcing frequency omega [dimensionless] (> 0, not a whole number)")  //

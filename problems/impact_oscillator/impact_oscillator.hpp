@@ -21,11 +21,10 @@
 #pragma once
 
 #include <array>
+#include <boost/program_options.hpp>
 #include <complex>
 #include <memory>
 #include <optional>
-
-#include <boost/program_options.hpp>
 
 #include "core/orbits/hybrid_orbit.hpp"
 
@@ -56,9 +55,9 @@ class ImpactOscillator : public core::HybridOrbitProblem {
 
 // The period-1 orbit with one impact per forcing period (README.md, 'The period-1 orbit').
 struct PeriodOneOrbit {
-  double phase = 0;           // omega t* of the impact, in [0, 2 pi)
-  double impact_velocity = 0; // V > 0, the speed just before the impact
-  core::Vector start;         // (x, v) at t = 0 (and t = 2 pi / omega)
+  double phase = 0;                                 // omega t* of the impact, in [0, 2 pi)
+  double impact_velocity = 0;                       // V > 0, the speed just before the impact
+  core::Vector start;                               // (x, v) at t = 0 (and t = 2 pi / omega)
   std::array<std::complex<double>, 2> multipliers;  // eigenvalues of S R(2 pi / omega)
 };
 // nullopt when no such orbit exists (the quadratic for V has no positive root: beyond grazing)

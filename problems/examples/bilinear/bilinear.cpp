@@ -32,7 +32,9 @@ class Bilinear : public core::HybridOrbitProblem {
  public:
   Bilinear() : HybridOrbitProblem(2, {"frequency", "damping", "gap", "stiffness"}) {}
   std::string name() const override { return "bilinear"; }
-  std::unique_ptr<core::Problem> clone() const override { return std::make_unique<Bilinear>(*this); }
+  std::unique_ptr<core::Problem> clone() const override {
+    return std::make_unique<Bilinear>(*this);
+  }
   void field(double t, const double* y, const core::Vector& p, double* dy) const override {
     dy[0] = y[1];
     dy[1] = -y[0] - 2 * p[damping] * y[1] - p[stiffness] * std::max(y[0] - p[gap], 0.0) +
@@ -56,10 +58,10 @@ class Bilinear : public core::HybridOrbitProblem {
 boost::program_options::options_description scene_keys() {
   namespace po = boost::program_options;
   po::options_description keys("bilinear (x'' + 2 zeta x' + x + k max(x - gap, 0) = cos(omega t))");
-  keys.add_options()  //
+  keys.add_options()                                                                              //
       ("frequency", po::value<double>()->default_value(0.5), "starting forcing frequency (> 0)")  //
-      ("damping", po::value<double>()->default_value(0.05), "damping ratio zeta (> 0)")  //
-      ("gap", po::value<double>()->default_value(1.0), "gap before the spring (> 0)")  //
+      ("damping", po::value<double>()->default_value(0.05), "damping ratio zeta (> 0)")           //
+      ("gap", po::value<double>()->default_value(1.0), "gap before the spring (> 0)")             //
       ("stiffness", po::value<double>()->default_value(4.0), "spring stiffness k (>= 0)");
   return keys;
 }
@@ -82,7 +84,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
   s.describe_point = [zeta](const continuation::BranchPoint& p) {
     if (!p.floquet) return std::string();
     const double T = p.observable("period");
-    return fmt::format("det M - exp(-2 zeta T) {:.1e}", p.floquet->determinant - std::exp(-2 * zeta * T));
+    return fmt::format("det M - exp(-2 zeta T) {:.1e}",
+                       p.floquet->determinant - std::exp(-2 * zeta * T));
   };
   s.problem = std::move(problem);
   return s;

@@ -31,7 +31,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
                                        "with the free oscillation and no period-1 orbit exists)",
                                        omega));
   const double r = scene.positive("restitution");
-  if (!(r <= 1)) throw core::InputError("restitution", fmt::format("must be in (0, 1] (got {})", r));
+  if (!(r <= 1))
+    throw core::InputError("restitution", fmt::format("must be in (0, 1] (got {})", r));
   const double sigma = scene.number("wall");
   const double wall_min = scene.number("wall_min"), wall_max = scene.number("wall_max");
   if (!(wall_min < sigma))
@@ -60,8 +61,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
   s.guess << orbit->start, problem->parameters()[problem->free_parameter()];
   problem->check_guess(s.guess);
   s.direction = core::Vector::Unit(3, 2);  // the free parameter grows
-  s.branch_options = [wall_min, wall_max, free, grazing_velocity, grazing_gap](cli::ContinuationOptions& continuation,
-                                                core::NewtonOptions&) {
+  s.branch_options = [wall_min, wall_max, free, grazing_velocity, grazing_gap](
+                         cli::ContinuationOptions& continuation, core::NewtonOptions&) {
     if (free == "wall") continuation.bounds.push_back({"wall", wall_min, wall_max});
     const double inf = std::numeric_limits<double>::infinity();
     continuation.bounds.push_back({"impact_velocity", grazing_velocity, inf});
@@ -69,8 +70,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
   };
   s.describe_point = [exact = problem.get()](const cli::BranchPoint& point) {
     const auto oracle = period_one_orbit(point.observable("frequency"),
-                                         point.observable("restitution"),
-                                         point.observable("wall"));
+                                         point.observable("restitution"), point.observable("wall"));
     if (!oracle || point.observable("impacts_per_period") != 1) return std::string();
     return fmt::format("closed-form impact velocity rel err {:.1e}",
                        std::abs(point.observable("impact_velocity") / oracle->impact_velocity - 1));
@@ -84,7 +84,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
 void register_plugin(cli::PluginRegistry& registry) {
   cli::ProblemPlugin p;
   p.name = "impact_oscillator";
-  p.summary = "harmonically forced impact oscillator x'' + x = cos(omega t), v -> -r v at x = sigma";
+  p.summary =
+      "harmonically forced impact oscillator x'' + x = cos(omega t), v -> -r v at x = sigma";
   p.scene_keys = &scene_keys;
   p.branches = {"period1"};
   p.setup = &setup_trace;
@@ -98,11 +99,11 @@ void register_plugin(cli::PluginRegistry& registry) {
     p.reproduce.push_back({fmt::format("impact_{}_up", name),
                            "trace",
                            {scene, "--restitution", r, "--out", folder + name + "_up"}});
-    p.reproduce.push_back({fmt::format("impact_{}_down", name),
-                           "trace",
-                           {scene, "--restitution", r, "--start", folder + name + "_up:0",
-                            "--direction", "-1", "--follow", "doubling", "--out",
-                            folder + name + "_down"}});
+    p.reproduce.push_back(
+        {fmt::format("impact_{}_down", name),
+         "trace",
+         {scene, "--restitution", r, "--start", folder + name + "_up:0", "--direction", "-1",
+          "--follow", "doubling", "--out", folder + name + "_down"}});
   }
   registry.add(std::move(p));
 }

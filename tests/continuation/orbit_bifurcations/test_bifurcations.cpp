@@ -31,9 +31,7 @@ class Axis : public core::Problem, public core::FloquetProblem {
   explicit Axis(Kind kind) : kind_(kind) {}
   int num_unknowns() const override { return 2; }
   int num_equations() const override { return 1; }
-  core::Observables observables(const core::Vector& x) const override {
-    return {{"lambda", x[1]}};
-  }
+  core::Observables observables(const core::Vector& x) const override { return {{"lambda", x[1]}}; }
   core::EvalStatus monodromy(const core::Vector& x, core::Matrix& M) const override {
     const double lambda = x[1];
     M = core::Matrix::Zero(2, 2);
@@ -81,9 +79,9 @@ continuation::Branch trace(const Axis& axis) {
 }  // namespace
 
 TEST(OrbitBifurcations, EachKindIsDetectedAndLocatedAtItsCrossing) {
-  for (const auto& [kind, name] : {std::pair{Kind::fold, "fold"},
-                                   std::pair{Kind::doubling, "period_doubling"},
-                                   std::pair{Kind::torus, "torus"}}) {
+  for (const auto& [kind, name] :
+       {std::pair{Kind::fold, "fold"}, std::pair{Kind::doubling, "period_doubling"},
+        std::pair{Kind::torus, "torus"}}) {
     const Axis axis(kind);
     const continuation::Branch branch = trace(axis);
     ASSERT_GT(branch.points.size(), 10u) << branch.message;

@@ -153,14 +153,16 @@ TEST(HybridOrbit, CrossingsWithinOneStepAreNotLost) {
   for (const auto& [direction, expected] : {std::pair{0, 2}, std::pair{1, 1}, std::pair{-1, 1}}) {
     Poke poke(direction);
     const core::HybridShot shot = poke.shoot(x);
-    ASSERT_TRUE(shot.ok) << shot.message << " failure " << static_cast<int>(shot.failure) << " events " << shot.events.size();
+    ASSERT_TRUE(shot.ok) << shot.message << " failure " << static_cast<int>(shot.failure)
+                         << " events " << shot.events.size();
     EXPECT_EQ(static_cast<int>(shot.events.size()), expected) << "direction " << direction;
   }
   // The surface just above the orbit: no event, and the gap is the distance to it.
   Poke above(1, -1e-6);
   x[2] = std::abs(Poke::c) + 1e-6;
   const core::HybridShot shot = above.shoot(x);
-  ASSERT_TRUE(shot.ok) << shot.message << " failure " << static_cast<int>(shot.failure) << " events " << shot.events.size();
+  ASSERT_TRUE(shot.ok) << shot.message << " failure " << static_cast<int>(shot.failure)
+                       << " events " << shot.events.size();
   EXPECT_TRUE(shot.events.empty());
   EXPECT_NEAR(-shot.extremum[0], 1e-6, 1e-10);
 }

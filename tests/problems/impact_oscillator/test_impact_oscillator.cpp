@@ -86,8 +86,8 @@ TEST(ImpactOscillator, ClosedFormOrbitSolvesTheShootingWithItsMultipliers) {
       const core::Floquet f = core::analyse_monodromy(M, o.floquet_structure(), {});
       // Multipliers up to 111 in modulus (sigma 0.14), relative to the largest: measured 6e-9 at
       // V = 0.014 (the impact time's error, 7e-11, amplified by 1 / V), 1e-10 elsewhere.
-      const double scale = std::max(
-          {1.0, std::abs(exact->multipliers[0]), std::abs(exact->multipliers[1])});
+      const double scale =
+          std::max({1.0, std::abs(exact->multipliers[0]), std::abs(exact->multipliers[1])});
       double worst = 0;
       for (const auto& mu : f.multipliers)
         worst = std::max(worst, std::min(std::abs(mu - exact->multipliers[0]),
