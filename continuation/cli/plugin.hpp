@@ -71,6 +71,11 @@ struct TraceSetup {
   // Optional: describes a verified branch point (ContinuationHooks::describe_branch_point).
   std::function<core::Observables(const core::Vector& on_branch, const core::Vector& attached)>
       describe_branch_point;
+  // Optional: the dimension of the solution set the extra outputs cover (an atlas of a 2D
+  // manifold), when it is not the curve the sizes make the branch: the header and summary.txt
+  // state it, and the traced branch, only the corrected start the covering grows from, gets no
+  // branch.png. 0: the dimension the sizes give.
+  int covered_dimension = 0;
   // Applies branch_options (when set) to the settings a run read from its scene and checks
   // them: what every runner of a trace (trace, the benchmarks) does before making its corrector.
   void apply_branch_options(ContinuationOptions& options, core::NewtonOptions& newton) const;

@@ -175,7 +175,8 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
                t.restart->note);
   }
   // A consistent overdetermined system (m > n - 1) still has curves of solutions.
-  t.expected_dimension = n - std::min(m, n - 1);
+  t.expected_dimension =
+      t.setup.covered_dimension > 0 ? t.setup.covered_dimension : n - std::min(m, n - 1);
   return t;
 }
 
@@ -185,9 +186,12 @@ void print_trace_header(TraceRun& t) {
                t.branch_name, t.entry->name, fmt::join(t.entry->branches, ", "));
   const continuation::ContinuationOptions& options = t.options();
   const core::Problem& problem = t.problem();
-  fmt::print("{} / {}: {} equations in {} unknowns, expected manifold dimension {}\n",
+  fmt::print("{} / {}: {} equations in {} unknowns, expected manifold dimension {}{}\n",
              t.entry->name, t.branch_name, problem.num_equations(), problem.num_unknowns(),
-             t.expected_dimension);
+             t.expected_dimension,
+             t.setup.covered_dimension > 0
+                 ? " (covered by the problem's own outputs from the corrected start below)"
+                 : "");
   const auto& restart = t.restart;
   fmt::print("  {} continuation, {} predictor, newton {}, {}{}{}\n",
              continuation::to_string(options.method), continuation::to_string(options.predictor),
@@ -325,9 +329,11 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
   if (branch.points.empty()) return followed_complete;
   const core::Table table = core::Table::read_csv(t.out / "branch.csv");
   report.points_in_files = table.rows();
-  continuation::plot_branch(
-      t.out, table, fmt::format("{} / {} ({} points)", t.entry->name, t.branch_name, table.rows()),
-      t.entry->units, t.entry->branch_axes);
+  if (t.setup.covered_dimension == 0)
+    continuation::plot_branch(
+        t.out, table,
+        fmt::format("{} / {} ({} points)", t.entry->name, t.branch_name, table.rows()),
+        t.entry->units, t.entry->branch_axes);
   continuation::write_after_run(t.out, t.problem(), branch, !t.resume.empty(),
                                 options.branch_points.detect, t.setup.write_extra_outputs);
   if (options.stability) {

@@ -331,6 +331,25 @@ TEST(TraceOutputs, TheSubharmonicTraceSaysWhichDimensionItsBranchFileHolds) {
       << text;
 }
 
+TEST(TraceOutputs, TheManifoldTraceStatesTheDimensionItCovers) {
+  // The atlas covers a 2D manifold from one corrected start: the header says 2, summary.txt
+  // too, and no one-point branch.png is drawn (manifold.png is the figure).
+  const fs::path out = cli::scratch("trace_outputs", "manifold");
+  int code = -1;
+  std::string arguments = "trace " + scene;
+  arguments += " --branch subharmonic_manifold --energy_min 1e-5 --energy_max 2e-5 --out ";
+  arguments += out.string();
+  const std::string text = stdout_of(arguments, code);
+  ASSERT_EQ(code, 0) << text;
+  EXPECT_NE(text.find("expected manifold dimension 2"), std::string::npos) << text;
+  std::ifstream summary(out / "summary.txt");
+  const std::string lines((std::istreambuf_iterator<char>(summary)),
+                          std::istreambuf_iterator<char>());
+  EXPECT_NE(lines.find("expected_dimension 2"), std::string::npos) << lines;
+  EXPECT_FALSE(fs::exists(out / "branch.png"));
+  EXPECT_TRUE(fs::exists(out / "manifold.png"));
+}
+
 TEST(FiguresInput, AFolderWithNoTracedBranchIsBadInput) {
   const fs::path empty = cli::scratch("cli_input", "empty_results");
   fs::create_directories(empty);

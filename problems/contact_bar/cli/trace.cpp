@@ -527,7 +527,10 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
   };
   s.write_extra_outputs = subharmonic_outputs(scene, problem.get(), mode2, st);
   problem->set_path_rows(scene.flag("path_rows"));
-  if (st.manifold) add_manifold_outputs(scene, s, *problem);
+  if (st.manifold) {
+    add_manifold_outputs(scene, s, *problem);
+    s.covered_dimension = 2;
+  }
   s.problem = std::move(problem);
   return s;
 }
