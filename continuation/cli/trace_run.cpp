@@ -247,12 +247,12 @@ std::string TraceReport::summary(const std::string& status, const continuation::
       "problem {}\nbranch {}\nstatus {}\nequations {}\nunknowns {}\nexpected_dimension {}\n"
       "method {}\nnewton {}\nformulation {}\npoints {}\nrejected_corrections {}\n"
       "switch_index {}\nstop_reason {}\nmessage {}\ndimension_rechecked {}\n"
-      "dimension_unconfirmed {}\n",
+      "dimension_unconfirmed {}\ndimension_above_expected {}\n",
       t_.entry->name, t_.branch_name, status, problem.num_equations(), problem.num_unknowns(),
       t_.expected_dimension, continuation::to_string(t_.run.options.method), t_.corrector->name(),
       t_.periodic ? core::scene_name(t_.run.formulation) : "-", points_in_files, rejected,
       switch_index, branch ? continuation::to_string(branch->reason) : "-",
-      branch ? branch->message : "-", dimension_flags_[1], dimension_flags_[2]);
+      branch ? branch->message : "-", dimension_flags_[1], dimension_flags_[2], dimension_above_);
 }
 
 void TraceReport::on_point(const continuation::BranchPoint& p) {
@@ -262,6 +262,19 @@ void TraceReport::on_point(const continuation::BranchPoint& p) {
     fmt::print(stderr, "backbone trace: point {}: {}\n", p.index,
                continuation::dimension_warning(p));
   dimension_flags_[static_cast<int>(p.dimension_flag)] += 1;
+  // A verified dimension above the expected one is a finding, not noise: other families pass
+  // through the point (continuation/README.md, 'What a branch records'). Said where it changes.
+  if (p.dimension > t_.expected_dimension) {
+    ++dimension_above_;
+    if (p.dimension != last_dimension_)
+      fmt::print(stderr,
+                 "backbone trace: point {}: verified dimension {} where the branch expects {} "
+                 "({} of {} candidate directions re-corrected): other families of solutions pass "
+                 "through here\n",
+                 p.index, p.dimension, t_.expected_dimension, p.dimension,
+                 p.rank ? p.rank->nullity : -1);
+  }
+  if (p.dimension >= 0) last_dimension_ = p.dimension;
   progress_.finish();  // the point's line replaces the progress line, which follows it
   fmt::print("  {}{}\n", point_line(p),
              t_.setup.describe_point ? "  " + t_.setup.describe_point(p) : "");
