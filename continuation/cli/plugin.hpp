@@ -71,6 +71,9 @@ struct TraceSetup {
   // Optional: describes a verified branch point (ContinuationHooks::describe_branch_point).
   std::function<core::Observables(const core::Vector& on_branch, const core::Vector& attached)>
       describe_branch_point;
+  // Optional: checks of the scene that apply to a trace but not to `inspect`, which builds the
+  // same setup (e.g. a key that leaves the traced curve undefined); throws core::InputError.
+  std::function<void()> check_for_trace;
   // Optional: the dimension of the solution set the extra outputs cover (an atlas of a 2D
   // manifold), when it is not the curve the sizes make the branch: the header and summary.txt
   // state it, and the traced branch, only the corrected start the covering grows from, gets no

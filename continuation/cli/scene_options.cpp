@@ -55,7 +55,8 @@ po::options_description continuation_keys(const po::options_description& problem
   add("period_max", po::value<double>()->default_value(inf),
       "stop above this period (the problem's time unit; inf: no bound)");
   add("bound", po::value<std::vector<std::string>>()->composing(),
-      "NAME:MIN:MAX, stop when observable NAME leaves [MIN, MAX] (empty = unbounded; repeatable)");
+      "NAME:MIN:MAX, stop when observable NAME leaves [MIN, MAX] (an empty MIN or MAX: no bound "
+      "on that side; an empty value: no bound; repeatable)");
   add("rank_check_every", po::value<long>()->default_value(1),
       "verified rank report every k points (k >= 0; 0: never)");
   add("rank_threshold", po::value<double>()->default_value(1e-8),
@@ -136,6 +137,7 @@ void read_bounds(const core::Scene& scene, ContinuationOptions& o) {
   }
   if (!scene.has("bound")) return;
   for (const std::string& spec : scene.values()["bound"].as<std::vector<std::string>>()) {
+    if (spec.empty()) continue;  // no bound (a scene.ini may keep an empty `bound =`)
     const auto first = spec.find(':');
     const auto second = first == std::string::npos ? first : spec.find(':', first + 1);
     if (second == std::string::npos)

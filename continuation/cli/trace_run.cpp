@@ -12,6 +12,7 @@
 #include "continuation/cli/progress.hpp"
 #include "continuation/cli/stability_report.hpp"
 #include "continuation/orbit_bifurcations/doubling.hpp"
+#include "core/stability/floquet.hpp"
 #include "core/errors.hpp"
 #include "core/io/output_folder.hpp"
 #include "core/io/scene_ini.hpp"
@@ -76,9 +77,11 @@ void check_natural_parameter(const RunSettings& run, const core::Problem& proble
 
 // A resumed run appends rows to the saved branch.csv: its columns must be the ones this run
 // writes (another version, or another problem, wrote other ones).
-void check_saved_columns(const std::filesystem::path& dir, const core::Observables& at_start) {
+void check_saved_columns(const std::filesystem::path& dir, const core::Observables& at_start,
+                         bool with_multipliers) {
   continuation::BranchPoint point;
   point.observables = at_start;
+  if (with_multipliers) point.floquet = core::undecided_floquet(0);
   continuation::Branch one;
   one.points.push_back(point);
   const std::vector<std::string> expected = continuation::branch_table(one).columns();
@@ -120,6 +123,7 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
                            "the saved branch goes on)");
 
   t.setup = entry.setup(scene, t.branch_name);
+  if (t.setup.check_for_trace) t.setup.check_for_trace();
   if (!t.setup.problem) throw core::InputError("problem", "setup returned no problem");
   const core::Problem& problem = *t.setup.problem;
   t.setup.apply_branch_options(options, t.run.newton_options);
@@ -156,7 +160,9 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
     continuation::take_up(*t.restart, restart_key, static_cast<int>(start_direction), problem,
                           options, t.setup.guess, t.direction);
   const core::Observables at_start = problem.observables(t.setup.guess);
-  if (t.restart && !t.resume.empty()) check_saved_columns(t.resume, at_start);
+  if (t.restart && !t.resume.empty())
+    check_saved_columns(t.resume, at_start,
+                        options.stability && dynamic_cast<const core::FloquetProblem*>(&problem));
 
   const int n = problem.num_unknowns(), m = problem.num_equations();
   if (m != n - 1 && t.corrector->name() == "kinsol")

@@ -96,6 +96,10 @@ void check_scene_text(const std::string& path, const std::string& content) {
   std::string line;
   for (int number = 1; std::getline(lines, line); ++number) {
     const auto first = line.find_first_not_of(" \t");
+    if (first != std::string::npos && line[first] == '=')
+      throw InputError("scene", fmt::format("'{}' line {}: '{}' names no key (a scene line is "
+                                            "`key = value`)",
+                                            path, number, line));
     if (first != std::string::npos && line[first] == '[')
       throw InputError("scene", fmt::format("'{}' line {}: a scene has no [sections], only flat "
                                             "`key = value` lines",
@@ -141,6 +145,32 @@ std::istringstream open_scene(const std::string& given_path) {
 }
 
 // "--gap -1" would read "-1" as an option: glue a negative number to its key.
+// The key of a word `--key` (without `=value`), or empty.
+std::string key_of(const std::string& word) {
+  if (word.rfind("--", 0) != 0 || word.find('=') != std::string::npos) return {};
+  return word.substr(2);
+}
+
+// Refuses, naming the key, a `--key` that needs a value but is followed by another `--key` or
+// by nothing (Boost would take the next key as its value, or report a word further on), and a
+// word that follows a key that takes no value (Boost would report the word, not the key).
+void check_key_values(const std::vector<std::string>& words, const po::options_description& keys) {
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    const std::string key = key_of(words[i]);
+    const po::option_description* option = key.empty() ? nullptr : keys.find_nothrow(key, false);
+    if (!option) continue;
+    const bool next_is_key = i + 1 < words.size() && !key_of(words[i + 1]).empty();
+    if (option->semantic()->min_tokens() > 0 && (i + 1 == words.size() || next_is_key))
+      throw InputError(key, i + 1 == words.size()
+                                ? std::string("needs a value (none given at the end)")
+                                : fmt::format("needs a value (got the key '{}' next)",
+                                              words[i + 1]));
+    if (option->semantic()->max_tokens() == 0 && i + 1 < words.size() && !next_is_key &&
+        words[i + 1].rfind("-", 0) != 0)
+      throw InputError(key, fmt::format("takes no value (got '{}' after it)", words[i + 1]));
+  }
+}
+
 std::vector<std::string> glue_negative_values(const std::vector<std::string>& words) {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < words.size(); ++i) {
@@ -241,6 +271,7 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
   try {
     // Command line first: po::store keeps the first value it sees, so the command line wins.
     std::vector<std::string> words = glue_negative_values(arguments);
+    check_key_values(words, cli_keys);
     const po::parsed_options parsed =
         po::command_line_parser(words)
             .options(cli_keys)
@@ -274,6 +305,7 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
 po::variables_map parse_options(const po::options_description& keys,
                                 const std::vector<std::string>& arguments) {
   po::variables_map vm;
+  check_key_values(glue_negative_values(arguments), keys);
   try {
     const po::parsed_options parsed = po::command_line_parser(arguments).options(keys).run();
     for (const std::string& word : po::collect_unrecognized(parsed.options, po::include_positional))

@@ -303,6 +303,15 @@ void describe_mode(cli::TraceSetup& s, const ContactBarOrbitProblem* p,
 
 cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
   if (branch.rfind("subharmonic", 0) == 0) return setup_subharmonic(scene, branch);
+  // A subharmonic key given to a mode would be ignored in silence.
+  const po::options_description subharmonic = subharmonic_keys();
+  for (const auto& option : subharmonic.options()) {
+    const std::string& key = option->long_name();
+    if (scene.has(key) && !scene.values()[key].defaulted())
+      throw core::InputError(key, fmt::format("applies to the subharmonic branches only (this "
+                                              "trace follows {})",
+                                              branch));
+  }
   const int mode = branch == "mode2" ? 2 : 1;
   bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
   check_orbit_ends(setup, "the contact-bar modes");
@@ -527,6 +536,11 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
   };
   s.write_extra_outputs = subharmonic_outputs(scene, problem.get(), mode2, st);
   problem->set_path_rows(scene.flag("path_rows"));
+  if (!scene.flag("path_rows"))
+    s.check_for_trace = [] {
+      throw core::InputError("path_rows", "false leaves F alone, a 2D manifold with no curve to "
+                                          "trace: it is for `backbone inspect`");
+    };
   if (st.manifold) {
     add_manifold_outputs(scene, s, *problem);
     s.covered_dimension = 2;

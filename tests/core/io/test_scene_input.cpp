@@ -113,8 +113,14 @@ TEST_F(SceneInput, StrayCommandLineWordIsRefused) {
       },
       "command line");
   EXPECT_NE(message.find("unexpected argument 'x'"), std::string::npos) << message;
-  // After a flag too: --verbose takes no value, so "yes" is a stray word, not its value.
-  input_error([&] { read_scene(keys(), "", {"--verbose", "yes"}, {}); }, "command line");
+  // After a flag too: --verbose takes no value, so "yes" is a stray word, named with the flag.
+  const std::string after_flag =
+      input_error([&] { read_scene(keys(), "", {"--verbose", "yes"}, {}); }, "verbose");
+  EXPECT_NE(after_flag.find("takes no value (got 'yes' after it)"), std::string::npos)
+      << after_flag;
+  // A key that needs a value, followed by another key, is named with its own.
+  input_error([&] { read_scene(keys(), "", {"--length", "--points", "3"}, {}); }, "length");
+  input_error([&] { read_scene(keys(), "", {"--points"}, {}); }, "points");
   // Negative values are still values.
   EXPECT_EQ(read_scene(keys(), "", {"--length", "-2"}, {}).number("length"), -2.0);
 }
