@@ -196,17 +196,18 @@ void add_manifold_outputs(const core::Scene& scene, cli::TraceSetup& setup,
                                                        margin, newton, return_tolerance);
     manifold_table(run).write_csv(out / "manifold.csv");
     write_manifold_figure(out, run, e1, e2);
+    const continuation::Atlas& a = run.atlas;
     fmt::print(
-        "manifold: {} charts ({} placed by bisection), energy {:.3e} .. {:.3e} J, {} corrections "
-        "({} "
-        "failed, {} rejected by the exact return, {} directions closed by failure), {:.1f} s; "
-        "worst exact return {:.1e}, worst "
-        "period vs 2 T2 {:.1e}; largest gap {:.2f} chart radii (2000 closed-form members); {}\n",
-        run.atlas.charts.size(),
-        std::count_if(run.atlas.charts.begin(), run.atlas.charts.end(),
+        "manifold: {} charts ({} on the boundary), energy {:.3e} .. {:.3e} J, {} corrections ({} "
+        "failed: {} not converged, {} too far or turned, {} rejected by the exact return; {} "
+        "outside the bounds; {} directions closed by failure), {:.1f} s; worst exact return "
+        "{:.1e}, worst period vs 2 T2 {:.1e}; largest gap {:.2f} chart radii (2000 closed-form "
+        "members); {}\n",
+        a.charts.size(),
+        std::count_if(a.charts.begin(), a.charts.end(),
                       [](const continuation::Chart& c) { return c.on_boundary; }),
-        run.energy_low, run.energy_high, run.atlas.corrections, run.atlas.failed_corrections,
-        run.atlas.rejected, run.atlas.closed_by_failure, run.atlas.seconds, run.worst_return,
+        run.energy_low, run.energy_high, a.corrections, a.failed_corrections, a.not_converged,
+        a.too_far, a.rejected, a.outside, a.closed_by_failure, a.seconds, run.worst_return,
         run.worst_period, run.largest_gap, run.atlas.message);
   };
 }
