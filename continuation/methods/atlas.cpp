@@ -27,6 +27,8 @@ void AtlasOptions::validate() const {
   positive(max_angle_degrees, "atlas.max_angle_degrees");
   if (!(radius_min <= radius))
     throw core::InputError("atlas.radius_min", "must be <= atlas.radius");
+  if (!(null_threshold >= 0 && null_threshold < 1))
+    throw core::InputError("atlas.null_threshold", "must be in [0, 1)");
   if (!(boundary_fraction >= 0 && boundary_fraction < 1))
     throw core::InputError("atlas.boundary_fraction", "must be in [0, 1)");
   if (bisection_steps < 0) throw core::InputError("atlas.bisection_steps", "must be >= 0");
@@ -41,6 +43,22 @@ core::Matrix tangent_plane(const core::Matrix& J) {
   padded.topRows(J.rows()) = J;
   Eigen::JacobiSVD<core::Matrix> svd(padded, Eigen::ComputeFullV);
   return svd.matrixV().rightCols(2);
+}
+
+core::Matrix tangent_plane(const core::Matrix& J, const core::Matrix& near, double threshold) {
+  const Eigen::Index n = J.cols();
+  core::Matrix padded = core::Matrix::Zero(std::max(J.rows(), n), n);
+  padded.topRows(J.rows()) = J;
+  Eigen::JacobiSVD<core::Matrix> svd(padded, Eigen::ComputeFullV);
+  const core::Vector& sigma = svd.singularValues();  // decreasing
+  Eigen::Index k = 2;
+  while (k < n && sigma[n - k - 1] <= threshold * sigma[0]) ++k;
+  const core::Matrix null_space = svd.matrixV().rightCols(k);
+  if (k == 2) return null_space;
+  // The plane of the near-null space closest to `near`: its projection, orthonormalized.
+  const core::Matrix projected = null_space * (null_space.transpose() * near);
+  Eigen::JacobiSVD<core::Matrix> basis(projected, Eigen::ComputeThinU);
+  return basis.matrixU();
 }
 
 double plane_angle(const core::Matrix& a, const core::Matrix& b) {
@@ -161,7 +179,7 @@ class AtlasBuilder {
     Chart c;
     c.z = z;
     c.x = scaled_->to_unknowns(z);
-    c.tangent = tangent_plane(J);
+    c.tangent = tangent_plane(J, T, options_.null_threshold);
     c.radius = radius;
     c.newton_iterations = summary.iterations;
     core::Vector r;
@@ -173,72 +191,117 @@ class AtlasBuilder {
 
   bool inside(const Chart& c) const { return !inside_ || inside_(c.x); }
 
-  enum class Outcome { accepted, not_converged, too_far };
+  enum class Outcome { accepted, not_converged, too_far, refused };
 
   // Corrects from chart i along direction dir at distance h: accepted when close to the
-  // prediction and not turned too much.
+  // prediction, not turned too much and agreed by accept_. The geometric test comes first: a
+  // correction that lands far away is a step too long (the radius shrinks), whatever accept_
+  // would say of the point it found.
   Outcome attempt(int i, const Point2& dir, double h, double radius, std::optional<Chart>& out) {
     const Chart& from = atlas_.charts[static_cast<std::size_t>(i)];
     out = correct(from.z, from.tangent, h * dir, radius);
-    if (out && accept_ && !accept_(out->x)) {
-      ++atlas_.rejected;
-      out.reset();
-    }
     if (!out) {
       ++atlas_.failed_corrections;
+      ++atlas_.not_converged;
       return Outcome::not_converged;
     }
     const double max_angle = options_.max_angle_degrees * std::numbers::pi / 180;
-    if ((out->z - (from.z + from.tangent * (h * dir))).norm() <= options_.max_distance_ratio * h &&
-        plane_angle(out->tangent, from.tangent) <= max_angle)
-      return Outcome::accepted;
-    ++atlas_.failed_corrections;
-    out.reset();
-    return Outcome::too_far;
+    if ((out->z - (from.z + from.tangent * (h * dir))).norm() > options_.max_distance_ratio * h ||
+        plane_angle(out->tangent, from.tangent) > max_angle) {
+      ++atlas_.failed_corrections;
+      ++atlas_.too_far;
+      out.reset();
+      return Outcome::too_far;
+    }
+    if (accept_ && !accept_(out->x)) {
+      ++atlas_.failed_corrections;
+      ++atlas_.rejected;
+      out.reset();
+      return Outcome::refused;
+    }
+    return Outcome::accepted;
+  }
+
+  // Whether the prediction of chart i at distance h along dir lies inside the bounds.
+  bool prediction_inside(int i, const Point2& dir, double h) const {
+    const Chart& from = atlas_.charts[static_cast<std::size_t>(i)];
+    return !inside_ || inside_(scaled_->to_unknowns(from.z + from.tangent * (h * dir)));
+  }
+
+  // The longest step in (0, h] whose prediction stays inside the bounds, to 1e-3 h: the bound
+  // on the tangent line, found without a correction (a prediction beyond the domain, e.g. past
+  // a grazing limit where no solution exists, would only cost a failed Newton solve).
+  double reach(int i, const Point2& dir, double h) const {
+    if (prediction_inside(i, dir, h)) return h;
+    double in = 0, out = h;
+    while (out - in > 1e-3 * h) {
+      const double mid = (in + out) / 2;
+      (prediction_inside(i, dir, mid) ? in : out) = mid;
+    }
+    return in;
   }
 
   void close(int i, const Point2& dir) {
     atlas_.charts[static_cast<std::size_t>(i)].closed.push_back(dir);
   }
 
-  // One new chart from chart i towards its open vertex. A correction too far from its
-  // prediction (or turned too much) halves the chart's radius (Henderson's rule; its polygon
-  // and its neighbours' are rebuilt). One that does not converge or leaves the bounds marks the
-  // end of the manifold in that direction: the step is bisected to the last good point, a
-  // boundary chart when it is at least boundary_fraction * R away, else the direction closes.
-  // Returns true when a chart was added.
+  // One new chart from chart i towards its open vertex. The step is first cut to the bound of
+  // the domain on the tangent line (reach); a step cut below boundary_fraction * R closes the
+  // direction. A correction too far from its prediction (or turned too much) halves the chart's
+  // radius (Henderson's rule; its polygon and its neighbours' are rebuilt). One that does not
+  // converge, is refused or leaves the bounds marks the end of the manifold in that direction:
+  // the step is bisected to the last good point, a boundary chart when it is at least
+  // boundary_fraction * R away, else the direction closes. Returns true when a chart was added.
   bool expand(int i, const Point2& vertex) {
     const Point2 dir = vertex.normalized();
-    const double h = atlas_.charts[static_cast<std::size_t>(i)].radius;
-    const double radius = std::min(options_.radius, 2 * h);
+    const double radius_i = atlas_.charts[static_cast<std::size_t>(i)].radius;
+    const double radius = std::min(options_.radius, 2 * radius_i);
+    const double h = reach(i, dir, radius_i);
+    if (h < options_.boundary_fraction * radius_i) {
+      close(i, dir);
+      return false;
+    }
     std::optional<Chart> c;
     const Outcome outcome = attempt(i, dir, h, radius, c);
     if (outcome == Outcome::too_far) {
-      if (h / 2 < options_.radius_min) {
+      if (radius_i / 2 < options_.radius_min) {
         ++atlas_.closed_by_failure;
         close(i, dir);
       } else {
-        shrink(i, h / 2);
+        shrink(i, radius_i / 2);
       }
       return false;
     }
-    if (outcome == Outcome::accepted && inside(*c)) {
-      add_chart(std::move(*c));
-      return true;
+    if (outcome == Outcome::accepted) {
+      if (inside(*c)) {
+        c->on_boundary = h < radius_i;
+        add_chart(std::move(*c));
+        return true;
+      }
+      ++atlas_.outside;
     }
+    return bisect(i, dir, h, radius_i, radius);
+  }
+
+  // The last good point between chart i and the failed step h along dir, by bisection: a
+  // boundary chart when at least boundary_fraction * R (R: chart i's radius) away, else the
+  // direction closes.
+  bool bisect(int i, const Point2& dir, double h, double radius_i, double radius) {
     double h_in = 0, h_out = h;
     std::optional<Chart> last_inside;
     for (int k = 0; k < options_.bisection_steps; ++k) {
       const double mid = (h_in + h_out) / 2;
       std::optional<Chart> m;
-      if (attempt(i, dir, mid, radius, m) == Outcome::accepted && inside(*m)) {
+      const bool accepted = attempt(i, dir, mid, radius, m) == Outcome::accepted;
+      if (accepted && inside(*m)) {
         h_in = mid;
         last_inside = std::move(m);
       } else {
+        if (accepted) ++atlas_.outside;
         h_out = mid;
       }
     }
-    if (!last_inside || h_in < options_.boundary_fraction * h) {
+    if (!last_inside || h_in < options_.boundary_fraction * radius_i) {
       close(i, dir);
       return false;
     }

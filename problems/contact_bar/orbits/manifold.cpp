@@ -49,6 +49,69 @@ double observable(const core::Observables& o, const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+// Sutherland-Hodgman with one half-plane n . q <= c (a convex clip of any simple polygon).
+std::vector<PlanePoint> clip(const std::vector<PlanePoint>& polygon, const PlanePoint& n,
+                             double c) {
+  std::vector<PlanePoint> out;
+  const std::size_t k = polygon.size();
+  for (std::size_t i = 0; i < k; ++i) {
+    const PlanePoint& a = polygon[i];
+    const PlanePoint& b = polygon[(i + 1) % k];
+    const double da = n.dot(a) - c, db = n.dot(b) - c;
+    if (da <= 0) out.push_back(a);
+    if ((da < 0 && db > 0) || (da > 0 && db < 0)) out.push_back(a + (b - a) * (da / (da - db)));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::vector<PlanePoint>> plane_cells(
+    const std::vector<PlanePoint>& centres, const std::vector<std::vector<PlanePoint>>& polygons) {
+  std::vector<std::vector<PlanePoint>> cells;
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    std::vector<PlanePoint> cell = polygons[i];
+    for (const auto& [n, c] : {std::pair{PlanePoint(-1, 0), 0.0}, std::pair{PlanePoint(1, 0), 1.0},
+                               std::pair{PlanePoint(0, -1), 0.0}, std::pair{PlanePoint(0, 1), 1.0}})
+      cell = clip(cell, n, c);
+    for (std::size_t j = 0; j < centres.size() && !cell.empty(); ++j) {
+      if (j == i) continue;
+      const PlanePoint d = centres[j] - centres[i];
+      cell = clip(cell, d, (centres[j].squaredNorm() - centres[i].squaredNorm()) / 2);
+    }
+    cells.push_back(std::move(cell));
+  }
+  return cells;
+}
+
+namespace {
+
+// The figure's cells in (shape, energy): the Voronoi cells of the chart centres in the plane of
+// shape and normalised log energy, clipped to the bounds (plane_cells with the box as every
+// polygon). The charts' own polygons live in their tangent planes of the scaled unknowns; mapped
+// to this plane they neither tile it nor stay disjoint, so the figure tiles its own plane.
+std::vector<std::vector<std::array<double, 2>>> figure_cells(const continuation::Atlas& atlas,
+                                                             double energy_min, double energy_max) {
+  const double log_min = std::log(energy_min), log_range = std::log(energy_max) - log_min;
+  std::vector<PlanePoint> centres;
+  for (const continuation::Chart& c : atlas.charts)
+    centres.emplace_back(observable(c.observables, "shape"),
+                         (std::log(observable(c.observables, "energy")) - log_min) / log_range);
+  const std::vector<PlanePoint> box{{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const std::vector<std::vector<PlanePoint>> boxes(centres.size(), box);
+  std::vector<std::vector<std::array<double, 2>>> cells;
+  for (const std::vector<PlanePoint>& cell : plane_cells(centres, boxes)) {
+    cells.emplace_back();
+    for (const PlanePoint& q : cell)
+      cells.back().push_back({q[0], std::exp(log_min + q[1] * log_range)});
+  }
+  return cells;
+}
+
+}  // namespace
+
 ManifoldRun cover_subharmonic_manifold(const ContactBarOrbitProblem& problem,
                                        const core::Vector& seed,
                                        const continuation::AtlasOptions& options, double energy_min,
@@ -98,6 +161,7 @@ ManifoldRun cover_subharmonic_manifold(const ContactBarOrbitProblem& problem,
       nearest = std::min(nearest, (z - c.z).norm() / c.radius);
     run.largest_gap = std::max(run.largest_gap, nearest);
   }
+  run.cells = figure_cells(run.atlas, energy_min, energy_max);
   return run;
 }
 
@@ -127,7 +191,8 @@ core::Table manifold_table(const ManifoldRun& run) {
 
 namespace {
 
-// Energy (log axis) vs shape: chart centres, neighbour edges, boundary charts highlighted.
+// Energy (log axis) vs shape: each chart's cell (its polygon, cut so that neighbours do not
+// overlap), chart centres, boundary charts highlighted.
 void write_manifold_figure(const std::filesystem::path& out, const ManifoldRun& run,
                            double energy_min, double energy_max) {
   std::string edges = "$edges << EOD\n", charts = "$charts << EOD\n", rim = "$rim << EOD\n";
@@ -137,12 +202,10 @@ void write_manifold_figure(const std::filesystem::path& out, const ManifoldRun& 
   for (std::size_t i = 0; i < cs.size(); ++i) {
     (cs[i].on_boundary ? rim : charts) +=
         fmt::format("{:.9g} {:.9g}\n", shape(cs[i]), energy(cs[i]));
-    for (int j : cs[i].adjacent) {
-      if (j < static_cast<int>(i)) continue;
-      const auto& b = cs[static_cast<std::size_t>(j)];
-      edges += fmt::format("{:.9g} {:.9g}\n{:.9g} {:.9g}\n\n", shape(cs[i]), energy(cs[i]),
-                           shape(b), energy(b));
-    }
+    const auto& cell = run.cells[i];
+    if (cell.empty()) continue;
+    for (const auto& q : cell) edges += fmt::format("{:.9g} {:.9g}\n", q[0], q[1]);
+    edges += fmt::format("{:.9g} {:.9g}\n\n", cell.front()[0], cell.front()[1]);
   }
   const std::string script =
       edges + "EOD\n" + charts + "EOD\n" + rim + "EOD\n" +
@@ -156,9 +219,9 @@ void write_manifold_figure(const std::filesystem::path& out, const ManifoldRun& 
           "at every point)'\n"
           "set arrow from 0,graph 0 to 0,graph 1 nohead dt 2 lc rgb 'gray40'\n"
           "set arrow from 1,graph 0 to 1,graph 1 nohead dt 2 lc rgb 'gray40'\n"
-          "plot $edges using 1:2 with lines lc rgb '#8fa8cc' lw 1 title 'adjacent charts', "
+          "plot $edges using 1:2 with lines lc rgb '#8fa8cc' lw 1 title 'chart cells', "
           "$charts using 1:2 with points pt 7 ps 0.6 lc rgb '#1f4e9a' title 'chart centres', "
-          "$rim using 1:2 with points pt 7 ps 0.7 lc rgb '#c0392b' title 'bisected (bounds, "
+          "$rim using 1:2 with points pt 7 ps 0.7 lc rgb '#c0392b' title 'on the boundary (bounds, "
           "refused corrections)'\n",
           energy_min / 1.15, energy_max * 1.15, cs.size(),
           run.atlas.complete ? "" : " (incomplete)");
@@ -196,17 +259,18 @@ void add_manifold_outputs(const core::Scene& scene, cli::TraceSetup& setup,
                                                        margin, newton, return_tolerance);
     manifold_table(run).write_csv(out / "manifold.csv");
     write_manifold_figure(out, run, e1, e2);
+    const continuation::Atlas& a = run.atlas;
     fmt::print(
-        "manifold: {} charts ({} placed by bisection), energy {:.3e} .. {:.3e} J, {} corrections "
-        "({} "
-        "failed, {} rejected by the exact return, {} directions closed by failure), {:.1f} s; "
-        "worst exact return {:.1e}, worst "
-        "period vs 2 T2 {:.1e}; largest gap {:.2f} chart radii (2000 closed-form members); {}\n",
-        run.atlas.charts.size(),
-        std::count_if(run.atlas.charts.begin(), run.atlas.charts.end(),
+        "manifold: {} charts ({} on the boundary), energy {:.3e} .. {:.3e} J, {} corrections ({} "
+        "failed: {} not converged, {} too far or turned, {} rejected by the exact return; {} "
+        "outside the bounds; {} directions closed by failure), {:.1f} s; worst exact return "
+        "{:.1e}, worst period vs 2 T2 {:.1e}; largest gap {:.2f} chart radii (2000 closed-form "
+        "members); {}\n",
+        a.charts.size(),
+        std::count_if(a.charts.begin(), a.charts.end(),
                       [](const continuation::Chart& c) { return c.on_boundary; }),
-        run.energy_low, run.energy_high, run.atlas.corrections, run.atlas.failed_corrections,
-        run.atlas.rejected, run.atlas.closed_by_failure, run.atlas.seconds, run.worst_return,
+        run.energy_low, run.energy_high, a.corrections, a.failed_corrections, a.not_converged,
+        a.too_far, a.rejected, a.outside, a.closed_by_failure, a.seconds, run.worst_return,
         run.worst_period, run.largest_gap, run.atlas.message);
   };
 }

@@ -16,6 +16,8 @@
 //   AtlasRun run = cover_subharmonic_manifold(problem, seed, options, e1, e2, margin);
 #pragma once
 
+#include <Eigen/Core>
+#include <array>
 #include <boost/program_options.hpp>
 #include <filesystem>
 #include <vector>
@@ -43,6 +45,9 @@ struct ManifoldRun {
   // chart centre in units of that chart's radius (<= 1: no holes).
   double largest_gap = 0;
   std::vector<double> return_errors, period_errors;  // per chart (period: signed)
+  // Per chart, its cell in (shape, energy): the Voronoi cell of its centre in the plane of shape
+  // and normalised log energy, clipped to the bounds (plane_cells); what manifold.png draws.
+  std::vector<std::vector<std::array<double, 2>>> cells;
 };
 
 // Covers the manifold of `problem` (a subharmonic ContactBarOrbitProblem; its path rows are
@@ -54,6 +59,16 @@ ManifoldRun cover_subharmonic_manifold(const ContactBarOrbitProblem& problem,
                                        const continuation::AtlasOptions& options, double energy_min,
                                        double energy_max, double shape_margin,
                                        const core::NewtonOptions& newton, double return_tolerance);
+
+// A point of the figure's plane: (shape, normalised log energy), both in [0, 1] inside the bounds.
+using PlanePoint = Eigen::Vector2d;
+
+// Non-overlapping cells for a figure of an atlas: cell i is polygon i (any simple polygon, e.g.
+// the box itself: the Voronoi diagram of the centres) clipped to the box [0, 1]^2 and to the
+// Voronoi cell of centre i among all centres (the half-planes nearer centre i than centre j), so no
+// two cells overlap whatever the polygons do; a centre inside its polygon is inside its cell.
+std::vector<std::vector<PlanePoint>> plane_cells(
+    const std::vector<PlanePoint>& centres, const std::vector<std::vector<PlanePoint>>& polygons);
 
 // manifold.csv: point, chart, energy, period, shape, neighbours (chart indices joined by ';'),
 // adjacent (the neighbours whose polygons share an edge: what the figure draws), radius,

@@ -113,6 +113,76 @@ TEST(Atlas, ClosesOnTheWholeSphere) {
   EXPECT_LE(charts, 16 / r2);
 }
 
+// The plane x3 = 0 whose residual exists only inside the square |x1|, |x2| <= 1, as a family
+// that ends where no solution exists (the contact bar's subharmonic manifold past its grazing
+// limits): outside, the evaluation fails.
+class SquareOfAPlane : public core::Problem {
+ public:
+  int num_unknowns() const override { return 3; }
+  int num_equations() const override { return 1; }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    if (!(std::abs(x[0]) <= 1 && std::abs(x[1]) <= 1)) return core::EvalStatus::failed;
+    r = x.tail(1);
+    return core::EvalStatus::ok;
+  }
+  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override {
+    if (!(std::abs(x[0]) <= 1 && std::abs(x[1]) <= 1)) return core::EvalStatus::failed;
+    J = (core::Matrix(1, 3) << 0, 0, 1).finished();
+    return core::EvalStatus::ok;
+  }
+};
+
+// Predictions beyond the bounds are cut back to the bound on the tangent line before any
+// correction: on a plane the tangent line is the manifold, so every correction converges on its
+// prediction, none is evaluated outside the square and none is bisected; boundary charts sit on
+// the bound to the 1e-3 step resolution of that cut, which never overshoots.
+TEST(Atlas, CutsPredictionsAtTheBoundsBeforeCorrecting) {
+  const SquareOfAPlane plane;
+  AtlasOptions options;
+  options.radius = 0.25;
+  options.scale_unknowns = false;
+  auto corrector = core::make_corrector("eigen", tight());
+  auto inside = [](const core::Vector& x) { return std::abs(x[0]) <= 1 && std::abs(x[1]) <= 1; };
+  const core::Vector guess = (core::Vector(3) << 0.1, -0.2, 0.3).finished();
+  const Atlas atlas = cover_manifold(plane, guess, *corrector, options, inside);
+  ASSERT_TRUE(atlas.complete) << atlas.message;
+  EXPECT_EQ(atlas.failed_corrections, 0);
+  EXPECT_EQ(atlas.not_converged, 0);
+  EXPECT_EQ(atlas.outside, 0);
+  EXPECT_EQ(atlas.corrections, static_cast<int>(atlas.charts.size()));  // one each, no bisection
+  int boundary = 0;
+  for (const Chart& c : atlas.charts) {
+    EXPECT_TRUE(inside(c.x));
+    EXPECT_NEAR(c.x[2], 0, 1e-13);  // F linear: one Newton step, to the tolerance 1e-13
+    if (!c.on_boundary) continue;
+    ++boundary;
+    const double to_bound = 1 - c.x.head(2).lpNorm<Eigen::Infinity>();
+    EXPECT_GE(to_bound, 0);
+    EXPECT_LE(to_bound, 1e-3 * options.radius);
+  }
+  EXPECT_GT(boundary, 4);  // every side of the square is reached
+}
+
+// Where J has three null directions, the chart's plane is the one of them nearest its
+// parent's: here span(e1, e2, e3) and a parent plane spanned by (e1 + e4) / sqrt 2 and e2,
+// whose projection spans e1, e2 exactly.
+TEST(Atlas, TangentPlaneOfADegenerateJacobianFollowsItsParent) {
+  const core::Matrix J = (core::Matrix(1, 4) << 0, 0, 0, 2).finished();
+  core::Matrix parent = core::Matrix::Zero(4, 2);
+  parent(0, 0) = parent(3, 0) = std::sqrt(0.5);
+  parent(1, 1) = 1;
+  core::Matrix expected = core::Matrix::Zero(4, 2);
+  expected(0, 0) = expected(1, 1) = 1;
+  const core::Matrix t = tangent_plane(J, parent, 1e-3);
+  EXPECT_NEAR((t.transpose() * t - Eigen::Matrix2d::Identity()).norm(), 0, 1e-14);
+  EXPECT_LT(plane_angle(t, expected), 1e-7);  // acos near 1 resolves angles to ~sqrt(eps)
+  // Two null directions: the null space itself, whatever the parent.
+  const core::Matrix J2 = (core::Matrix(2, 4) << 0, 0, 1, 0, 0, 0, 0, 3).finished();
+  EXPECT_LT(plane_angle(tangent_plane(J2, parent, 1e-3), expected), 1e-7);
+}
+
 TEST(Atlas, BadOptionsNameTheirField) {
   const algebraic::Sphere sphere;
   auto corrector = core::make_corrector("eigen", tight());
