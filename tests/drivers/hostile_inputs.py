@@ -40,6 +40,7 @@ import time
 
 S = "problems/contact_bar/scenes/paper.ini"
 D = "problems/duffing/scenes/duffing.ini"
+I = "problems/impact_oscillator/scenes/impact.ini"
 SMALL = ["--branch", "mode1", "--shooting_elements", "20", "--energy_max", "2e-5"]
 MEMORY_CAP_KB = 4000000  # ulimit -v
 SLOW_SECONDS = 10.0      # a bad input answered later than this was not refused before work
@@ -51,7 +52,7 @@ FX = ""       # SCRATCH/_fixtures
 
 # --------------------------------------------------------------------------------------------
 # The table.  c(id, subcommand, arguments, key, kind, **options)
-#   arguments: list; "{S}" "{D}" "{FX}" "{OUT}" are replaced; --out OUT is appended unless the
+#   arguments: list; "{S}" "{D}" "{I}" "{FX}" "{OUT}" are replaced; --out OUT is appended unless the
 #              case says out=False or names {OUT} itself.
 #   options:   out=False (the subcommand takes no --out / the case must not add it),
 #              prep=fn(out) prepares the folder (then it must stay unchanged for `bad`),
@@ -159,6 +160,31 @@ c("trace_branch_empty", "trace", ["{S}", "--branch", "", "--energy_max", "2e-5"]
 c("trace_branch_unknown", "trace", ["{S}", "--branch", "mode3"], "branch")
 c("trace_branch_of_other_problem", "trace", ["{D}", "--branch", "mode1"], "branch")
 c("trace_contact_key_on_duffing", "trace", ["{D}", "--gap", "1e-3"], "gap")
+# The forced impact oscillator and the stability keys.
+c("impact_frequency_zero", "trace", ["{I}", "--frequency", "0"], "frequency")
+c("impact_frequency_negative", "trace", ["{I}", "--frequency", "-2.8"], "frequency")
+c("impact_frequency_resonant", "trace", ["{I}", "--frequency", "2"], "frequency")
+c("impact_frequency_nan", "trace", ["{I}", "--frequency", "nan"], "frequency")
+c("impact_restitution_zero", "trace", ["{I}", "--restitution", "0"], "restitution")
+c("impact_restitution_above_one", "trace", ["{I}", "--restitution", "1.01"], "restitution")
+c("impact_wall_beyond_grazing", "trace", ["{I}", "--wall", "0.2"], "wall",
+  note="no impact: the event never fires")
+c("impact_wall_min_above_wall", "trace", ["{I}", "--wall_min", "0.05"], "wall_min")
+c("impact_wall_max_below_wall", "trace", ["{I}", "--wall_max", "-0.05"], "wall_max")
+c("impact_grazing_velocity_zero", "trace", ["{I}", "--grazing_velocity", "0"], "grazing_velocity")
+c("impact_grazing_gap_negative", "trace", ["{I}", "--grazing_gap", "-1"], "grazing_gap")
+c("impact_unknown_parameter", "trace", ["{I}", "--continuation_parameter", "mass"],
+  "continuation_parameter")
+c("impact_rtol_too_loose", "trace", ["{I}", "--rtol", "0.1"], "rtol")
+c("impact_contact_key", "trace", ["{I}", "--gap", "1e-3"], "gap")
+c("stability_not_a_bool", "trace", ["{I}", "--stability", "maybe"], "stability")
+c("floquet_tolerance_zero", "trace", ["{I}", "--floquet_tolerance", "0"], "floquet_tolerance")
+c("floquet_tolerance_huge", "trace", ["{D}", "--floquet_tolerance", "5"], "floquet_tolerance")
+c("floquet_trivial_tolerance_nan", "trace", ["{D}", "--floquet_trivial_tolerance", "nan"],
+  "floquet_trivial_tolerance")
+c("follow_doubling_typo", "trace", ["{I}", "--follow", "doublings"], "follow")
+c("impact_key_without_value", "trace", ["{I}", "--wall", "--max_points", "3"], "wall")
+c("impact_flag_with_value", "reproduce", ["--quick", "yes", "--out", "{OUT}"], "quick", out=False)
 
 # ---- scene files ----------------------------------------------------------------------------
 c("scene_missing_file", "trace", ["/nonexistent/scene.ini"] + SMALL, "scene")
@@ -838,7 +864,7 @@ def cwd_snapshot():
 
 
 def substitute(arg, out):
-    return (arg.replace("{S}", S).replace("{D}", D).replace("{FX}", FX)
+    return (arg.replace("{S}", S).replace("{D}", D).replace("{I}", I).replace("{FX}", FX)
             .replace("{OUT}", out))
 
 
