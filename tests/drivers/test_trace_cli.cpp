@@ -347,6 +347,26 @@ TEST(TraceCli, DimensionOnTheCurveIsNeverZero) {
   fs::remove_all(out);
 }
 
+TEST(TraceCli, BackwardsFromASavedPointAsTheReadmeSays) {
+  // README.md, 'Commands': backwards from point 50 of mode 1, bounded at 6e-7 J, exit 0; without
+  // the bound the branch runs into mode 1's grazing limit (T = 4 L/c) and stops early, exit 1.
+  const fs::path mode1 = cli::scratch("trace_cli", "readme_mode1");
+  ASSERT_EQ(cli::run("trace", paper + " --branch mode1", mode1).code, 0);
+  const std::string start = paper + " --branch mode1 --start " + (mode1 / "orbits.csv").string() +
+                            ":50 --direction -1";
+  const fs::path bounded = cli::scratch("trace_cli", "readme_back");
+  const cli::Run r = cli::run("trace", start + " --energy_min 6e-7", bounded);
+  EXPECT_EQ(r.code, 0) << r.err;
+  const auto energy = backbone::core::Table::read_csv(bounded / "branch.csv").column("energy");
+  EXPECT_NEAR(energy.back(), 6e-7, 6e-7 * 1e-9);  // landed on the bound
+  const fs::path unbounded = cli::scratch("trace_cli", "readme_back_to_grazing");
+  const cli::Run g = cli::run("trace", start, unbounded);
+  EXPECT_EQ(g.code, 1) << g.err;
+  const auto period = backbone::core::Table::read_csv(unbounded / "branch.csv").column("period");
+  EXPECT_NEAR(period.back(), 4.0, 1e-3);  // at the grazing limit, T = 4 L/c (L = c = 1)
+  for (const fs::path& dir : {mode1, bounded, unbounded}) fs::remove_all(dir);
+}
+
 TEST(TraceCli, DimensionAboveTheExpectedIsSaidAndCounted) {
   // Far above the gap (end amplitude 1e8 g0, T - 3 = 1e-8 L/c) the attached families crowd mode
   // 1 and the verified dimension exceeds 1 (problems/contact_bar/orbits/README.md, 'Dimension
