@@ -12,11 +12,11 @@
 #include "continuation/cli/progress.hpp"
 #include "continuation/cli/stability_report.hpp"
 #include "continuation/orbit_bifurcations/doubling.hpp"
-#include "core/stability/floquet.hpp"
 #include "core/errors.hpp"
 #include "core/io/output_folder.hpp"
 #include "core/io/scene_ini.hpp"
 #include "core/io/table.hpp"
+#include "core/stability/floquet.hpp"
 
 namespace backbone::cli {
 

@@ -161,10 +161,10 @@ void check_key_values(const std::vector<std::string>& words, const po::options_d
     if (!option) continue;
     const bool next_is_key = i + 1 < words.size() && !key_of(words[i + 1]).empty();
     if (option->semantic()->min_tokens() > 0 && (i + 1 == words.size() || next_is_key))
-      throw InputError(key, i + 1 == words.size()
-                                ? std::string("needs a value (none given at the end)")
-                                : fmt::format("needs a value (got the key '{}' next)",
-                                              words[i + 1]));
+      throw InputError(key,
+                       i + 1 == words.size()
+                           ? std::string("needs a value (none given at the end)")
+                           : fmt::format("needs a value (got the key '{}' next)", words[i + 1]));
     if (option->semantic()->max_tokens() == 0 && i + 1 < words.size() && !next_is_key &&
         words[i + 1].rfind("-", 0) != 0)
       throw InputError(key, fmt::format("takes no value (got '{}' after it)", words[i + 1]));

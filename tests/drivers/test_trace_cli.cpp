@@ -352,8 +352,8 @@ TEST(TraceCli, BackwardsFromASavedPointAsTheReadmeSays) {
   // the bound the branch runs into mode 1's grazing limit (T = 4 L/c) and stops early, exit 1.
   const fs::path mode1 = cli::scratch("trace_cli", "readme_mode1");
   ASSERT_EQ(cli::run("trace", paper + " --branch mode1", mode1).code, 0);
-  const std::string start = paper + " --branch mode1 --start " + (mode1 / "orbits.csv").string() +
-                            ":50 --direction -1";
+  const std::string start =
+      paper + " --branch mode1 --start " + (mode1 / "orbits.csv").string() + ":50 --direction -1";
   const fs::path bounded = cli::scratch("trace_cli", "readme_back");
   const cli::Run r = cli::run("trace", start + " --energy_min 6e-7", bounded);
   EXPECT_EQ(r.code, 0) << r.err;
@@ -387,6 +387,41 @@ TEST(TraceCli, DimensionAboveTheExpectedIsSaidAndCounted) {
       file_text(out / "summary.txt").find("dimension_above_expected " + std::to_string(above)),
       std::string::npos);
   fs::remove_all(out);
+}
+
+}  // namespace
+
+namespace {
+
+// The README's commands (README.md, 'Commands') that the main job does not run as written, run
+// here as written, into a scratch folder in place of out/: each exits 0 and writes what the
+// README says it writes.
+TEST(ReadmeCommands, TraceResumeInspectContinuumAndAtlasRunAsWritten) {
+  const fs::path root = cli::scratch("trace_cli", "readme_commands");
+  fs::create_directories(root);
+  const fs::path mode1 = root / "mode1";
+  ASSERT_EQ(cli::run("trace", paper + " --branch mode1", mode1).code, 0);
+  // A finished branch resumed: nothing left to do, exit 0, the same points.
+  const auto before = backbone::core::Table::read_csv(mode1 / "branch.csv").rows();
+  const std::string resume = "'" + std::string(BACKBONE_BINARY_DIR) +
+                             "/bin/backbone' trace --resume '" + mode1.string() +
+                             "' > /dev/null 2>&1";
+  EXPECT_EQ(std::system(resume.c_str()), 0);
+  EXPECT_EQ(backbone::core::Table::read_csv(mode1 / "branch.csv").rows(), before);
+  const std::string inspect = "'" + std::string(BACKBONE_BINARY_DIR) + "/bin/backbone' inspect " +
+                              paper + " --orbit '" + (mode1 / "orbits.csv").string() +
+                              ":10' > /dev/null 2>&1";
+  EXPECT_EQ(std::system(inspect.c_str()), 0);
+  const cli::Run sc =
+      cli::run("trace", paper + " --branch subharmonic_continuum --energy 1e-4", root / "sc");
+  EXPECT_EQ(sc.code, 0) << sc.err;
+  EXPECT_TRUE(fs::exists(root / "sc" / "limits.csv"));
+  const cli::Run atlas = cli::run(
+      "trace", paper + " --branch subharmonic_manifold --energy_min 1e-5 --energy_max 1e-4",
+      root / "atlas");
+  EXPECT_EQ(atlas.code, 0) << atlas.err;
+  EXPECT_TRUE(fs::exists(root / "atlas" / "manifold.png"));
+  fs::remove_all(root);
 }
 
 }  // namespace

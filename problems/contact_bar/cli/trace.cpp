@@ -538,8 +538,9 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
   problem->set_path_rows(scene.flag("path_rows"));
   if (!scene.flag("path_rows"))
     s.check_for_trace = [] {
-      throw core::InputError("path_rows", "false leaves F alone, a 2D manifold with no curve to "
-                                          "trace: it is for `backbone inspect`");
+      throw core::InputError("path_rows",
+                             "false leaves F alone, a 2D manifold with no curve to "
+                             "trace: it is for `backbone inspect`");
     };
   if (st.manifold) {
     add_manifold_outputs(scene, s, *problem);

@@ -114,8 +114,11 @@ TEST_F(SceneInput, StrayCommandLineWordIsRefused) {
       "command line");
   EXPECT_NE(message.find("unexpected argument 'x'"), std::string::npos) << message;
   // After a flag too: --verbose takes no value, so "yes" is a stray word, named with the flag.
-  const std::string after_flag =
-      input_error([&] { read_scene(keys(), "", {"--verbose", "yes"}, {}); }, "verbose");
+  const std::string after_flag = input_error(
+      [&] {
+        read_scene(keys(), "", {"--verbose", "yes"}, {});
+      },
+      "verbose");
   EXPECT_NE(after_flag.find("takes no value (got 'yes' after it)"), std::string::npos)
       << after_flag;
   // A key that needs a value, followed by another key, is named with its own.
