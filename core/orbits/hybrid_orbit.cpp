@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "core/errors.hpp"
 #include "core/orbits/cvode_integrator.hpp"
@@ -157,23 +158,6 @@ double HybridOrbitProblem::period_at(const Vector& x) const {
   return forced() ? periods_ * forcing_period(parameters_at(x)) : x[n_];
 }
 
-void HybridOrbitProblem::event_gradient(int k, double t, const Vector& y, const Vector& p,
-                                        Vector& n, double& dh_dt) const {
-  n.resize(n_);
-  Vector shifted = y;
-  for (int j = 0; j < n_; ++j) {
-    const double h = central_step(y[j]);
-    shifted[j] = y[j] + h;
-    const double plus = event(k, t, shifted.data(), p);
-    shifted[j] = y[j] - h;
-    const double minus = event(k, t, shifted.data(), p);
-    shifted[j] = y[j];
-    n[j] = (plus - minus) / (2 * h);
-  }
-  const double h = central_step(t);
-  dh_dt = (event(k, t + h, y.data(), p) - event(k, t - h, y.data(), p)) / (2 * h);
-}
-
 HybridShot HybridOrbitProblem::shoot(const Vector& x) const {
   {
     const std::lock_guard<std::mutex> lock(last_mutex_);
@@ -202,23 +186,197 @@ HybridShot HybridOrbitProblem::shoot_without(const Vector& x, const Suppression&
   return shoot_uncached(x, suppressed);
 }
 
+namespace {
+
+// One shot's fixed data and steps: the parameters (and their central-difference neighbours in
+// the free one), the period, the switched-off window; the right-hand side with the variational
+// equations, the root functions with their companions, and what happens at a root.
+class Shot {
+ public:
+  Shot(const HybridOrbitProblem& problem, const Vector& x,
+       const HybridOrbitProblem::Suppression& suppressed)
+      : problem_(problem),
+        n_(problem.state_size()),
+        K_(problem.num_events()),
+        p_(problem.parameters_at(x)),
+        T_(problem.period_at(x)),
+        suppressed_(suppressed) {
+    const int free = problem.free_parameter();
+    dp_ = central_step(p_[free]);
+    p_plus_ = p_minus_ = p_;
+    p_plus_[free] += dp_;
+    p_minus_[free] -= dp_;
+  }
+  double period() const { return T_; }
+
+  // Y = [y | Phi (column-major) | psi]; each call works in its own copies (concurrent shots
+  // share nothing).
+  OdeRightHandSide rhs() const {
+    return [&problem = problem_, n = n_, p = p_, p_plus = p_plus_, p_minus = p_minus_, dp = dp_,
+            A = Matrix(n_, n_), fp = Vector(n_),
+            fm = Vector(n_)](double t, const double* s, double* ds) mutable {
+      problem.field(t, s, p, ds);
+      problem.field_jacobian(t, s, p, A);
+      const Eigen::Map<const Matrix> Phi(s + n, n, n);
+      const Eigen::Map<const Vector> psi(s + n + n * n, n);
+      Eigen::Map<Matrix>(ds + n, n, n).noalias() = A * Phi;
+      problem.field(t, s, p_plus, fp.data());
+      problem.field(t, s, p_minus, fm.data());
+      Eigen::Map<Vector>(ds + n + n * n, n).noalias() = A * psi + (fp - fm) / (2 * dp);
+    };
+  }
+
+  // Roots 0..K-1: the events; K..2K-1: their companions, dh/dt along the flow (header).
+  OdeRootFunctions roots() const {
+    const double step = central_step(T_);
+    return [&problem = problem_, n = n_, K = K_, p = p_, T = T_, step, suppressed = suppressed_,
+            f = Vector(n_), ahead = Vector(n_),
+            behind = Vector(n_)](double t, const double* s, double* g) mutable {
+      problem.field(t, s, p, f.data());
+      const Eigen::Map<const Vector> y(s, n);
+      ahead = y + step * f;
+      behind = y - step * f;
+      for (int k = 0; k < K; ++k) {
+        // A switched-off event stays on its near side (no change of sign at the window's ends,
+        // where the orbit is away from the surface).
+        g[k] = suppressed.covers(k, t, T) ? -(problem.event_direction(k) < 0 ? -1.0 : 1.0)
+                                          : problem.event(k, t, s, p);
+        g[K + k] = (problem.event(k, t + step, ahead.data(), p) -
+                    problem.event(k, t - step, behind.data(), p)) /
+                   (2 * step);
+      }
+    };
+  }
+
+  std::vector<int> directions() const {
+    std::vector<int> d(2 * K_);
+    for (int k = 0; k < K_; ++k) {
+      d[k] = problem_.event_direction(k);
+      d[K_ + k] = -problem_.event_direction(k);
+    }
+    return d;
+  }
+
+  // An extremum of h_k found on the far side of its surface by a segment that started on the near
+  // side (one that starts on the surface, after an event, may reach beyond it: a switch without a
+  // jump): a crossing was stepped over.
+  bool crossing_lost(const std::vector<int>& found, double t, const Vector& Y, double t_start,
+                     const Vector& start) const {
+    for (int r : found) {
+      if (r < K_ || suppressed_.covers(r - K_, t, T_)) continue;
+      const int k = r - K_, dir = problem_.event_direction(k);
+      const double h = problem_.event(k, t, Y.data(), p_);
+      const double h0 = problem_.event(k, t_start, start.data(), p_);
+      if ((dir > 0 && h0 < 0 && h > 0) || (dir < 0 && h0 > 0 && h < 0) || (dir == 0 && h * h0 < 0))
+        return true;
+    }
+    return false;
+  }
+
+  void record_extrema(const std::vector<int>& found, double t, const Vector& Y,
+                      HybridShot& shot) const {
+    for (int r : found) {
+      if (r < K_) continue;
+      const int k = r - K_;
+      const double h =
+          (problem_.event_direction(k) < 0 ? -1.0 : 1.0) * problem_.event(k, t, Y.data(), p_);
+      if ((suppressed_.event < 0 || suppressed_.covers(k, t, T_)) && h > shot.extremum[k]) {
+        shot.extremum[k] = h;
+        shot.extremum_time[k] = t;
+      }
+    }
+  }
+
+  // Event k at t: the reset, and the saltation of Phi and psi (header). Empty on success, else
+  // the failed shot.
+  std::optional<HybridShot> apply_event(int k, double t, Vector& Y, HybridShot& shot) const;
+
+ private:
+  // n = dh_k/dy and dh_k/dt at (t, y), central differences.
+  void event_gradient(int k, double t, const Vector& y, Vector& n, double& dh_dt) const;
+
+  const HybridOrbitProblem& problem_;
+  int n_, K_;
+  Vector p_, p_plus_, p_minus_;
+  double dp_ = 0, T_;
+  HybridOrbitProblem::Suppression suppressed_;
+};
+
+void Shot::event_gradient(int k, double t, const Vector& y, Vector& n, double& dh_dt) const {
+  n.resize(n_);
+  Vector shifted = y;
+  for (int j = 0; j < n_; ++j) {
+    const double h = central_step(y[j]);
+    shifted[j] = y[j] + h;
+    const double plus = problem_.event(k, t, shifted.data(), p_);
+    shifted[j] = y[j] - h;
+    const double minus = problem_.event(k, t, shifted.data(), p_);
+    shifted[j] = y[j];
+    n[j] = (plus - minus) / (2 * h);
+  }
+  const double h = central_step(t);
+  dh_dt =
+      (problem_.event(k, t + h, y.data(), p_) - problem_.event(k, t - h, y.data(), p_)) / (2 * h);
+}
+
+std::optional<HybridShot> Shot::apply_event(int k, double t, Vector& Y, HybridShot& shot) const {
+  const int n = n_;
+  const Vector y_minus = Y.head(n);
+  Vector f_minus(n), f_plus(n), normal, y_plus(n), g_plus(n), g_minus(n);
+  problem_.field(t, y_minus.data(), p_, f_minus.data());
+  double dh_dt = 0;
+  event_gradient(k, t, y_minus, normal, dh_dt);
+  const double D = dh_dt + normal.dot(f_minus);
+  const double speed = std::abs(D) / std::max(normal.norm(), 1e-300);
+  if (!(speed > 0) || !std::isfinite(speed))
+    return failed(HybridShot::Failure::grazing,
+                  fmt::format("event {} is met tangentially at t = {} (grazing)", k, t));
+  problem_.reset(k, y_minus.data(), p_, y_plus.data());
+  if (!y_plus.allFinite())
+    return failed(HybridShot::Failure::reset,
+                  fmt::format("reset {} returned NaN or Inf at t = {}", k, t));
+  // G = dg/dy and g_p, h_p by central differences.
+  Matrix G(n, n);
+  Vector shifted = y_minus;
+  for (int j = 0; j < n; ++j) {
+    const double h = central_step(y_minus[j]);
+    shifted[j] = y_minus[j] + h;
+    problem_.reset(k, shifted.data(), p_, g_plus.data());
+    shifted[j] = y_minus[j] - h;
+    problem_.reset(k, shifted.data(), p_, g_minus.data());
+    shifted[j] = y_minus[j];
+    G.col(j) = (g_plus - g_minus) / (2 * h);
+  }
+  problem_.reset(k, y_minus.data(), p_plus_, g_plus.data());
+  problem_.reset(k, y_minus.data(), p_minus_, g_minus.data());
+  const Vector g_p = (g_plus - g_minus) / (2 * dp_);
+  const double h_p = (problem_.event(k, t, y_minus.data(), p_plus_) -
+                      problem_.event(k, t, y_minus.data(), p_minus_)) /
+                     (2 * dp_);
+  problem_.field(t, y_plus.data(), p_, f_plus.data());
+  const Vector w = f_plus - G * f_minus;
+  const Matrix S = G + w * normal.transpose() / D;
+  Eigen::Map<Matrix> Phi(Y.data() + n, n, n);
+  Eigen::Map<Vector> psi(Y.data() + n + n * n, n);
+  Phi = (S * Phi).eval();
+  psi = (S * psi + g_p + w * (h_p / D)).eval();
+  Y.head(n) = y_plus;
+  shot.events.push_back({k, t, y_minus, y_plus, speed});
+  return std::nullopt;
+}
+
+}  // namespace
+
 HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x,
                                               const Suppression& suppressed) const {
   const int n = n_, K = num_events();
   if (x.size() != num_unknowns() || !x.allFinite())
     return failed(HybridShot::Failure::period, "the unknowns are not finite");
-  const Vector p = parameters_at(x);
-  const double T = period_at(x);
+  const Shot step(*this, x, suppressed);
+  const double T = step.period();
   if (!(T > 0) || !std::isfinite(T))
     return failed(HybridShot::Failure::period,
                   fmt::format("the period is not finite and > 0 (got {})", T));
-  const int free = free_;
-  const double dp = central_step(p[free]);
-  Vector p_plus = p, p_minus = p;
-  p_plus[free] += dp;
-  p_minus[free] -= dp;
-
-  // Y = [y | Phi (column-major) | psi].
   const int size = n + n * n + n;
   Vector Y = Vector::Zero(size);
   Y.head(n) = x.head(n);
@@ -229,43 +387,9 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x,
   cvode.absolute_tolerance = Vector::Constant(size, 1e-3 * options_.relative_tolerance);
   const double amplitude = std::max(x.head(n).lpNorm<Eigen::Infinity>(), 1e-300);
   cvode.absolute_tolerance.head(n).setConstant(1e-3 * options_.relative_tolerance * amplitude);
-
-  // Each right-hand side call works in its own copies (concurrent shots share nothing).
-  const OdeRightHandSide rhs = [this, n, p, p_plus, p_minus, dp, A = Matrix(n, n), fp = Vector(n),
-                                fm = Vector(n)](double t, const double* s, double* ds) mutable {
-    field(t, s, p, ds);
-    field_jacobian(t, s, p, A);
-    const Eigen::Map<const Matrix> Phi(s + n, n, n);
-    const Eigen::Map<const Vector> psi(s + n + n * n, n);
-    Eigen::Map<Matrix>(ds + n, n, n).noalias() = A * Phi;
-    field(t, s, p_plus, fp.data());
-    field(t, s, p_minus, fm.data());
-    Eigen::Map<Vector>(ds + n + n * n, n).noalias() = A * psi + (fp - fm) / (2 * dp);
-  };
-  // Roots 0..K-1: the events; K..2K-1: their companions, dh/dt along the flow (header).
-  const double time_step = central_step(T);
-  const OdeRootFunctions roots = [this, n, K, p, T, time_step, suppressed, f = Vector(n),
-                                  ahead = Vector(n), behind = Vector(n)](double t, const double* s,
-                                                                         double* g) mutable {
-    field(t, s, p, f.data());
-    const Eigen::Map<const Vector> y(s, n);
-    ahead = y + time_step * f;
-    behind = y - time_step * f;
-    for (int k = 0; k < K; ++k) {
-      // A switched-off event stays on its near side (no change of sign at the window's ends,
-      // where the orbit is away from the surface).
-      g[k] =
-          suppressed.covers(k, t, T) ? -(event_direction(k) < 0 ? -1.0 : 1.0) : event(k, t, s, p);
-      g[K + k] =
-          (event(k, t + time_step, ahead.data(), p) - event(k, t - time_step, behind.data(), p)) /
-          (2 * time_step);
-    }
-  };
-  std::vector<int> directions(2 * K);
-  for (int k = 0; k < K; ++k) {
-    directions[k] = event_direction(k);
-    directions[K + k] = -event_direction(k);
-  }
+  const OdeRightHandSide rhs = step.rhs();
+  const OdeRootFunctions roots = step.roots();
+  const std::vector<int> directions = step.directions();
 
   HybridShot shot;
   shot.period = T;
@@ -273,8 +397,6 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x,
   shot.extremum_time.assign(K, nan);
   double t = 0;
   int redo = 0;
-  Vector f_minus(n), f_plus(n), normal, y_plus(n), g_plus(n), g_minus(n), shifted(n);
-  Matrix G(n, n);
   while (true) {
     const Vector start = Y;
     const double t_start = t;
@@ -282,20 +404,7 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x,
     if (!seg.ok) return failed(HybridShot::Failure::integration, seg.message);
     t = seg.t;
     if (seg.roots.empty()) break;
-    // An extremum of h_k on the far side of its surface: a crossing was stepped over.
-    bool lost = false;
-    for (int r : seg.roots) {
-      if (r < K) continue;
-      const int k = r - K;
-      const double h = event(k, t, Y.data(), p), h0 = event(k, t_start, start.data(), p);
-      const int dir = event_direction(k);
-      if (suppressed.covers(k, t, T)) continue;
-      // Lost only when the segment started on the near side (a segment that starts on the
-      // surface, after an event, may reach beyond it: a switch without a jump).
-      if ((dir > 0 && h0 < 0 && h > 0) || (dir < 0 && h0 > 0 && h < 0) || (dir == 0 && h * h0 < 0))
-        lost = true;
-    }
-    if (lost) {
+    if (step.crossing_lost(seg.roots, t, Y, t_start, start)) {
       if (++redo > max_redo)
         return failed(HybridShot::Failure::lost_event,
                       fmt::format("an event crossed twice within a step near t = {}", t));
@@ -305,60 +414,14 @@ HybridShot HybridOrbitProblem::shoot_uncached(const Vector& x,
       continue;
     }
     cvode.max_step = 0;
-    for (int r : seg.roots) {
-      if (r < K) continue;
-      const int k = r - K;
-      const double signed_h = (event_direction(k) < 0 ? -1.0 : 1.0) * event(k, t, Y.data(), p);
-      if ((suppressed.event < 0 || suppressed.covers(k, t, T)) && signed_h > shot.extremum[k]) {
-        shot.extremum[k] = signed_h;
-        shot.extremum_time[k] = t;
-      }
-    }
-    for (int r : seg.roots) {
-      if (r >= K) continue;
-      const int k = r;
+    step.record_extrema(seg.roots, t, Y, shot);
+    for (int k : seg.roots) {
+      if (k >= K) continue;
       if (static_cast<int>(shot.events.size()) >= options_.max_events)
         return failed(
             HybridShot::Failure::too_many_events,
             fmt::format("more than {} events in a period (max_events)", options_.max_events));
-      const Vector y_minus = Y.head(n);
-      field(t, y_minus.data(), p, f_minus.data());
-      double dh_dt = 0;
-      event_gradient(k, t, y_minus, p, normal, dh_dt);
-      const double D = dh_dt + normal.dot(f_minus);
-      const double speed = std::abs(D) / std::max(normal.norm(), 1e-300);
-      if (!(speed > 0) || !std::isfinite(speed))
-        return failed(HybridShot::Failure::grazing,
-                      fmt::format("event {} is met tangentially at t = {} (grazing)", k, t));
-      reset(k, y_minus.data(), p, y_plus.data());
-      if (!y_plus.allFinite())
-        return failed(HybridShot::Failure::reset,
-                      fmt::format("reset {} returned NaN or Inf at t = {}", k, t));
-      // G = dg/dy and g_p, h_p by central differences.
-      shifted = y_minus;
-      for (int j = 0; j < n; ++j) {
-        const double h = central_step(y_minus[j]);
-        shifted[j] = y_minus[j] + h;
-        reset(k, shifted.data(), p, g_plus.data());
-        shifted[j] = y_minus[j] - h;
-        reset(k, shifted.data(), p, g_minus.data());
-        shifted[j] = y_minus[j];
-        G.col(j) = (g_plus - g_minus) / (2 * h);
-      }
-      reset(k, y_minus.data(), p_plus, g_plus.data());
-      reset(k, y_minus.data(), p_minus, g_minus.data());
-      const Vector g_p = (g_plus - g_minus) / (2 * dp);
-      const double h_p =
-          (event(k, t, y_minus.data(), p_plus) - event(k, t, y_minus.data(), p_minus)) / (2 * dp);
-      field(t, y_plus.data(), p, f_plus.data());
-      const Vector w = f_plus - G * f_minus;
-      const Matrix S = G + w * normal.transpose() / D;
-      Eigen::Map<Matrix> Phi(Y.data() + n, n, n);
-      Eigen::Map<Vector> psi(Y.data() + n + n * n, n);
-      Phi = (S * Phi).eval();
-      psi = (S * psi + g_p + w * (h_p / D)).eval();
-      Y.head(n) = y_plus;
-      shot.events.push_back({k, t, y_minus, y_plus, speed});
+      if (auto failure = step.apply_event(k, t, Y, shot)) return *failure;
     }
     if (!(t < T)) break;
   }

@@ -192,8 +192,6 @@ class HybridOrbitProblem : public Problem, public FloquetProblem {
 
  private:
   HybridShot shoot_uncached(const Vector& x, const Suppression& suppressed) const;
-  void event_gradient(int k, double t, const Vector& y, const Vector& p, Vector& n,
-                      double& dh_dt) const;
 
   int n_;
   std::vector<std::string> names_;

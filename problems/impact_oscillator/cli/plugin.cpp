@@ -68,7 +68,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
     continuation.bounds.push_back({"impact_velocity", grazing_velocity, inf});
     continuation.bounds.push_back({"wall_gap", grazing_gap, inf});
   };
-  s.describe_point = [exact = problem.get()](const cli::BranchPoint& point) {
+  s.describe_point = [](const cli::BranchPoint& point) {
     const auto oracle = period_one_orbit(point.observable("frequency"),
                                          point.observable("restitution"), point.observable("wall"));
     if (!oracle || point.observable("impacts_per_period") != 1) return std::string();
