@@ -9,9 +9,7 @@
 namespace backbone::continuation {
 
 double BranchPoint::observable(const std::string& name) const {
-  for (const auto& [key, value] : observables)
-    if (key == name) return value;
-  return std::numeric_limits<double>::quiet_NaN();
+  return core::observable_value(observables, name);
 }
 
 const char* to_string(StopReason r) {
@@ -128,11 +126,6 @@ core::Table branch_point_table(const Branch& branch, const core::Observables& te
     for (const auto& [key, value] : r.observables) add_name(observables, key);
     for (const auto& [key, value] : r.attached_description) add_name(described, key);
   }
-  const auto value_of = [](const core::Observables& list, const std::string& name) {
-    for (const auto& [key, value] : list)
-      if (key == name) return value;
-    return std::numeric_limits<double>::quiet_NaN();
-  };
   std::vector<std::string> columns = observables;
   columns.push_back("dimension");
   columns.insert(columns.end(), described.begin(), described.end());
@@ -143,9 +136,11 @@ core::Table branch_point_table(const Branch& branch, const core::Observables& te
   core::Table table(columns);
   for (const BranchPointReport& r : branch.branch_points) {
     std::vector<double> row;
-    for (const std::string& n : observables) row.push_back(value_of(r.observables, n));
+    for (const std::string& n : observables)
+      row.push_back(core::observable_value(r.observables, n));
     row.push_back(r.attached_dimension);
-    for (const std::string& n : described) row.push_back(value_of(r.attached_description, n));
+    for (const std::string& n : described)
+      row.push_back(core::observable_value(r.attached_description, n));
     row.insert(
         row.end(),
         {r.tangent_angle, r.verified() ? 1.0 : 0.0, static_cast<double>(r.nullity),

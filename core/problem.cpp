@@ -1,8 +1,15 @@
 #include "core/problem.hpp"
 
 #include <chrono>
+#include <limits>
 
 namespace backbone::core {
+
+double observable_value(const Observables& observables, const std::string& name) {
+  for (const auto& [key, value] : observables)
+    if (key == name) return value;
+  return std::numeric_limits<double>::quiet_NaN();
+}
 
 const char* to_string(EvalStatus s) {
   switch (s) {

@@ -85,6 +85,8 @@ struct JacobianPattern {
 
 // A named scalar derived from a solution point (period, energy, frequency...).
 using Observables = std::vector<std::pair<std::string, double>>;
+// The value of the observable `name` in the list; NaN when it is not there.
+double observable_value(const Observables& observables, const std::string& name);
 
 class Problem {
  public:

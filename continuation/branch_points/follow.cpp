@@ -15,15 +15,7 @@
 
 namespace backbone::continuation {
 
-namespace {
-
-double observable_of(const core::Observables& observables, const std::string& name) {
-  for (const auto& [key, value] : observables)
-    if (key == name) return value;
-  return std::numeric_limits<double>::quiet_NaN();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 FollowSelection parse_follow(const std::string& text) {
   FollowSelection s;
@@ -59,12 +51,12 @@ std::optional<AttachedStart> attached_start(const core::Problem& problem,
   if (report.x.size() == 0 || rank < 0) return std::nullopt;
   const ScaledProblem scaled(problem);
   const core::Vector zx = scaled.to_scaled(report.x);
-  const double fx = observable_of(problem.observables(report.x), observable);
+  const double fx = core::observable_value(problem.observables(report.x), observable);
   std::vector<AttachedStart> starts;
   for (std::size_t i = 0; i < report.attached_points.size(); ++i) {
     const core::Vector& y = report.attached_points[i];
     const double distance = (scaled.to_scaled(y) - zx).norm();
-    const double change = observable_of(problem.observables(y), observable) - fx;
+    const double change = core::observable_value(problem.observables(y), observable) - fx;
     if (!(distance > 0) || !std::isfinite(change)) continue;
     const double sign = change < 0 ? -1.0 : 1.0;
     starts.push_back({report.x + sign * (y - report.x), sign * (y - report.x), static_cast<int>(i),

@@ -105,7 +105,7 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
 }
 
 void PointRecorder::add_floquet(BranchPoint& point) const {
-  if (!options_.stability || !dynamic_cast<const core::FloquetProblem*>(&counted_)) return;
+  if (!options_.stability) return;
   // The point's unknowns in the base's units (the loops record points in scaled unknowns).
   const auto* scaled = dynamic_cast<const ScaledProblem*>(&problem_);
   const core::Vector x = scaled ? scaled->to_unknowns(point.x) : point.x;

@@ -21,12 +21,6 @@ constexpr double bracket_tolerance = 1e-10;
 constexpr int max_location_steps = 80;
 constexpr double grazing_fraction = 0.5;
 
-double observable_of(const core::Observables& list, const std::string& name) {
-  for (const auto& [key, value] : list)
-    if (key == name) return value;
-  return nan;
-}
-
 enum class Kind { fold, period_doubling, torus };
 
 const char* name_of(Kind k) {
@@ -258,7 +252,7 @@ core::Table bifurcation_table(const std::vector<OrbitBifurcation>& found,
   core::Table table(columns);
   for (const OrbitBifurcation& b : found) {
     std::vector<double> row;
-    for (const std::string& n : names) row.push_back(observable_of(b.observables, n));
+    for (const std::string& n : names) row.push_back(core::observable_value(b.observables, n));
     row.push_back(b.floquet.stable);
     row.push_back(b.floquet.max_modulus);
     for (std::size_t k = 0; k < multipliers; ++k) {

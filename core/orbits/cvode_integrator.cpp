@@ -172,29 +172,6 @@ std::string prepare(Workspace& workspace, const Vector& y, double t0, double t_e
 
 }  // namespace
 
-IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t_end,
-                                const CvodeOptions& options) {
-  thread_local Workspace workspace;
-  const Callbacks callbacks{&rhs, nullptr};
-  const std::string problem = prepare(workspace, y, 0.0, t_end, options, callbacks, {});
-  if (!problem.empty()) return {false, 0, problem};
-  void* mem = workspace.memory.get();
-  sunrealtype t = 0;
-  const int flag = CVode(mem, t_end, workspace.state.get(), &t, CV_NORMAL);
-  IntegrationResult result;
-  long steps = 0;
-  CVodeGetNumSteps(mem, &steps);
-  result.steps = steps;
-  if (flag < 0) {
-    result.message =
-        fmt::format("cvode: CVode failed at t = {} of {} ({})", t, t_end, flag_name(flag));
-    return result;
-  }
-  y = Eigen::Map<Vector>(N_VGetArrayPointer(workspace.state.get()), y.size());
-  result.ok = true;
-  return result;
-}
-
 SegmentResult integrate_to_event(const OdeRightHandSide& rhs, const OdeRootFunctions& roots,
                                  const std::vector<int>& directions, Vector& y, double t0,
                                  double t_end, const CvodeOptions& options) {
@@ -227,6 +204,11 @@ SegmentResult integrate_to_event(const OdeRightHandSide& rhs, const OdeRootFunct
   }
   result.ok = true;
   return result;
+}
+
+IntegrationResult integrate_ode(const OdeRightHandSide& rhs, Vector& y, double t_end,
+                                const CvodeOptions& options) {
+  return integrate_to_event(rhs, {}, {}, y, 0.0, t_end, options);
 }
 
 }  // namespace backbone::core

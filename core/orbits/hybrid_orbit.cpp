@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "core/errors.hpp"
+#include "core/jacobians/finite_difference.hpp"
 #include "core/orbits/cvode_integrator.hpp"
 
 namespace backbone::core {
@@ -17,11 +18,10 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-// Central-difference step for a value z: cbrt(eps) max(|z|, 1), rounded so that z + h is exact.
+// Central-difference step for a value z: cbrt(eps) max(|z|, 1), rounded so that z + h is exact
+// (the step rule of finite_difference.hpp with a unit scale).
 double central_step(double z) {
-  const double h0 = std::cbrt(std::numeric_limits<double>::epsilon()) * std::max(std::abs(z), 1.0);
-  volatile double moved = z + h0;
-  return moved - z;
+  return finite_difference_step(z, 1.0, std::cbrt(std::numeric_limits<double>::epsilon()));
 }
 
 // A segment is integrated again with steps below (time to the lost crossing) / this, at most

@@ -46,13 +46,7 @@ double observable_value(const Problem& problem, const std::string& name, const V
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-namespace {
-double lookup(const Observables& observables, const std::string& name) {
-  for (const auto& [key, value] : observables)
-    if (key == name) return value;
-  return std::numeric_limits<double>::quiet_NaN();
-}
-}  // namespace
+namespace {}  // namespace
 
 BorderedSystem::BorderedSystem(const Problem& base, std::vector<BorderRow> rows)
     : base_(base), rows_(std::move(rows)) {
@@ -135,7 +129,7 @@ EvalStatus BorderedSystem::compute_residual(const Vector& x, Vector& r) const {
     if (row.kind == BorderRow::Kind::linear) {
       r[m + i] = row.direction.dot(x - row.anchor) - row.value;
     } else {
-      r[m + i] = (lookup(observed, row.observable_name) - row.value) / row_scale(i);
+      r[m + i] = (observable_value(observed, row.observable_name) - row.value) / row_scale(i);
       if (!std::isfinite(r[m + i])) return EvalStatus::failed;
     }
   }
@@ -180,7 +174,8 @@ EvalStatus BorderedSystem::jacobian_with_base(const Vector& x, const Matrix& bas
     for (int i = 0; i < num_rows(); ++i) {
       const BorderRow& row = rows_[static_cast<std::size_t>(i)];
       if (row.kind != BorderRow::Kind::observable) continue;
-      J(m + i, j) = (lookup(plus, row.observable_name) - lookup(minus, row.observable_name)) /
+      J(m + i, j) = (observable_value(plus, row.observable_name) -
+                     observable_value(minus, row.observable_name)) /
                     ((xp[j] - xm[j]) * row_scale(i));
     }
   }

@@ -227,21 +227,11 @@ int write_summary(const fs::path& out) {
         if (type == "grazing" && name == "up") grazing = f.column("wall")[i];
       }
     }
-    // The closed form's period doubling: 1 + tr M + det M = 0, by bisection over [-0.2, 0].
-    const auto g = [&](double sigma) {
-      const auto o = period_one_orbit(omega, r, sigma);
-      return std::real((1.0 + o->multipliers[0]) * (1.0 + o->multipliers[1]));
-    };
-    double lo = -0.2, hi = 0.0;
-    const double g_lo = g(lo);
-    for (int i = 0; i < 200; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      (g(mid) * g_lo > 0 ? lo : hi) = mid;
-    }
-    const double exact_doubling = 0.5 * (lo + hi);
+    const double exact_doubling = period_doubling_wall(omega, r, -0.2, 0.0);
+    const auto at_doubling = period_one_orbit(omega, r, exact_doubling);
     summary.add_row({r, points, det, velocity, mu0, mu1, doubling, exact_doubling,
-                     doubling_velocity, period_one_orbit(omega, r, exact_doubling)->impact_velocity,
-                     grazing, 1 / (omega * omega - 1), p2_points, p2_stable, p2_period, p2_det});
+                     doubling_velocity, at_doubling ? at_doubling->impact_velocity : nan, grazing,
+                     1 / (omega * omega - 1), p2_points, p2_stable, p2_period, p2_det});
   }
   if (!any) {
     fmt::print(stderr, "[figures] impact_summary: no branch in {}\n", folder(out).string());

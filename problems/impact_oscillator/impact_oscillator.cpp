@@ -1,6 +1,7 @@
 #include "problems/impact_oscillator/impact_oscillator.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace backbone::impact_oscillator {
@@ -80,6 +81,21 @@ std::optional<PeriodOneOrbit> period_one_orbit(double omega, double r, double si
   const std::complex<double> root = std::sqrt(std::complex<double>(trace * trace / 4 - det));
   orbit.multipliers = {trace / 2 + root, trace / 2 - root};
   return orbit;
+}
+
+double period_doubling_wall(double omega, double r, double lo, double hi) {
+  const auto g = [omega, r](double sigma) {
+    const auto o = period_one_orbit(omega, r, sigma);
+    return o ? std::real((1.0 + o->multipliers[0]) * (1.0 + o->multipliers[1]))
+             : std::numeric_limits<double>::quiet_NaN();
+  };
+  const double g_lo = g(lo);
+  if (!(g_lo * g(hi) < 0)) return std::numeric_limits<double>::quiet_NaN();
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (g(mid) * g_lo > 0 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 boost::program_options::options_description scene_keys() {

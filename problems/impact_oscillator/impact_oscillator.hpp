@@ -64,6 +64,11 @@ struct PeriodOneOrbit {
 // or omega is a multiple of 1 (resonance: no particular solution).
 std::optional<PeriodOneOrbit> period_one_orbit(double omega, double r, double sigma);
 
+// The wall where the period-1 orbit's closed-form multipliers pass -1 (1 + tr M + r^2 = 0), by
+// bisection over [lo, hi] to machine precision; NaN when no orbit exists at an end or the sign
+// does not change there.
+double period_doubling_wall(double omega, double r, double lo, double hi);
+
 // Scene keys of the impact oscillator (frequency, restitution, wall, wall_min, wall_max, rtol,
 // continuation_parameter) with defaults.
 boost::program_options::options_description scene_keys();
