@@ -38,7 +38,7 @@ void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_dir
   const core::Matrix* nearby = options_.chord_corrections ? &J : nullptr;
   if (verifier_) {
     core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, report,
-                                 nearby, previous);
+                                 nearby, previous, known_residual(previous));
     point.dimension = report.verified_dimension;
   } else {
     point.dimension = report.nullity;
@@ -57,7 +57,7 @@ void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& cu
   core::RankReport along;
   along.null_directions = curve_direction / norm;
   core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, along,
-                               jacobian, previous);
+                               jacobian, previous, known_residual(previous));
   if (along.verified_dimension != 1) return;
   // The curve is there. The rest of the candidate null space, orthogonal to it: the columns of
   // an orthonormal basis of span(D) after the curve direction's component in it.
@@ -73,7 +73,7 @@ void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& cu
   core::RankReport others;
   others.null_directions = D * Q.rightCols(k - 1);
   core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, others,
-                               jacobian, previous);
+                               jacobian, previous, known_residual(previous));
   point.dimension += std::max(others.verified_dimension, 0);
 }
 
@@ -98,10 +98,17 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   const bool due = options_.rank_check_every > 0 && index % options_.rank_check_every == 0;
   if (due || (force_rank && options_.rank_check_every > 0))
     check_rank(p, curve_direction, previous);
+  last_x_ = p.x;
+  last_residual_ = p.residual;
   p.residual_evaluations = counted_.counters().residuals - residuals_at_start_;
   p.jacobian_evaluations = counted_.counters().jacobians - jacobians_at_start_;
   p.seconds = elapsed_seconds();
   return p;
+}
+
+double PointRecorder::known_residual(const core::Vector* x) const {
+  if (x && x->size() == last_x_.size() && *x == last_x_) return last_residual_;
+  return std::numeric_limits<double>::quiet_NaN();
 }
 
 void PointRecorder::add_floquet(BranchPoint& point) const {

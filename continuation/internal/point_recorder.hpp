@@ -18,6 +18,7 @@
 #pragma once
 
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -61,12 +62,18 @@ class PointRecorder {
   double elapsed_seconds() const;
 
  private:
+  // ||F(x)||_inf when x is the last point finish() recorded (the branch's previous point, the
+  // verification's known neighbour), else NaN.
+  double known_residual(const core::Vector* x) const;
+
   const core::Problem& problem_;
   const core::Problem& counted_;
   const ContinuationOptions& options_;
   std::unique_ptr<core::Corrector> verifier_;  // eigen: handles non-square constrained systems
   std::chrono::steady_clock::time_point start_;
   long residuals_at_start_ = 0, jacobians_at_start_ = 0;
+  core::Vector last_x_;  // the last recorded point and its residual norm
+  double last_residual_ = std::numeric_limits<double>::quiet_NaN();
 };
 
 }  // namespace backbone::continuation

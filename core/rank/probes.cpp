@@ -166,26 +166,25 @@ class DirectionProbes {
  public:
   DirectionProbes(const Problem& problem, const Vector& x, Corrector& corrector,
                   const VerifyOptions& options, const Matrix* jacobian_at_x,
-                  const Vector* neighbour)
+                  const Vector* neighbour, double neighbour_residual)
       : problem_(problem),
         x_(x),
         corrector_(corrector),
         options_(options),
         scale_(problem.typical_scale().cwiseAbs()),
-        neighbour_(neighbour),
         start_{jacobian_at_x} {
-    // A known neighbour stands in for the probe of the direction it verifies.
     if (neighbour && neighbour->size() == problem.num_unknowns() && neighbour->allFinite()) {
-      Vector f;
-      neighbour_ok_ = problem.residual(*neighbour, f) == EvalStatus::ok &&
-                      f.lpNorm<Eigen::Infinity>() <= options.residual_tolerance;
+      neighbour_ = neighbour;
+      neighbour_residual_ = neighbour_residual;
     }
   }
 
   Probe operator()(const Vector& d) {
-    if (neighbour_ok_) {
+    // A known neighbour stands in for the probe of the direction it verifies; its residual is
+    // evaluated (once) only when the drift test passes and the caller did not give it.
+    if (neighbour_) {
       Probe known = known_neighbour(x_, d, *neighbour_);
-      if (found_neighbour(known, options_)) return known;
+      if (found_neighbour(known, options_) && neighbour_is_solution()) return known;
     }
     return probe_either_side(problem_, x_, d, step_along(d), corrector_, options_, start_);
   }
@@ -202,8 +201,18 @@ class DirectionProbes {
   Corrector& corrector_;
   const VerifyOptions& options_;
   const Vector scale_;
-  const Vector* neighbour_;
-  bool neighbour_ok_ = false;
+  bool neighbour_is_solution() {
+    if (std::isnan(neighbour_residual_)) {
+      Vector f;
+      neighbour_residual_ = problem_.residual(*neighbour_, f) == EvalStatus::ok
+                                ? f.lpNorm<Eigen::Infinity>()
+                                : std::numeric_limits<double>::infinity();
+    }
+    return neighbour_residual_ <= options_.residual_tolerance;
+  }
+
+  const Vector* neighbour_ = nullptr;
+  double neighbour_residual_ = std::numeric_limits<double>::quiet_NaN();
   ChordStart start_;
 };
 
@@ -250,7 +259,8 @@ Matrix passed_then_rotated(const Matrix& D, const std::vector<Probe>& first,
 
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
                             const VerifyOptions& options, RankReport& report,
-                            const Matrix* jacobian_at_x, const Vector* neighbour) {
+                            const Matrix* jacobian_at_x, const Vector* neighbour,
+                            double neighbour_residual) {
   options.validate();
   const int n = problem.num_unknowns();
   if (x.size() != n || report.null_directions.rows() != n)
@@ -261,7 +271,8 @@ void verify_null_directions(const Problem& problem, const Vector& x, Corrector& 
   report.direction_verified.assign(static_cast<std::size_t>(k), false);
   report.verified_dimension = 0;
   if (k == 0) return;
-  DirectionProbes probe_direction(problem, x, corrector, options, jacobian_at_x, neighbour);
+  DirectionProbes probe_direction(problem, x, corrector, options, jacobian_at_x, neighbour,
+                                  neighbour_residual);
 
   // Pass 1: probe the candidate basis as given.
   const Matrix D = report.null_directions;

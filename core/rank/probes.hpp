@@ -16,6 +16,7 @@
 //   fmt::print("nullity {} verified {}\n", rep.nullity, rep.verified_dimension);
 #pragma once
 
+#include <limits>
 #include <memory>
 
 #include "core/problem.hpp"
@@ -70,10 +71,13 @@ std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options);
 // h = d . (neighbour - x) and been corrected onto it: ||F(neighbour)||_inf <= residual_tolerance
 // and |neighbour - x - h d| <= drift_ratio |h|. On a curve the one candidate is the tangent,
 // which the secant to the previous point verifies: one residual instead of a correction
-// (core/README.md, 'Rank reports').
+// (core/README.md, 'Rank reports'). neighbour_residual: ||F(neighbour)||_inf when the caller
+// has it (a branch recorded it with the point); NaN: evaluated here, once, and only when some
+// direction passes the drift test on the neighbour.
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
                             const VerifyOptions& options, RankReport& report,
                             const Matrix* jacobian_at_x = nullptr,
-                            const Vector* neighbour = nullptr);
+                            const Vector* neighbour = nullptr,
+                            double neighbour_residual = std::numeric_limits<double>::quiet_NaN());
 
 }  // namespace backbone::core

@@ -46,10 +46,16 @@ struct BackboneRun {
   long residuals = 0;
   long jacobians = 0;
   std::string message;  // the branch's stop message
+  std::string label;    // the table's setting (empty: rtol and ds_max of settings)
 };
 
 // Throws InputError for bad settings; a numerical failure is complete = false.
 BackboneRun trace_backbone(const BackboneSettings& settings);
+
+// The command line's defaults: `backbone trace problems/duffing/scenes/duffing.ini --bound
+// amplitude:0.005:5` (the scene's rtol, steps and Newton settings, a verified rank report and
+// the multipliers at every point), the continuation alone timed (no output files, no figure).
+BackboneRun trace_scene_defaults();
 
 // One AUTO-07p run of the stored input files (peers/duffing.f90, peers/duffing.auto).
 struct AutoRun {

@@ -249,12 +249,41 @@ TEST(VerifyNullDirections, AKnownNeighbourAlongTheDirectionStandsInForItsProbe) 
     EXPECT_EQ(r.verified_dimension, 1) << r.summary();
     const long used = circle.counters().residuals - residuals;
     if (c.probed) {
-      EXPECT_GT(used, 1);  // the neighbour's residual, then the probe's
+      EXPECT_GT(used, 0);  // the probe's residuals (and the neighbour's when it passed drift)
     } else {
       EXPECT_EQ(used, 1);
       EXPECT_EQ(circle.counters().jacobians, jacobians);
     }
   }
+}
+
+// The residual of the neighbour, when the caller has it (a branch recorded it), is not
+// evaluated again: the neighbour along the tangent then verifies for no evaluation at all. A
+// given residual above residual_tolerance refuses the neighbour as an evaluated one would (the
+// probe then runs), so the verdict is the same either way.
+TEST(VerifyNullDirections, AGivenNeighbourResidualIsNotEvaluatedAgain) {
+  Sphere circle(2);
+  const double a = std::atan2(0.8, 0.6);
+  Vector x(2), neighbour(2);
+  x << std::cos(a), std::sin(a);
+  neighbour << std::cos(a + 0.1), std::sin(a + 0.1);
+  Matrix J;
+  ASSERT_EQ(circle.jacobian(x, J), EvalStatus::ok);
+  EigenNewton eigen(tight());
+  Vector f;
+  ASSERT_EQ(circle.residual(neighbour, f), EvalStatus::ok);
+  const double known = f.lpNorm<Eigen::Infinity>();
+  RankReport r = rank_report(J, RankOptions{});
+  long residuals = circle.counters().residuals;
+  verify_null_directions(circle, x, eigen, VerifyOptions{}, r, nullptr, &neighbour, known);
+  EXPECT_EQ(r.verified_dimension, 1) << r.summary();
+  EXPECT_EQ(circle.counters().residuals - residuals, 0);
+  // A residual of 1e-3 (above 1e-9) for the same point: refused, so the probe runs and verifies.
+  RankReport again = rank_report(J, RankOptions{});
+  residuals = circle.counters().residuals;
+  verify_null_directions(circle, x, eigen, VerifyOptions{}, again, nullptr, &neighbour, 1e-3);
+  EXPECT_EQ(again.verified_dimension, 1) << again.summary();
+  EXPECT_GT(circle.counters().residuals - residuals, 0);
 }
 
 // The probes' chord steps start on J(x) while it serves (rank_report.cpp, ChordStart). On the
