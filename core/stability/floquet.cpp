@@ -55,6 +55,17 @@ Floquet analyse_monodromy(const Matrix& M, const FloquetStructure& structure,
               return std::arg(a) < std::arg(b);
             });
   f.determinant = M.determinant();
+  if (!std::isfinite(f.determinant)) {
+    // LU's product of pivots overflows on a large M whose rows carry different units (the
+    // contact bar's u and v rows): the product of the multipliers, by decreasing modulus
+    // interleaved with the smallest so that it stays in range, is the same number.
+    std::complex<double> product = 1;
+    for (int i = 0, j = n - 1; i <= j; ++i, --j) {
+      product *= f.multipliers[static_cast<std::size_t>(i)];
+      if (j != i) product *= f.multipliers[static_cast<std::size_t>(j)];
+    }
+    f.determinant = product.real();
+  }
 
   // The trivial ones: the structure's count nearest to +1.
   f.trivial.assign(n, false);

@@ -26,6 +26,7 @@
 
 #include "core/errors.hpp"
 #include "core/io/table.hpp"
+#include "core/jacobians/finite_difference.hpp"
 #include "problems/contact_bar/cli/simulate.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/orbits/attached_content.hpp"
@@ -63,6 +64,18 @@ po::options_description subharmonic_keys() {
        "subharmonic branches: replace branch.csv's dimension (that of F plus the path rows) by "
        "the verified dimension of the periodicity residual F alone at each point");
   return keys;
+}
+
+// The monodromy's grid, difference step and threads (keys stability_elements, stability_step,
+// threads); InputError naming the key.
+MonodromyOptions monodromy_options(const core::Scene& scene) {
+  MonodromyOptions o;
+  o.elements = static_cast<int>(scene.integer("stability_elements", 0, 2000));
+  o.relative_step = scene.number("stability_step");
+  o.courant = scene.number("stability_courant");
+  o.threads = static_cast<int>(scene.integer("threads", 1, core::max_jacobian_threads));
+  o.validate();
+  return o;
 }
 
 po::options_description trace_keys() {
@@ -120,6 +133,20 @@ po::options_description trace_keys() {
       ("max_memory", po::value<double>()->default_value(0),
        "refuse a trace whose dense Jacobian and its factorizations would need more than this "
        "many GB (>= 0; 0: half of this machine's memory)")  //
+      ("stability", po::value<bool>()->default_value(false),
+       "Floquet multipliers of every point (branch.csv's stability columns, multipliers.csv): "
+       "the monodromy of the full state (u, v) on a grid of stability_elements, by "
+       "differences of 4 x stability_elements simulations of one period per point "
+       "(problems/contact_bar/orbits/README.md, section 'Stability'). Off by default: it costs "
+       "more than the point itself")  //
+      ("stability_elements", po::value<long>()->default_value(0),
+       "intervals of the monodromy's (u, v) grid, in [0, 2000] (0: shooting_elements); M is "
+       "2N x 2N, dense (128 MB and about a minute of eigenvalues at 2000)")  //
+      ("stability_courant", po::value<double>()->default_value(1.0 / 32),
+       "c dt / dx of the monodromy's simulations at most, in (0, 1]: the velocity columns of "
+       "the monodromy carry an error of 0.46 (c dt / dx)^2")  //
+      ("stability_step", po::value<double>()->default_value(1e-6),
+       "difference step of the monodromy, relative to the orbit's amplitude, in (0, 1e-2)")  //
       ("return_tolerance", po::value<double>()->default_value(1e-6),
        "reject a converged point whose orbit, re-simulated over T by the exact oracle, misses "
        "u0 or v0 = 0 by more than this, relative to max|u0| (0: no check). Catches spurious "
@@ -332,6 +359,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   options.amplitude_units = scene.flag("amplitude_units") && scene.text("follow") == "none";
 
   auto problem = std::make_unique<ContactBarOrbitProblem>(setup, solver, options);
+  problem->set_monodromy_options(monodromy_options(scene));
   const double ratio = 1 + scene.positive("start_offset");
   const std::string guess = scene.choice("start_guess", {"contact_family", "linear_mode"});
 
@@ -512,6 +540,7 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
   const OrbitOptions options = subharmonic_chart(scene, material, st);
 
   auto problem = std::make_unique<ContactBarOrbitProblem>(setup, shooting_solver(scene), options);
+  problem->set_monodromy_options(monodromy_options(scene));
   cli::TraceSetup s;
   s.guess = problem->subharmonic_guess(st.start_energy, st.shape);
   check_time_step(material, s.guess[problem->period_index()], options.steps_per_period);

@@ -434,6 +434,10 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
   return pattern;
 }
 
+EvalStatus ContactBarOrbitProblem::monodromy(const Vector& x, core::Matrix& M) const {
+  return full_state_monodromy(*this, x, monodromy_options_, M);
+}
+
 EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
   const int n = options_.elements;
   const int m = options_.test_elements > 0 ? options_.test_elements : state_size();  // grid

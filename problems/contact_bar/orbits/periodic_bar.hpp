@@ -38,7 +38,9 @@
 
 #include "continuation/scaled_problem.hpp"
 #include "core/orbits/periodic_orbit.hpp"
+#include "core/stability/floquet.hpp"
 #include "problems/bar/bar.hpp"
+#include "problems/contact_bar/orbits/monodromy.hpp"
 
 namespace backbone::contact_bar {
 
@@ -83,7 +85,9 @@ struct OrbitOptions {
   void validate() const;  // throws core::InputError naming the field
 };
 
-class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continuation::LocalScale {
+class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
+                               public continuation::LocalScale,
+                               public core::FloquetProblem {
  public:
   // setup: material and ends (left fixed, right contact or free, no body force); its u0, v0
   // are ignored. The solver must outlive the problem. Throws core::InputError.
@@ -150,6 +154,18 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continu
   // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
   double displacement_scale() const;
 
+  // Floquet multipliers (core::FloquetProblem): the monodromy of the full state (u, v) in the
+  // representation of monodromy.hpp, 2N x 2N, by differences of 4N simulations of one period
+  // (README.md, section 'Stability'). Conservative, two trivial multipliers (time shift and
+  // energy).
+  core::EvalStatus monodromy(const core::Vector& x, core::Matrix& M) const override;
+  core::FloquetStructure floquet_structure() const override { return {2, true}; }
+  void set_monodromy_options(const MonodromyOptions& options) {
+    options.validate();
+    monodromy_options_ = options;
+  }
+  const MonodromyOptions& monodromy_options() const { return monodromy_options_; }
+
   // The initial displacement at x, as the solver sees it (knots at the node positions).
   bar::PiecewiseLinear initial_displacement(const core::Vector& x) const;
   // The full setup the residual simulates at x (template + u0, v0 = 0).
@@ -188,6 +204,7 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem, public continu
   bar::BarSetup setup_;
   const bar::BarSolver& solver_;
   OrbitOptions options_;
+  MonodromyOptions monodromy_options_;
   bool path_rows_enabled_ = true;
 };
 

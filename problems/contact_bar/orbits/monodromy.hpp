@@ -1,0 +1,62 @@
+// The monodromy of a contact-bar orbit: the derivative of the period map of the full state
+// (u, v), in a stated finite representation (README.md, section 'Stability').
+//
+// Representation: continuous piecewise-linear u and v on the uniform grid of `elements`
+// intervals, nodal values at x_1..x_N (x_0 = 0 is the fixed end, u = v = 0 there). The state
+// s = [u_1..u_N | v_1..v_N] is simulated over one period T by the problem's bar solver, and
+// mapped back onto the grid: u by its point values at the nodes, v by its L2 projection onto
+// the same space (hat-weighted integrals, solved with the P1 mass matrix). Both are exact for a
+// piecewise-linear state on the grid, so the period map is exact wherever the state at T is one
+// (the free bar after 2L/c or 4L/c: -I and I); a state at T with kinks off the grid is
+// projected, and a projection dissipates (README.md, 'Stability').
+//
+// The bar solver marches the piecewise-linear u0 exactly, a piecewise-linear v0 to second order
+// in c dt / dx (its end histories are quadratic between steps, the march's linear): the time step
+// of the map is the problem's, or courant dx / c when smaller (T / dt an integer). Measured on the
+// free bar after 4L/c (tests/problems/contact_bar/orbits/test_monodromy.cpp): the v columns of M
+// are off by 0.46 (c dt / dx)^2, the u columns by round-off.
+// M = d(map)/ds by central differences, 4N simulations of one period (on `threads` threads). The
+// period map is affine while the contact sequence and the grid cells holding its instants' fronts
+// stay the same, so the differences are exact up to the round-off of each simulation divided by the
+// step (relative_step times the orbit's scale).
+//
+//   contact_bar::MonodromyOptions o; o.elements = 40;
+//   core::Matrix M;
+//   core::EvalStatus st = contact_bar::full_state_monodromy(problem, x, o, M);   // 2N x 2N
+#pragma once
+
+#include "core/problem.hpp"
+#include "core/types.hpp"
+
+namespace backbone::contact_bar {
+
+class ContactBarOrbitProblem;
+
+struct MonodromyOptions {
+  int elements = 0;             // N of the representation; 0: the problem's elements
+  double relative_step = 1e-6;  // difference step: this times max(max|u0|, gap) for u, times
+                                // c / L that for v
+  double courant = 1.0 / 32;    // c dt / dx of the map at most (0.46 / 32^2 = 4.5e-4 in M's v
+                                // columns)
+  int threads = 1;
+  void validate() const;  // InputError naming stability_elements / stability_step
+};
+
+// The state s of the representation for the orbit x of `problem` (u0 sampled at the uniform
+// nodes, v0 = 0), size 2N.
+core::Vector full_state(const ContactBarOrbitProblem& problem, const core::Vector& x, int elements);
+
+// The time step of the map at period T on a grid of `elements` (the rule above).
+double full_state_time_step(const ContactBarOrbitProblem& problem, double period, int elements,
+                            double courant);
+
+// The period map of the representation at period T and time step dt: s -> [u(x_i, T) |
+// P v(., T)]. EvalStatus failed when the simulation fails.
+core::EvalStatus full_state_map(const ContactBarOrbitProblem& problem, double period, double dt,
+                                const core::Vector& state, core::Vector& mapped);
+
+// M at the orbit x (2N x 2N).
+core::EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const core::Vector& x,
+                                      const MonodromyOptions& options, core::Matrix& M);
+
+}  // namespace backbone::contact_bar

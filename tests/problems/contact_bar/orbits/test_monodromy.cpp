@@ -1,0 +1,83 @@
+// The contact bar's full-state monodromy (orbits/monodromy.hpp) against exact oracles: the
+// fixed-free bar without contact returns every state after 4L/c and reverses it after 2L/c
+// (d'Alembert: the fixed-free bar's period is 4L/c for every initial state, and u(t + 2L/c) =
+// -u(t)), and a piecewise-linear state on the grid is held exactly by the representation, so M
+// is I and -I. Against its own structure on mode 1: multipliers on the unit circle, the trivial
+// pair at +1 (README.md, section 'Stability').
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <iostream>
+
+#include "core/errors.hpp"
+#include "core/stability/floquet.hpp"
+#include "problems/contact_bar/orbits/monodromy.hpp"
+#include "problems/contact_bar/orbits/periodic_bar.hpp"
+#include "problems/contact_bar/solver/tdbem.hpp"
+#include "tests/problems/contact_bar/paper_setup.hpp"
+
+namespace {
+
+using namespace backbone;
+
+TEST(ContactBarMonodromy, FreeBarReturnsEveryStateAfterFourTransits) {
+  bar::BarSetup setup = test_support::paper_setup();
+  setup.right = {bar::EndType::free, 0};
+  const contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
+  contact_bar::OrbitOptions o;
+  o.elements = 10;
+  o.steps_per_period = 2;  // the map's dt is then courant dx / c
+  const contact_bar::ContactBarOrbitProblem orbit(setup, tdbem, o);
+  core::Vector x = core::Vector::Zero(o.elements + 1);
+  for (int i = 0; i < o.elements; ++i) x[i] = 1e-3 * std::sin(0.7 * (i + 1));
+  const int n = o.elements;
+  for (double transits : {4.0, 2.0}) {
+    x[orbit.period_index()] = transits;  // L / c = 1
+    const double sign = transits == 4.0 ? 1.0 : -1.0;
+    double previous = 0;
+    for (double courant : {1.0, 0.5, 0.25, 0.125}) {
+      contact_bar::MonodromyOptions mo;
+      mo.courant = courant;
+      core::Matrix M;
+      ASSERT_EQ(contact_bar::full_state_monodromy(orbit, x, mo, M), core::EvalStatus::ok);
+      const core::Matrix error = M - sign * core::Matrix::Identity(M.rows(), M.cols());
+      // The u columns: differences of an affine map the march holds exactly, round-off of the
+      // march (1e-16 of the state) over the step (1e-6 of it) times the v rows' c / dx: 1e-8
+      // leaves a factor of 100.
+      EXPECT_LE(error.leftCols(n).lpNorm<Eigen::Infinity>(), 1e-8) << "T " << transits;
+      // The v columns: second order in c dt / dx (the header): each halving divides the error by
+      // 4, asserted as at least 3.5 (measured 0.464, 0.116, 0.029, 0.0073 at T = 4).
+      const double v_error = error.rightCols(n).lpNorm<Eigen::Infinity>();
+      EXPECT_LE(v_error, 0.5 * courant * courant) << "T " << transits << " courant " << courant;
+      if (previous > 0) {
+        EXPECT_LE(v_error, previous / 3.5) << "courant " << courant;
+      }
+      previous = v_error;
+    }
+  }
+}
+
+TEST(ContactBarMonodromy, ModeOnesMultipliersLieOnTheUnitCircleWithTheTrivialPairAtOne) {
+  const bar::BarSetup setup = test_support::paper_setup();
+  const contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
+  for (int n : {20, 40}) {
+    contact_bar::OrbitOptions o;
+    o.elements = n;
+    const contact_bar::ContactBarOrbitProblem orbit(setup, tdbem, o);
+    const core::Vector x = orbit.contact_family_guess(1, 1.5);  // exact on the grid
+    core::Matrix M;
+    ASSERT_EQ(orbit.monodromy(x, M), core::EvalStatus::ok);
+    const core::Floquet f = core::analyse_monodromy(M, orbit.floquet_structure(), {});
+    // The wave equation's spectrum lies on the unit circle. The projection of the state at T
+    // onto the grid dissipates (the smallest |mu| is 0.45 at N = 20 and 40) and moves the
+    // largest by at most 2e-3 beyond it at N = 20 to 80 (README.md, 'Stability'): none may lie
+    // beyond 1 + 1e-2, which a growth of the representation itself would break.
+    EXPECT_LE(f.max_modulus, 1 + 1e-2) << "N = " << n;
+    // The trivial pair (a Jordan block at +1) moves by the square root of M's error: measured
+    // 1.3e-4 to 2.3e-4 here; 1e-3 allows M an error of 1e-6.
+    EXPECT_LE(f.trivial_distance, 1e-3) << "N = " << n;
+  }
+}
+
+}  // namespace
