@@ -40,6 +40,15 @@ std::vector<continuation::OrbitBifurcation> report_stability(const core::Problem
         "min_j |mu_i mu_j - 1| = {:.2e}\n",
         determinant, pairing);
   std::fflush(stdout);
+  if (orbit && !orbit->floquet_structure().bifurcations_detectable) {
+    continuation::bifurcation_table({}, whole.points.front().observables)
+        .write_csv(out / "bifurcations.csv");
+    fmt::print(
+        "bifurcations of the orbits: not detected ({} multipliers come from a projected "
+        "representation; see its README, 'Stability')\n",
+        problem.name());
+    return {};
+  }
   const auto found = continuation::detect_orbit_bifurcations(
       problem, whole, corrector, floquet, [](const continuation::OrbitBifurcation& b) {
         fmt::print("  bifurcation {}\n", continuation::bifurcation_line(b));

@@ -271,10 +271,17 @@ std::string bifurcation_line(const OrbitBifurcation& b) {
   std::string line =
       fmt::format("{}{} after point {}:", b.type, b.located ? "" : " (not located)", b.after_point);
   for (const auto& [key, value] : b.observables) line += fmt::format(" {} {:.12g}", key, value);
+  // The largest few (they come by decreasing modulus): a discretised continuum (the contact
+  // bar's) has hundreds, which bifurcations.csv's point and multipliers.csv hold.
+  constexpr std::size_t shown = 8;
+  const auto& all = b.floquet.multipliers;
   line += "  multipliers";
-  for (const auto& mu : b.floquet.multipliers)
+  for (std::size_t i = 0; i < std::min(all.size(), shown); ++i) {
+    const auto& mu = all[i];
     line += mu.imag() == 0 ? fmt::format(" {:.9g}", mu.real())
                            : fmt::format(" {:.9g}{:+.9g}i", mu.real(), mu.imag());
+  }
+  if (all.size() > shown) line += fmt::format(" (and {} smaller)", all.size() - shown);
   return line;
 }
 

@@ -32,6 +32,10 @@ namespace backbone::core {
 struct FloquetStructure {
   int trivial = 0;            // multipliers at +1 by construction (0, 1 or 2)
   bool conservative = false;  // M symplectic: det M = 1, multipliers in pairs mu, 1/mu
+  // false: M comes from a representation whose isolated multipliers are not known to converge
+  // (the contact bar's projected full state): the per-point counts stand, but the sign changes
+  // of the test functions between points are not taken for bifurcations.
+  bool bifurcations_detectable = true;
 };
 
 struct FloquetOptions {

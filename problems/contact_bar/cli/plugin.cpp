@@ -10,6 +10,7 @@
 #include "problems/contact_bar/cli/trace.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/figures/resonance.hpp"
+#include "problems/contact_bar/figures/stability.hpp"
 
 namespace backbone::contact_bar {
 
@@ -19,6 +20,7 @@ void register_plugin(cli::PluginRegistry& registry) {
   for (cli::ProblemJob& job : peer_bench_cases()) p.bench_cases.push_back(std::move(job));
   p.figures = figure_jobs();
   for (cli::ProblemJob& job : resonance_figure_jobs()) p.figures.push_back(std::move(job));
+  for (cli::ProblemJob& job : stability_figure_jobs()) p.figures.push_back(std::move(job));
   const std::string scenes = "problems/contact_bar/scenes/";
   p.reproduce = {
       {"bouncing_bar",
@@ -47,6 +49,39 @@ void register_plugin(cli::PluginRegistry& registry) {
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1e-3", "--out",
         "{out}/subharmonic_continuum_1e-3"}},
+      // The stability study (problems/contact_bar/orbits/README.md, section 'Stability'): modes
+      // 1 and 2 with their multipliers at 40 and 80 intervals, at 40 with c dt / dx halved, and
+      // mode 2 at 160.
+      {"stability_mode1_N40",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40", "--stability",
+        "true", "--threads", "2", "--out", "{out}/stability/mode1_N40"}},
+      {"stability_mode1_N80",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "80", "--stability",
+        "true", "--threads", "2", "--out", "{out}/stability/mode1_N80"}},
+      {"stability_mode1_N40_dt_half",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40",
+        "--stability_courant", "0.015625", "--stability", "true", "--threads", "2", "--out",
+        "{out}/stability/mode1_N40_dt_half"}},
+      {"stability_mode2_N40",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "40", "--stability",
+        "true", "--threads", "2", "--out", "{out}/stability/mode2_N40"}},
+      {"stability_mode2_N80",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "80", "--stability",
+        "true", "--threads", "2", "--out", "{out}/stability/mode2_N80"}},
+      {"stability_mode2_N160",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "160", "--stability",
+        "true", "--threads", "2", "--out", "{out}/stability/mode2_N160"}},
+      {"stability_mode2_N40_dt_half",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "40",
+        "--stability_courant", "0.015625", "--stability", "true", "--threads", "2", "--out",
+        "{out}/stability/mode2_N40_dt_half"}},
       // Other scenes, the bar changed (and u0, period and dt with it, so that each scene.ini
       // simulates too): the closed forms must hold there as well.
       {"mode1_short_bar",

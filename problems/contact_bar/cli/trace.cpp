@@ -139,8 +139,16 @@ po::options_description trace_keys() {
        "differences of 4 x stability_elements simulations of one period per point "
        "(problems/contact_bar/orbits/README.md, section 'Stability'). Off by default: it costs "
        "more than the point itself")  //
+      ("floquet_tolerance", po::value<double>()->default_value(1e-2),
+       "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1). 1e-2 for the bar: its "
+       "monodromy's projection moves multipliers by up to 3e-3 off the circle on mode 1 at 40 "
+       "intervals (problems/contact_bar/orbits/README.md, 'Stability')")  //
+      ("floquet_trivial_tolerance", po::value<double>()->default_value(1e-2),
+       "the two trivial multipliers must lie within this of +1, else the point is undecided, "
+       "in (0, 0.5)")  //
       ("stability_elements", po::value<long>()->default_value(0),
-       "intervals of the monodromy's (u, v) grid, in [0, 2000] (0: shooting_elements); M is "
+       "intervals of a uniform (u, v) grid for the monodromy, in [0, 2000] (0: the shooting "
+       "grid itself, mapped by its free knots); M is "
        "2N x 2N, dense (128 MB and about a minute of eigenvalues at 2000)")  //
       ("stability_courant", po::value<double>()->default_value(1.0 / 32),
        "c dt / dx of the monodromy's simulations at most, in (0, 1]: the velocity columns of "

@@ -9,6 +9,7 @@
 #include "core/errors.hpp"
 #include "core/job_queue.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
+#include "problems/contact_bar/solver/tdbem.hpp"
 
 namespace backbone::contact_bar {
 
@@ -30,99 +31,108 @@ void MonodromyOptions::validate() const {
 
 namespace {
 
-int grid_of(const ContactBarOrbitProblem& problem, int elements) {
-  return elements > 0 ? elements : problem.options().elements;
+// Nodal values 0, s_1..s_N on the nodes as a bar::PiecewiseLinear.
+bar::PiecewiseLinear nodal_function(const std::vector<double>& nodes, const double* values) {
+  std::vector<double> y(nodes.size());
+  for (std::size_t i = 1; i < nodes.size(); ++i) y[i] = values[i - 1];
+  return bar::PiecewiseLinear(nodes, std::move(y));
 }
 
-// Nodal values 0, s_1..s_N on the uniform grid as a bar::PiecewiseLinear.
-bar::PiecewiseLinear nodal_function(double length, const double* values, int n) {
-  std::vector<double> x(static_cast<std::size_t>(n) + 1), y(x.size());
-  for (int i = 0; i <= n; ++i) {
-    x[static_cast<std::size_t>(i)] = length * i / n;
-    y[static_cast<std::size_t>(i)] = i == 0 ? 0.0 : values[i - 1];
-  }
-  return bar::PiecewiseLinear(std::move(x), std::move(y));
-}
-
-// Solves M v = b for the P1 mass matrix of nodes 1..N (uniform, node 0 fixed): rows
-// dx/6 [1 4 1], the last dx/6 [1 2]; symmetric positive definite and tridiagonal (Thomas).
-Vector solve_mass(double length, const Vector& b) {
+// Solves M v = b for the P1 mass matrix of nodes 1..N (node 0 fixed): row i has
+// (h_i + h_{i+1}) / 3 on the diagonal and h / 6 beside it, the last row h_N / 3; symmetric
+// positive definite and tridiagonal (Thomas).
+Vector solve_mass(const std::vector<double>& nodes, const Vector& b) {
   const int n = static_cast<int>(b.size());
-  const double h = length / n;
-  const double off = h / 6;
-  Vector diagonal(n), rhs = b, v(n);
-  for (int i = 0; i < n; ++i) diagonal[i] = (i == n - 1 ? 2.0 : 4.0) * h / 6;
+  const auto width = [&](int i) {  // h_i = y_i - y_{i-1}, i = 1..N
+    return nodes[static_cast<std::size_t>(i)] - nodes[static_cast<std::size_t>(i) - 1];
+  };
+  Vector diagonal(n), off(n), rhs = b, v(n);
+  for (int i = 1; i <= n; ++i) {
+    diagonal[i - 1] = (width(i) + (i < n ? width(i + 1) : 0.0)) / 3;
+    off[i - 1] = i < n ? width(i + 1) / 6 : 0.0;  // M(i, i + 1)
+  }
   for (int i = 1; i < n; ++i) {
-    const double w = off / diagonal[i - 1];
-    diagonal[i] -= w * off;
+    const double w = off[i - 1] / diagonal[i - 1];
+    diagonal[i] -= w * off[i - 1];
     rhs[i] -= w * rhs[i - 1];
   }
   v[n - 1] = rhs[n - 1] / diagonal[n - 1];
-  for (int i = n - 2; i >= 0; --i) v[i] = (rhs[i] - off * v[i + 1]) / diagonal[i];
+  for (int i = n - 2; i >= 0; --i) v[i] = (rhs[i] - off[i] * v[i + 1]) / diagonal[i];
   return v;
 }
 
 }  // namespace
 
-Vector full_state(const ContactBarOrbitProblem& problem, const Vector& x, int elements) {
-  const int n = grid_of(problem, elements);
+std::vector<double> full_state_nodes(const ContactBarOrbitProblem& problem, const Vector& x,
+                                     int elements) {
+  const double length = problem.setup_template().material.length;
+  std::vector<double> nodes{0.0};
+  if (elements > 0) {
+    for (int i = 1; i <= elements; ++i) nodes.push_back(length * i / elements);
+  } else {
+    const Vector y = problem.node_positions(x);
+    for (int i = 0; i < problem.options().elements; ++i) nodes.push_back(y[i]);
+    nodes.back() = length;
+  }
+  return nodes;
+}
+
+Vector full_state(const ContactBarOrbitProblem& problem, const Vector& x,
+                  const std::vector<double>& nodes) {
+  const int n = static_cast<int>(nodes.size()) - 1;
   const bar::BarSetup s = problem.setup_at(x);
-  const double length = s.material.length;
   Vector state = Vector::Zero(2 * n);
-  for (int i = 1; i <= n; ++i) state[i - 1] = s.u0(length * i / n);
+  for (int i = 1; i <= n; ++i) state[i - 1] = s.u0(nodes[static_cast<std::size_t>(i)]);
   return state;
 }
 
-double full_state_time_step(const ContactBarOrbitProblem& problem, double period, int elements,
-                            double courant) {
+double full_state_time_step(const ContactBarOrbitProblem& problem, double period,
+                            const std::vector<double>& nodes, double courant) {
   const bar::Material& m = problem.setup_template().material;
-  const double dx = m.length / grid_of(problem, elements);
+  double dx = m.length;
+  for (std::size_t i = 1; i < nodes.size(); ++i) dx = std::min(dx, nodes[i] - nodes[i - 1]);
   const double target = std::min(problem.time_step(period), courant * dx / m.wave_speed());
   return period / std::ceil(period / target - 1e-9);
 }
 
-EvalStatus full_state_map(const ContactBarOrbitProblem& problem, double period, double dt,
-                          const Vector& state, Vector& mapped) {
-  const int n = static_cast<int>(state.size() / 2);
+EvalStatus full_state_map(const ContactBarOrbitProblem& problem, const std::vector<double>& nodes,
+                          double period, double dt, const Vector& state, Vector& mapped) {
+  const int n = static_cast<int>(nodes.size()) - 1;
   if (n < 1 || state.size() != 2 * n || !(period > 0)) return EvalStatus::failed;
+  const auto* tdbem = dynamic_cast<const TdbemSolver*>(&problem.solver());
+  if (!tdbem) return EvalStatus::failed;
   bar::BarSetup s = problem.setup_template();
-  const double length = s.material.length;
-  s.u0 = nodal_function(length, state.data(), n);
-  s.v0 = nodal_function(length, state.data() + n, n);
-  bar::SnapshotRequest request;
-  request.elements = n;
-  request.dt = dt;
-  request.nodal_u = true;
-  request.projected_v = true;
-  bar::FieldSnapshot snap;
+  s.u0 = nodal_function(nodes, state.data());
+  s.v0 = nodal_function(nodes, state.data() + n);
   try {
-    snap = problem.solver().snapshot(s, period, request);
+    TdbemMarch march(s, dt, tdbem->method());
+    if (!march.advance_to(period)) return EvalStatus::non_finite;
+    mapped.resize(2 * n);
+    for (int i = 1; i <= n; ++i)
+      mapped[i - 1] = march.displacement(nodes[static_cast<std::size_t>(i)]);
+    const std::vector<double> b = march.projected_velocity(nodes);
+    Vector rhs(n);
+    for (int i = 1; i <= n; ++i) rhs[i - 1] = b[static_cast<std::size_t>(i)];
+    mapped.tail(n) = solve_mass(nodes, rhs);
   } catch (const core::InputError&) {
     return EvalStatus::failed;
   }
-  if (!snap.ok || static_cast<int>(snap.u.size()) != n + 1 ||
-      static_cast<int>(snap.v_projected.size()) != n + 1)
-    return EvalStatus::failed;
-  mapped.resize(2 * n);
-  for (int i = 1; i <= n; ++i) mapped[i - 1] = snap.u[static_cast<std::size_t>(i)];
-  Vector b(n);
-  for (int i = 1; i <= n; ++i) b[i - 1] = snap.v_projected[static_cast<std::size_t>(i)];
-  mapped.tail(n) = solve_mass(length, b);
   return mapped.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 
 EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vector& x,
                                 const MonodromyOptions& options, Matrix& M) {
   options.validate();
-  const int n = grid_of(problem, options.elements);
   const double period = x[problem.period_index()];
   if (!(period > 0) || !std::isfinite(period)) return EvalStatus::failed;
-  const Vector base = full_state(problem, x, n);
+  const std::vector<double> nodes = full_state_nodes(problem, x, options.elements);
+  const int n = static_cast<int>(nodes.size()) - 1;
+  const Vector base = full_state(problem, x, nodes);
   const bar::Material& material = problem.setup_template().material;
   const double u_scale = std::max(base.head(n).cwiseAbs().maxCoeff(), problem.displacement_scale());
   const double h_u = options.relative_step * u_scale;
   const double h_v = h_u * material.wave_speed() / material.length;
-  const double dt = full_state_time_step(problem, period, n, options.courant);
+  const double dt = full_state_time_step(problem, period, nodes, options.courant);
   M.resize(2 * n, 2 * n);
   std::vector<EvalStatus> status(static_cast<std::size_t>(2 * n), EvalStatus::ok);
   core::run_tasks(2 * n, options.threads, [&](int j) {
@@ -130,8 +140,9 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
     Vector plus = base, minus = base, f_plus, f_minus;
     plus[j] += h;
     minus[j] -= h;
-    EvalStatus a = full_state_map(problem, period, dt, plus, f_plus);
-    EvalStatus b = a == EvalStatus::ok ? full_state_map(problem, period, dt, minus, f_minus) : a;
+    EvalStatus a = full_state_map(problem, nodes, period, dt, plus, f_plus);
+    EvalStatus b =
+        a == EvalStatus::ok ? full_state_map(problem, nodes, period, dt, minus, f_minus) : a;
     status[static_cast<std::size_t>(j)] = b;
     if (b == EvalStatus::ok) M.col(j) = (f_plus - f_minus) / (2 * h);
   });

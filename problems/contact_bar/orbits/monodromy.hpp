@@ -1,8 +1,9 @@
 // The monodromy of a contact-bar orbit: the derivative of the period map of the full state
 // (u, v), in a stated finite representation (README.md, section 'Stability').
 //
-// Representation: continuous piecewise-linear u and v on the uniform grid of `elements`
-// intervals, nodal values at x_1..x_N (x_0 = 0 is the fixed end, u = v = 0 there). The state
+// Representation: continuous piecewise-linear u and v on a node grid (the orbit's own, or a
+// uniform one of `elements` intervals), nodal values at y_1..y_N (y_0 = 0 is the fixed end,
+// u = v = 0 there). The state
 // s = [u_1..u_N | v_1..v_N] is simulated over one period T by the problem's bar solver, and
 // mapped back onto the grid: u by its point values at the nodes, v by its L2 projection onto
 // the same space (hat-weighted integrals, solved with the P1 mass matrix). Both are exact for a
@@ -25,6 +26,8 @@
 //   core::EvalStatus st = contact_bar::full_state_monodromy(problem, x, o, M);   // 2N x 2N
 #pragma once
 
+#include <vector>
+
 #include "core/problem.hpp"
 #include "core/types.hpp"
 
@@ -33,7 +36,7 @@ namespace backbone::contact_bar {
 class ContactBarOrbitProblem;
 
 struct MonodromyOptions {
-  int elements = 0;             // N of the representation; 0: the problem's elements
+  int elements = 0;             // N of a uniform representation; 0: the problem's own nodes
   double relative_step = 1e-6;  // difference step: this times max(max|u0|, gap) for u, times
                                 // c / L that for v
   double courant = 1.0 / 32;    // c dt / dx of the map at most (0.46 / 32^2 = 4.5e-4 in M's v
@@ -42,17 +45,25 @@ struct MonodromyOptions {
   void validate() const;  // InputError naming stability_elements / stability_step
 };
 
-// The state s of the representation for the orbit x of `problem` (u0 sampled at the uniform
-// nodes, v0 = 0), size 2N.
-core::Vector full_state(const ContactBarOrbitProblem& problem, const core::Vector& x, int elements);
+// The representation's nodes 0 = y_0 < ... < y_N = L: the uniform grid of `elements` intervals,
+// or with elements = 0 the problem's own node grid at x (mapped by its free knots, so that a
+// kink of u0 on a knot is held exactly).
+std::vector<double> full_state_nodes(const ContactBarOrbitProblem& problem, const core::Vector& x,
+                                     int elements);
 
-// The time step of the map at period T on a grid of `elements` (the rule above).
-double full_state_time_step(const ContactBarOrbitProblem& problem, double period, int elements,
-                            double courant);
+// The state s of the orbit x on the nodes: u0 at y_1..y_N, v0 = 0 (size 2N).
+core::Vector full_state(const ContactBarOrbitProblem& problem, const core::Vector& x,
+                        const std::vector<double>& nodes);
 
-// The period map of the representation at period T and time step dt: s -> [u(x_i, T) |
-// P v(., T)]. EvalStatus failed when the simulation fails.
-core::EvalStatus full_state_map(const ContactBarOrbitProblem& problem, double period, double dt,
+// The time step of the map at period T (the rule above, dx the smallest interval).
+double full_state_time_step(const ContactBarOrbitProblem& problem, double period,
+                            const std::vector<double>& nodes, double courant);
+
+// The period map of the representation at period T and time step dt: s -> [u(y_i, T) |
+// P v(., T)], by the TD-BEM march of the problem's solver (EvalStatus failed for another
+// solver or when the march fails).
+core::EvalStatus full_state_map(const ContactBarOrbitProblem& problem,
+                                const std::vector<double>& nodes, double period, double dt,
                                 const core::Vector& state, core::Vector& mapped);
 
 // M at the orbit x (2N x 2N).

@@ -157,9 +157,10 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // Floquet multipliers (core::FloquetProblem): the monodromy of the full state (u, v) in the
   // representation of monodromy.hpp, 2N x 2N, by differences of 4N simulations of one period
   // (README.md, section 'Stability'). Conservative, two trivial multipliers (time shift and
-  // energy).
+  // energy); the projection keeps the isolated multipliers from converging pointwise, so no
+  // bifurcation of the orbits is read from them.
   core::EvalStatus monodromy(const core::Vector& x, core::Matrix& M) const override;
-  core::FloquetStructure floquet_structure() const override { return {2, true}; }
+  core::FloquetStructure floquet_structure() const override { return {2, true, false}; }
   void set_monodromy_options(const MonodromyOptions& options) {
     options.validate();
     monodromy_options_ = options;

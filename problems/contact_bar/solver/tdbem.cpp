@@ -627,10 +627,15 @@ double TdbemMarch::strain(double x, std::size_t* hints) const {
 // knots of each end arrive in monotone order (end 0 from x = 0, end 1 from x = L), so the two
 // window sequences are merged with the few other points rather than sorted (O(window)).
 std::vector<double> TdbemMarch::breakpoints(int elements) const {
+  std::vector<double> nodes;
+  for (int i = 0; i <= elements; ++i) nodes.push_back(L_ * i / elements);
+  return breakpoints(nodes);
+}
+
+std::vector<double> TdbemMarch::breakpoints(const std::vector<double>& nodes) const {
   const auto inside = [&](double p) { return p >= 0 && p <= L_; };
-  std::vector<double> other;
+  std::vector<double> other(nodes);
   const double ct = c_ * seconds(now_);
-  for (int i = 0; i <= elements; ++i) other.push_back(L_ * i / elements);
   for (const auto* f : {&setup_.u0, &setup_.v0})
     for (double k : f->knots()) {
       if (inside(k - ct)) other.push_back(k - ct);
@@ -683,6 +688,29 @@ std::vector<double> TdbemMarch::project(int elements, bool use_velocity) const {
     result[j] += w * value * (1 - theta);
     result[j + 1] += w * value * theta;
   });
+  return result;
+}
+
+std::vector<double> TdbemMarch::projected_velocity(const std::vector<double>& nodes) const {
+  std::vector<double> result(nodes.size(), 0.0);
+  const std::vector<double> pts = breakpoints(nodes);
+  const double g = 0.5 / std::sqrt(3.0);
+  const auto last = nodes.size() - 1;
+  std::size_t hints[2] = {ends_[0].knots.size(), 0};  // pieces come in increasing x
+  std::size_t k = 0;  // the element [nodes[k], nodes[k + 1]] holding the piece
+  for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+    const double a = pts[i], b = pts[i + 1], h = b - a;
+    if (!(h > 1e-15 * L_)) continue;
+    const double mid = 0.5 * (a + b);
+    while (k + 1 < last && mid >= nodes[k + 1]) ++k;
+    const double width = nodes[k + 1] - nodes[k];
+    for (double x : {mid - g * h, mid + g * h}) {
+      const double value = 0.5 * h * velocity(x, hints);
+      const double theta = (x - nodes[k]) / width;
+      result[k] += value * (1 - theta);
+      result[k + 1] += value * theta;
+    }
+  }
   return result;
 }
 

@@ -79,6 +79,8 @@ class TdbemMarch {
   // int_0^L w psi_i dx on the uniform grid of `elements` intervals (exact integration).
   std::vector<double> projected_displacement(int elements) const;
   std::vector<double> projected_velocity(int elements) const;
+  // int_0^L v psi_i dx for the hats psi_i of any node grid (nodes increasing from 0 to L), exact.
+  std::vector<double> projected_velocity(const std::vector<double>& nodes) const;
   // 1/2 int (rho A v^2 + EA u_x^2) dx - int body_force A u dx, integrated exactly.
   double energy() const;
   std::size_t stored_knots() const;  // history window size (both ends)
@@ -213,6 +215,8 @@ class TdbemMarch {
   void solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_end);
   void regauge();  // moves a constant between the ends' Q (u unchanged) to keep both small
   std::vector<double> breakpoints(int elements) const;
+  // The field's breakpoints merged with `nodes` (breakpoints(elements) with other nodes).
+  std::vector<double> breakpoints(const std::vector<double>& nodes) const;
   template <class F>
   void integrate_pieces(int elements, F&& f) const;
   std::vector<double> project(int elements, bool velocity) const;

@@ -1,0 +1,124 @@
+#include "problems/contact_bar/figures/stability.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include "core/io/plot.hpp"
+#include "core/io/table.hpp"
+
+namespace backbone::contact_bar {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The value of `key` in a trace's resolved scene.ini ("key = value", a default commented out
+// as "# key = value  (default)"); empty when absent.
+std::string scene_value(const fs::path& scene, const std::string& key) {
+  std::ifstream in(scene);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::string text = line;
+    if (text.rfind("# ", 0) == 0) text = text.substr(2);
+    const auto eq = text.find(" = ");
+    if (eq == std::string::npos || text.substr(0, eq) != key) continue;
+    std::string value = text.substr(eq + 3);
+    const auto note = value.find("  (default)");
+    if (note != std::string::npos) value = value.substr(0, note);
+    return value;
+  }
+  return {};
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double largest(const std::vector<double>& v) {
+  double m = std::nan("");
+  for (double x : v)
+    if (!std::isnan(x) && !(x <= m)) m = x;
+  return m;
+}
+
+}  // namespace
+
+int write_stability_summary(const fs::path& out) {
+  const fs::path folder = out / "stability";
+  std::vector<fs::path> runs;
+  if (fs::exists(folder))
+    for (const auto& entry : fs::directory_iterator(folder))
+      if (fs::exists(entry.path() / "branch.csv") && fs::exists(entry.path() / "multipliers.csv"))
+        runs.push_back(entry.path());
+  if (runs.empty()) {
+    fmt::print("[figures] stability_summary skipped: no trace with --stability true in {}\n",
+               folder.string());
+    return 0;
+  }
+  std::sort(runs.begin(), runs.end());
+  core::Table summary({"run", "branch", "elements", "courant", "points", "unstable_points",
+                       "undecided_points", "max_modulus_worst", "max_modulus_median",
+                       "trivial_distance_worst", "trivial_distance_median",
+                       "real_negative_modulus_worst", "complex_modulus_worst"});
+  std::string curves;
+  for (const fs::path& run : runs) {
+    const core::Table branch = core::Table::read_csv(run / "branch.csv");
+    const core::Table multipliers = core::Table::read_csv(run / "multipliers.csv");
+    const std::vector<double> stable = branch.column("stable");
+    int unstable = 0, undecided = 0;
+    for (double s : stable) {
+      unstable += s == 0 ? 1 : 0;
+      undecided += s < 0 ? 1 : 0;
+    }
+    const std::vector<double> re = multipliers.column("re"), im = multipliers.column("im"),
+                              modulus = multipliers.column("modulus"),
+                              trivial = multipliers.column("trivial");
+    std::vector<double> negative, complex;
+    for (std::size_t i = 0; i < re.size(); ++i) {
+      if (trivial[i] != 0) continue;
+      if (im[i] == 0 && re[i] < 0) negative.push_back(modulus[i]);
+      if (im[i] != 0) complex.push_back(modulus[i]);
+    }
+    const std::string name = run.filename().string();
+    const std::string elements = scene_value(run / "scene.ini", "shooting_elements");
+    const std::string courant = scene_value(run / "scene.ini", "stability_courant");
+    summary.add_cells({name, name.substr(0, name.find('_')),
+                       elements.empty() ? std::nan("") : std::stod(elements),
+                       courant.empty() ? std::nan("") : std::stod(courant), double(stable.size()),
+                       double(unstable), double(undecided),
+                       largest(branch.column("max_multiplier_modulus")),
+                       median(branch.column("max_multiplier_modulus")),
+                       largest(branch.column("trivial_multiplier_distance")),
+                       median(branch.column("trivial_multiplier_distance")), largest(negative),
+                       largest(complex)});
+    curves +=
+        fmt::format("{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",
+                    curves.empty() ? "plot " : ", ", core::gnuplot_quote(run / "branch.csv"), name);
+  }
+  summary.write_csv(folder / "summary.csv");
+  fmt::print("[figures] wrote {}\n{}", (folder / "summary.csv").string(), summary.aligned(4));
+  const core::PlotResult r = core::render_png(
+      folder / "max_modulus.png",
+      "set datafile separator ','\nset key autotitle columnhead\nset grid\nset logscale x\n"
+      "set xlabel 'energy [J]'\nset ylabel 'largest non-trivial |mu|'\nset key outside right\n"
+      "set title 'Bar modes: the largest Floquet multiplier by run (grid, c dt / dx)'\n" +
+          curves + "\n");
+  if (!r.ok) fmt::print("[figures] max_modulus.png skipped: {}\n", r.message);
+  return 0;
+}
+
+std::vector<cli::ProblemJob> stability_figure_jobs() {
+  return {{"stability_summary",
+           "stability/summary.csv and max_modulus.png from the traces in OUT/stability",
+           write_stability_summary}};
+}
+
+}  // namespace backbone::contact_bar

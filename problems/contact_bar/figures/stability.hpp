@@ -1,0 +1,25 @@
+// The stability study of the bar's modes (problems/contact_bar/orbits/README.md, section
+// 'Stability'), from the traces with --stability true that the main job writes into
+// OUT/stability/<run>/ (plugin.cpp: mode 1 and mode 2 at two grids and a halved time step).
+//   stability_summary  stability/summary.csv: per run its branch, grid, c dt / dx, points and
+//                      the multipliers' worst and median distances from the circle and from +1,
+//                      the largest |mu| of a real negative and of a complex multiplier; and
+//                      stability/max_modulus.png: the largest non-trivial |mu| against energy,
+//                      one curve per run (convergence under refinement)
+//
+//   for (const cli::ProblemJob& job : contact_bar::stability_figure_jobs()) job.run("results");
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "continuation/cli/plugin.hpp"
+
+namespace backbone::contact_bar {
+
+std::vector<cli::ProblemJob> stability_figure_jobs();
+
+// 0 when written, or skipped with a line when OUT/stability holds no run.
+int write_stability_summary(const std::filesystem::path& out);
+
+}  // namespace backbone::contact_bar
