@@ -58,7 +58,7 @@ void print_help(const cli::ProblemPlugin* problem) {
   fmt::print("problems (scene key `problem`):\n");
   for (const auto& p : plugins().all())
     if (p.can_trace())
-      fmt::print("  {:<14} {} (branches: {})\n", p.name, p.summary, fmt::join(p.branches, ", "));
+      fmt::print("  {:<14} {} (branches: {})\n", p.name, p.summary, p.branch_list());
   std::ostringstream text;
   text << "\n" << driver_keys() << "\n";
   if (problem) {

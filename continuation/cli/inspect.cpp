@@ -31,10 +31,10 @@ int inspect_command(const ProblemPlugin& plugin, const std::vector<std::string>&
   const std::string branch = scene.has("branch")
                                  ? scene.text("branch")
                                  : core::read_text_value(dir / "summary.txt", "branch");
-  if (std::find(plugin.branches.begin(), plugin.branches.end(), branch) == plugin.branches.end())
+  if (!plugin.has_branch(branch))
     throw core::InputError(scene.has("branch") ? "branch" : "orbit",
                            fmt::format("'{}' is not a branch of {} (known: {})", branch,
-                                       plugin.name, fmt::join(plugin.branches, ", ")));
+                                       plugin.name, plugin.branch_list()));
   const RunSettings run = read_run_settings(scene);
   TraceSetup setup = plugin.setup(scene, branch);
   if (auto* periodic = dynamic_cast<core::PeriodicOrbitProblem*>(setup.problem.get()))

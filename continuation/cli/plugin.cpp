@@ -1,5 +1,9 @@
 #include "continuation/cli/plugin.hpp"
 
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
 #include <stdexcept>
 
 namespace backbone::cli {
@@ -12,6 +16,17 @@ void TraceSetup::apply_branch_options(ContinuationOptions& options,
   branch_options(options, newton);
   options.validate();
   newton.validate();
+}
+
+bool ProblemPlugin::has_branch(const std::string& name) const {
+  return std::find(branches.begin(), branches.end(), name) != branches.end() ||
+         (branch_family && branch_family(name));
+}
+
+std::string ProblemPlugin::branch_list() const {
+  std::string list = fmt::format("{}", fmt::join(branches, ", "));
+  if (!branch_family_text.empty()) list += ", " + branch_family_text;
+  return list;
 }
 
 void PluginRegistry::add(ProblemPlugin plugin) {

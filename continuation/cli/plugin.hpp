@@ -109,6 +109,10 @@ struct ProblemPlugin {
   // itself to change its default), its branches (the first is the default) and the setup.
   std::function<boost::program_options::options_description()> scene_keys;
   std::vector<std::string> branches;
+  // Families of branch names beyond the list (optional): a test of a name, and how the
+  // messages and --help name the family ("modeJ for every J >= 1").
+  std::function<bool(const std::string& name)> branch_family;
+  std::string branch_family_text;
   std::function<TraceSetup(const core::Scene& scene, const std::string& branch)> setup;
 
   // `simulate` (optional): the scene and driver keys of a time simulation, and the run, which
@@ -126,6 +130,10 @@ struct ProblemPlugin {
   std::vector<ReproduceStep> reproduce;
 
   bool can_trace() const { return static_cast<bool>(setup); }
+  // A name in branches or in the family.
+  bool has_branch(const std::string& name) const;
+  // The branches for messages: the list, then the family's text.
+  std::string branch_list() const;
   bool can_simulate() const { return static_cast<bool>(simulate); }
 };
 

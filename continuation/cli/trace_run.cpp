@@ -104,11 +104,9 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
   t.scene = std::move(scene_in);
   const core::Scene& scene = t.scene;
   t.branch_name = scene.has("branch") ? scene.text("branch") : entry.branches.at(0);
-  if (std::find(entry.branches.begin(), entry.branches.end(), t.branch_name) ==
-      entry.branches.end())
-    throw core::InputError(
-        "branch", fmt::format("'{}' is not a branch of {} (known: {})", t.branch_name, entry.name,
-                              fmt::join(entry.branches, ", ")));
+  if (!entry.has_branch(t.branch_name))
+    throw core::InputError("branch", fmt::format("'{}' is not a branch of {} (known: {})",
+                                                 t.branch_name, entry.name, entry.branch_list()));
   t.out =
       scene.has("out") ? scene.text("out") : fmt::format("out/{}_{}", entry.name, t.branch_name);
   core::check_output_folder("out", t.out);

@@ -157,7 +157,7 @@ c("trace_equals_syntax", "trace", ["{S}", "--gap=0.001"] + SMALL, kind="ok",
   note="--key=value is boost's long-option syntax: accepted")
 c("trace_problem_override", "trace", ["{S}", "--problem", "duffing"] + SMALL, "problem")
 c("trace_branch_empty", "trace", ["{S}", "--branch", "", "--energy_max", "2e-5"], "branch")
-c("trace_branch_unknown", "trace", ["{S}", "--branch", "mode3"], "branch")
+c("trace_branch_unknown", "trace", ["{S}", "--branch", "mode3x"], "branch")
 c("trace_branch_of_other_problem", "trace", ["{D}", "--branch", "mode1"], "branch")
 c("trace_contact_key_on_duffing", "trace", ["{D}", "--gap", "1e-3"], "gap")
 # The forced impact oscillator and the stability keys.

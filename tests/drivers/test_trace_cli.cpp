@@ -50,7 +50,7 @@ backbone::core::Table trace_mode1_on_the_closed_form(const std::string& name,
 }
 
 TEST(TraceCli, BadInputExitsTwoAndWritesNothing) {
-  expect_bad_input(paper + " --branch mode3", "branch");
+  expect_bad_input(paper + " --branch mode3x", "branch");
   expect_bad_input(paper + " --ds 0", "ds");
   expect_bad_input(paper + " --test_elements 5", "test_elements");
   expect_bad_input(paper + " --steps_per_period 41", "steps_per_period");

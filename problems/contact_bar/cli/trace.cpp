@@ -1,4 +1,4 @@
-// The contact bar's trace branches (trace.hpp): mode1 and mode2
+// The contact bar's trace branches (trace.hpp): modeJ for every J >= 1
 // (the nonlinear modes born from the linear modes omega_k = (2k-1) pi c / (2L) at grazing),
 // subharmonic and subharmonic_continuum (mode 2 over two periods: a 2D manifold of orbits,
 // problems/contact_bar/orbits/README.md section 'Subharmonic continuum'),
@@ -66,6 +66,15 @@ po::options_description subharmonic_keys() {
   return keys;
 }
 
+// J of a branch named modeJ (J >= 1, no leading zero), else 0.
+int mode_number(const std::string& branch) {
+  if (branch.size() < 5 || branch.rfind("mode", 0) != 0 || branch[4] == '0' || branch.size() > 9)
+    return 0;
+  for (std::size_t i = 4; i < branch.size(); ++i)
+    if (branch[i] < '0' || branch[i] > '9') return 0;
+  return std::stoi(branch.substr(4));
+}
+
 // The monodromy's grid, difference step and threads (keys stability_elements, stability_step,
 // threads); InputError naming the key.
 MonodromyOptions monodromy_options(const core::Scene& scene) {
@@ -97,11 +106,9 @@ po::options_description trace_keys() {
        "bar solver of the residual: tdbem or exact")  //
       ("start_offset", po::value<double>()->default_value(0.05),
        "first orbit: end amplitude (1 + start_offset) * gap, just inside contact")  //
-      ("start_guess", po::value<std::string>()->default_value("contact_family"),
-       "contact_family (exact piecewise-linear orbit) or linear_mode (sine, linear period)")  //
       ("free_knots", po::value<long>()->default_value(-1),
        "movable knots of the u0 grid, kept ordered: K >= 0, or -1 = auto (one per kink of the "
-       "branch's exact u0: 0 for mode1, 1 for mode2, 2 for the subharmonic branches)")        //
+       "branch's exact u0: J - 1 for modeJ, 2 for the subharmonic branches)")                 //
       ("energy_max", po::value<double>()->default_value(1e-2), "stop above this energy [J]")  //
       ("max_points", po::value<long>()->default_value(1000),
        "points on the branch, first included")  //
@@ -347,7 +354,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
                                               "trace follows {})",
                                               branch));
   }
-  const int mode = branch == "mode2" ? 2 : 1;
+  const int mode = mode_number(branch);
   bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
   check_orbit_ends(setup, "the contact-bar modes");
   check_simulation_keys(scene);
@@ -356,7 +363,22 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
 
   OrbitOptions options = shooting_grid(scene);
   const long knots = scene.integer("free_knots", -1);
-  options.free_knots = knots < 0 ? (mode == 2 ? 1 : 0) : static_cast<int>(knots);
+  options.free_knots = knots < 0 ? mode - 1 : static_cast<int>(knots);
+  if (mode >= 3) {
+    // J - 1 kinks, each on a free knot whose reference node is the nearest to it at the start
+    // (README.md of orbits/, 'Mode J'); segments of at least L / J need two intervals each.
+    if (options.elements < 2 * mode)
+      throw core::InputError("shooting_elements",
+                             fmt::format("mode {} needs at least {} intervals (got {})", mode,
+                                         2 * mode, options.elements));
+    if (options.free_knots == mode - 1) {
+      const double s0 = (mode * (1 + scene.positive("start_offset")) + mode - 1) * setup.right.gap /
+                        setup.material.length;
+      options.knot_nodes = nearest_knot_nodes(
+          options.elements, setup.material.length,
+          family.kinks(0.5 * setup.material.axial_stiffness() * setup.material.length * s0 * s0));
+    }
+  }
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements = static_cast<int>(
       test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);
@@ -369,12 +391,10 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   auto problem = std::make_unique<ContactBarOrbitProblem>(setup, solver, options);
   problem->set_monodromy_options(monodromy_options(scene));
   const double ratio = 1 + scene.positive("start_offset");
-  const std::string guess = scene.choice("start_guess", {"contact_family", "linear_mode"});
 
   cli::TraceSetup s;
   if (options.amplitude_units) s.branch_options = amplitude_unit_options(scene);
-  s.guess = guess == "linear_mode" ? problem->linear_mode_guess(mode, ratio)
-                                   : problem->contact_family_guess(mode, ratio);
+  s.guess = problem->contact_family_guess(mode, ratio);
   check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
   // Energy grows along the family: the direction of the contact family's own tangent.
   s.direction = problem->contact_family_guess(mode, ratio * 1.01) -
@@ -595,6 +615,8 @@ cli::ProblemPlugin trace_plugin() {
   p.summary = "elastic bar fixed at x = 0, rigid wall at gap g0 beyond x = L (Signorini contact)";
   p.scene_keys = &trace_keys;
   p.branches = {"mode1", "mode2", "subharmonic", "subharmonic_continuum", "subharmonic_manifold"};
+  p.branch_family = [](const std::string& name) { return mode_number(name) >= 1; };
+  p.branch_family_text = "modeJ for every J >= 1";
   p.setup = &setup_trace;
   p.simulate_keys = &simulate_keys;
   p.simulate = &simulate_scene;

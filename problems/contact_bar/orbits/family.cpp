@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -12,10 +13,7 @@ namespace backbone::contact_bar {
 
 ContactFamily::ContactFamily(const bar::Material& material, double gap, int mode)
     : material_(material), gap_(gap), mode_(mode) {
-  if (mode != 1 && mode != 2)
-    throw core::InputError("mode", fmt::format("the contact family is known in closed form for "
-                                               "modes 1 and 2 (got {})",
-                                               mode));
+  if (mode < 1) throw core::InputError("mode", fmt::format("must be >= 1 (got {})", mode));
   if (!(gap > 0) || !std::isfinite(gap))
     throw core::InputError("gap", fmt::format("the contact family needs a gap > 0 (got {})", gap));
 }
@@ -40,7 +38,9 @@ double ContactFamily::period(double energy) const {
   const double length = material_.length, s = slope(energy);
   if (!(s * length >= (2 * mode_ - 1) * gap_)) return std::nan("");
   if (mode_ == 1) return (3 * length + gap_ / s) / material_.wave_speed();
-  return (5 * length + gap_ / s) / (4 * material_.wave_speed());
+  if (mode_ == 2) return (5 * length + gap_ / s) / (4 * material_.wave_speed());
+  const double j = mode_;
+  return ((2 * j + 1) * length + gap_ / s) / (j * j * material_.wave_speed());
 }
 
 double ContactFamily::frequency(double energy) const {
@@ -53,15 +53,57 @@ double ContactFamily::linear_frequency() const {
 
 double ContactFamily::asymptotic_frequency() const {
   const double c = material_.wave_speed(), length = material_.length;
-  return mode_ == 1 ? 2 * std::numbers::pi * c / (3 * length)
-                    : 8 * std::numbers::pi * c / (5 * length);
+  if (mode_ == 1) return 2 * std::numbers::pi * c / (3 * length);
+  if (mode_ == 2) return 8 * std::numbers::pi * c / (5 * length);
+  const double j = mode_;
+  return 2 * std::numbers::pi * j * j * c / ((2 * j + 1) * length);
 }
 
 double ContactFamily::node(double energy) const {
   const double s = slope(energy), length = material_.length;
-  if (mode_ == 1 || !(s * length >= 3 * gap_)) return std::nan("");
+  if (mode_ != 2 || !(s * length >= 3 * gap_)) return std::nan("");
   const double b = 0.25 * (1 + gap_ / (s * length));
   return 2 * b * length;
+}
+
+// Mode J (README.md, section 'Mode J'): with gamma = g0 / (s L), A = (J + 1 - (J - 1) gamma) /
+// J^2, B = (1 + gamma) / J and P = A + B (lengths in L), u0' = -s where the distance from the
+// end, xi = L - x, has xi mod P L in [0, A L), +s elsewhere: kinks at xi = A, P, P + A, 2P, ...
+std::vector<double> ContactFamily::kinks(double energy) const {
+  const double length = material_.length, s = slope(energy);
+  std::vector<double> at;
+  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s)) return at;
+  const double j = mode_, gamma = gap_ / (s * length);
+  const double a = (j + 1 - (j - 1) * gamma) / (j * j), b = (1 + gamma) / j, p = a + b;
+  for (int k = 1; static_cast<int>(at.size()) < mode_ - 1; ++k) {
+    at.push_back(length * (1 - ((k - 1) * p + a)));                                   // xi_{2k-1}
+    if (static_cast<int>(at.size()) < mode_ - 1) at.push_back(length * (1 - k * p));  // xi_{2k}
+  }
+  std::reverse(at.begin(), at.end());
+  return at;
+}
+
+bar::PiecewiseLinear ContactFamily::u0(double energy) const {
+  const double length = material_.length, s = slope(energy);
+  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s))
+    throw core::InputError("energy",
+                           fmt::format("mode {} exists from its grazing energy {} (got {})", mode_,
+                                       grazing_energy(), energy));
+  const std::vector<double> at = kinks(energy);
+  // From the end: u0(L), then slope -s back to the first kink (from the end), +s to the next...
+  const double end = -(s * length - (mode_ - 1) * gap_) / mode_;
+  std::vector<double> x{length}, y{end};
+  double sign = -1;  // u0' on the segment ending at the current knot
+  for (auto k = at.rbegin(); k != at.rend(); ++k) {
+    y.push_back(y.back() - sign * s * (x.back() - *k));
+    x.push_back(*k);
+    sign = -sign;
+  }
+  x.push_back(0.0);
+  y.push_back(0.0);  // u0(0) = 0 exactly (the sum of the segments rounds)
+  std::reverse(x.begin(), x.end());
+  std::reverse(y.begin(), y.end());
+  return bar::PiecewiseLinear(std::move(x), std::move(y));
 }
 
 double node_of(const bar::PiecewiseLinear& u0) {

@@ -8,6 +8,10 @@
 //           T = (5L + g0/s) / (4c), grazing at E = EA (3 g0)^2 / (2L), omega -> 8 pi c / (5L);
 //           u0 changes sign at x = 2bL, the mode's node (the quasi-node of the space-time
 //           figure: the point that moves least).
+//   mode J >= 1 (README.md, section 'Mode J'; J = 1, 2 are the two above): u0 of slopes +-s
+//           with J - 1 kinks, T = ((2J + 1) L + g0/s) / (J^2 c), grazing at
+//           E = EA ((2J - 1) g0)^2 / (2L) with the linear period 4L / ((2J - 1) c),
+//           omega -> 2 pi J^2 c / ((2J + 1) L);
 // with s = |eps| = sqrt(2E / (EA L)). Frequencies are NaN below grazing.
 //
 //   ContactFamily mode1(setup.material, setup.right.gap, 1);
@@ -21,13 +25,15 @@
 //   m.u0;  m.period;  m.first_contact;  m.second_contact;                 // durations [s]
 #pragma once
 
+#include <vector>
+
 #include "problems/bar/bar.hpp"
 
 namespace backbone::contact_bar {
 
 class ContactFamily {
  public:
-  // mode: 1 or 2 (InputError "mode" otherwise); gap > 0 (InputError "gap").
+  // mode >= 1 (InputError "mode" otherwise); gap > 0 (InputError "gap").
   ContactFamily(const bar::Material& material, double gap, int mode);
 
   int mode() const { return mode_; }
@@ -42,8 +48,12 @@ class ContactFamily {
   double linear_frequency() const;
   double asymptotic_frequency() const;
   // Mode 2: position 2bL where u0 changes sign (NaN for mode 1, which has no interior node,
-  // and below grazing).
+  // for modes above 2, and below grazing).
   double node(double energy) const;
+  // The J - 1 kinks of u0 at energy E, increasing in x (empty below grazing), and u0 itself:
+  // slopes +-s, u0(0) = 0, u0(L) = -(s L - (J - 1) g0) / J (README.md, section 'Mode J').
+  std::vector<double> kinks(double energy) const;
+  bar::PiecewiseLinear u0(double energy) const;  // InputError "energy" below grazing
 
  private:
   bar::Material material_;

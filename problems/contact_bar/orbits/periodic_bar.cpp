@@ -211,7 +211,8 @@ double ContactBarOrbitProblem::subharmonic_shape(const Vector& x) const {
 
 core::Observables ContactBarOrbitProblem::observables(const Vector& x) const {
   core::Observables o = PeriodicOrbitProblem::observables(x);
-  if (options_.free_knots >= 2) o.emplace_back("shape", subharmonic_shape(x));
+  if (options_.free_knots >= 2 && options_.start_on_wall)
+    o.emplace_back("shape", subharmonic_shape(x));
   o.emplace_back("end_amplitude", std::abs(node_value(x, options_.elements)));
   if (options_.free_knots == 1) o.emplace_back("knot", x[knot_index(0)]);
   if (options_.free_knots > 1)
@@ -528,9 +529,7 @@ Vector ContactBarOrbitProblem::linear_mode_guess(int mode, double amplitude_rati
 }
 
 Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_ratio) const {
-  if (mode != 1 && mode != 2)
-    throw InputError("mode",
-                     fmt::format("the contact family is known for modes 1 and 2 (got {})", mode));
+  if (mode < 1) throw InputError("mode", fmt::format("must be >= 1 (got {})", mode));
   if (!(amplitude_ratio > 0))
     throw InputError("amplitude_ratio", fmt::format("must be > 0 (got {})", amplitude_ratio));
   const double length = setup_.material.length;
@@ -539,7 +538,7 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
   const int n = options_.elements;
   Vector x(num_unknowns());
   if (options_.start_on_wall)
-    throw InputError("start_on_wall", "modes 1 and 2 start at rest away from the wall");
+    throw InputError("start_on_wall", "the modes start at rest away from the wall");
   const std::vector<int> m = reference_knot_nodes();
   for (int j = 0; j < options_.free_knots; ++j) x[knot_index(j)] = length * m[j] / n;
   if (mode == 1) {
@@ -551,6 +550,7 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
     x[period_index()] = tau * (3 + 1 / ratio);
     return x;
   }
+  if (mode >= 3) return mode_guess(mode, std::max(amplitude_ratio, 1.0), x);
   // Mode 2: tent of slopes +s, -s with crest at b L; |u0(L)| = (s L - g0) / 2 above grazing.
   const double ratio = std::max(amplitude_ratio, 1.0);
   const double slope = (2 * ratio + 1) * g0 / length;
@@ -572,6 +572,28 @@ Vector ContactBarOrbitProblem::contact_family_guess(int mode, double amplitude_r
     x[i - 1] = yi <= b * length ? slope * yi : slope * (2 * b * length - yi);
   }
   x[period_index()] = tau * (1 + b);
+  return x;
+}
+
+// Mode J >= 3 (README.md, 'Mode J'): |u0(L)| = (s L - (J - 1) g0) / J = ratio g0, so
+// s = (J ratio + J - 1) g0 / L; with J - 1 free knots its kinks sit on them (u0 held exactly),
+// with none u0 is sampled at the nodes (to O(dx)). x holds the reference knot positions.
+Vector ContactBarOrbitProblem::mode_guess(int mode, double ratio, Vector x) const {
+  const double length = setup_.material.length, g0 = gap();
+  const double s = (mode * ratio + mode - 1) * g0 / length;
+  const double energy = 0.5 * setup_.material.axial_stiffness() * length * s * s;
+  const ContactFamily family(setup_.material, g0, mode);
+  const std::vector<double> kinks = family.kinks(energy);
+  if (options_.free_knots == mode - 1) {
+    for (int j = 0; j < options_.free_knots; ++j) x[knot_index(j)] = kinks[j];
+  } else if (options_.free_knots > 0) {
+    throw InputError("free_knots", fmt::format("mode {} has {} kinks: free_knots {} or 0 (got {})",
+                                               mode, mode - 1, mode - 1, options_.free_knots));
+  }
+  const bar::PiecewiseLinear u0 = family.u0(energy);
+  const Vector y = node_positions(x);
+  for (int i = 1; i <= options_.elements; ++i) x[i - 1] = u0(y[i - 1]);
+  x[period_index()] = family.period(energy);
   return x;
 }
 

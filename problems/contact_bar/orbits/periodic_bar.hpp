@@ -125,8 +125,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   void initial_state_samples(const core::Vector& x, core::Vector& coordinates,
                              core::Vector& values) const override;
   // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (K = 1) or knot_1..knot_K,
-  // and shape with K >= 2. (The contact structure of a member costs an exact simulation:
-  // subharmonic.hpp adds it to branch.csv after the trace, not per observable call.)
+  // and shape with K >= 2 on the wall (the subharmonic members). (The contact structure of a member
+  // costs an exact simulation: subharmonic.hpp adds it to branch.csv after the trace, not per
+  // observable call.)
   core::Observables observables(const core::Vector& x) const override;
   // u_s for the u0 entries, L for a free knot, L/c for the period.
   core::Vector typical_scale() const override;
@@ -180,7 +181,8 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   core::Vector linear_mode_guess(int mode, double amplitude_ratio) const;
   // contact_family_guess: the exact piecewise-linear orbit of the contact family (README.md
   // 'Mode 1': u0 = eps x, T = (3L + g0/|eps|)/c; 'Mode 2': a tent with its crest
-  // at b L, b = (1 + g0/(s L))/4, slope +-s, T = (1 + b) L / c), sampled on the grid.
+  // at b L, b = (1 + g0/(s L))/4, slope +-s, T = (1 + b) L / c; 'Mode J': J - 1 kinks on the
+  // J - 1 free knots), sampled on the grid. Any mode >= 1.
   core::Vector contact_family_guess(int mode, double amplitude_ratio) const;
   // The subharmonic member of family.hpp at this energy and shape in (0, 1], T = 2 T2; needs
   // start_on_wall and K >= 2 free knots (its two kinks are the first two knots). InputError.
@@ -201,6 +203,7 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
 
  private:
   double gap() const;
+  core::Vector mode_guess(int mode, double ratio, core::Vector x) const;
   std::shared_ptr<const bar::BarSolver> owned_solver_;  // empty unless shared
   bar::BarSetup setup_;
   const bar::BarSolver& solver_;

@@ -3,6 +3,7 @@
 // brings the orbit back to its initial state; the mode-2 node is where its u0 changes sign.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -80,8 +81,73 @@ TEST(ContactFamily, GrazingAndLimits) {
                 1e-14);
   }
   EXPECT_TRUE(std::isnan(mode1.frequency(0.5 * mode1.grazing_energy())));
-  EXPECT_THROW(ContactFamily(paper, gap, 3), core::InputError);
+  EXPECT_THROW(ContactFamily(paper, gap, 0), core::InputError);
   EXPECT_THROW(ContactFamily(paper, 0.0, 1), core::InputError);
+}
+
+}  // namespace
+
+namespace {
+
+// Mode J (README.md, section 'Mode J'): the closed-form u0 at energy E, simulated over the
+// closed-form period by the exact oracle, comes back to itself. Its slopes are +-s, its J - 1
+// kinks where the derivation puts them; J = 1 and 2 are u0 = -s x and the tent of 'Mode 2'.
+TEST(ContactFamily, ModeJReturnsToItsClosedFormAfterItsPeriod) {
+  const exact_bar::ExactBarSolver exact;
+  for (double gap : {1e-3, 5e-3}) {
+    bar::BarSetup setup;
+    setup.left = {bar::EndType::fixed, 0};
+    setup.right = {bar::EndType::contact, gap};
+    if (gap == 5e-3) {  // another bar: L = 2, c = 2
+      setup.material.length = 2;
+      setup.material.youngs_modulus = 4;
+    }
+    const double length = setup.material.length;
+    for (int mode : {1, 2, 3, 4, 5, 8}) {
+      const ContactFamily family(setup.material, gap, mode);
+      for (double factor : {1.21, 100.0}) {
+        const double energy = factor * family.grazing_energy();
+        const double s = family.slope(energy);
+        const bar::PiecewiseLinear u0 = family.u0(energy);
+        ASSERT_EQ(u0.knots().size(), static_cast<std::size_t>(mode + 1)) << mode;
+        for (std::size_t k = 1; k < u0.knots().size(); ++k) {
+          const double slope =
+              (u0.values()[k] - u0.values()[k - 1]) / (u0.knots()[k] - u0.knots()[k - 1]);
+          // Each segment's slope from two knot values a few L apart: round-off of s.
+          EXPECT_NEAR(std::abs(slope) / s, 1, 1e-11) << "mode " << mode << " segment " << k;
+        }
+        EXPECT_NEAR(u0(length), -(s * length - (mode - 1) * gap) / mode, 1e-14 * length);
+        if (mode == 1) EXPECT_NEAR(u0(0.5 * length), -s * 0.5 * length, 1e-15);
+        if (mode == 2) EXPECT_NEAR(u0.knots()[1], 0.25 * (1 + gap / (s * length)) * length, 1e-15);
+        setup.u0 = u0;
+        bar::SnapshotRequest r;
+        r.elements = 200;
+        const bar::FieldSnapshot snap = exact.snapshot(setup, family.period(energy), r);
+        ASSERT_TRUE(snap.ok) << snap.message;
+        double worst = 0, scale = 0;
+        for (std::size_t i = 0; i < snap.x.size(); ++i) {
+          worst = std::max(worst, std::abs(snap.u[i] - u0(snap.x[i])));
+          scale = std::max(scale, std::abs(u0(snap.x[i])));
+        }
+        // Piecewise-linear data, exact solver: round-off of some 1e2 characteristic crossings.
+        EXPECT_LT(worst / scale, 1e-11) << "mode " << mode << " E/E_graze " << factor;
+      }
+    }
+  }
+}
+
+// At grazing the mode-J orbit is the linear mode J (period 4L/((2J - 1) c)); far above it the
+// period tends to (2J + 1) L / (J^2 c).
+TEST(ContactFamily, ModeJGrazesAtTheLinearPeriodAndHardensToItsLimit) {
+  const bar::Material paper;  // c = L = 1
+  for (int mode : {3, 4, 5, 8}) {
+    const ContactFamily family(paper, 1e-3, mode);
+    EXPECT_NEAR(family.period(family.grazing_energy() * (1 + 1e-14)), 4.0 / (2 * mode - 1), 1e-12);
+    EXPECT_NEAR(family.frequency(family.grazing_energy() * (1 + 1e-14)), family.linear_frequency(),
+                1e-10);
+    EXPECT_NEAR(family.asymptotic_frequency() / family.frequency(1e8), 1, 1e-6);
+    EXPECT_TRUE(std::isnan(family.period(0.99 * family.grazing_energy())));
+  }
 }
 
 }  // namespace
