@@ -636,7 +636,7 @@ c("inspect_orbit_of_duffing", "inspect", [IS, "--orbit", "{FX}/duff/orbits.csv:1
 c("inspect_orbit_corrupt", "inspect", [IS, "--orbit", "{FX}/bad_unknowns/orbits.csv:2"],
   "orbit", out=False)
 c("inspect_branch_bogus", "inspect", [IS, "--orbit", "{FX}/mode1/orbits.csv:3", "--branch",
-                                      "mode7"], "branch", out=False)
+                                      "mode7x"], "branch", out=False)
 c("inspect_out_given", "inspect", [IS, "--orbit", "{FX}/mode1/orbits.csv:3", "--out",
                                    "{OUT}"], "out", out=False)
 c("inspect_bad_key", "inspect", [IS, "--orbit", "{FX}/mode1/orbits.csv:3", "--rank_threshold",
