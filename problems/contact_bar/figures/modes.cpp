@@ -109,7 +109,7 @@ void spacetime_figure(const fs::path& out, int mode, const FigureScene& scene,
       "set pm3d depthorder\nset palette rgbformulae 33,13,10\nset view 55,35\n"
       "set key top left\nset ticslevel 0\n"
       "splot {} using 'x':'t':'u' with pm3d title 'u(x,t)'{}\n",
-      mode == 1 ? "Mode 1" : "Mode 2", orbit.energy, orbit.period, title_extra,
+      fmt::format("Mode {}", mode), orbit.energy, orbit.period, title_extra,
       core::gnuplot_quote(out / (name + "_spacetime.csv")), marker);
   const fs::path png = out / (name + "_spacetime.png");
   report(core::render_png(png, plot, {1100, 800}), png);
@@ -286,13 +286,77 @@ int draw_mode1_contact(const fs::path& out, const FigureInputs& inputs) {
 
 int draw_spacetime(const fs::path& out, const FigureInputs& inputs) {
   const FigureScene scene = read_figure_scene(inputs);
-  for (int mode : {1, 2}) {
+  for (int mode : {1, 2, 3}) {
     const fs::path dir = out / fmt::format("mode{}", mode);
     if (const auto orbit = load_traced_orbit(dir, inputs.energy, scene.setup.material.length))
       spacetime_figure(out, mode, scene, *orbit);
     else
       fmt::print("[figures] mode{}_spacetime skipped: no orbit in {}\n", mode, dir.string());
   }
+  return 0;
+}
+
+// Fig. 4 widened: modes 1 to 5 (closed forms from grazing, traced points where OUT/modeJ holds
+// a branch), the subharmonic band of mode 2, and the families attached to mode 1 (OUT/
+// mode1_resonances/branch_point_K) as the vertical segments they are.
+int draw_all_backbones(const fs::path& out, const FigureInputs& inputs) {
+  const bar::BarSetup s = read_figure_scene(inputs).setup;
+  const double g0 = s.right.gap;
+  constexpr int modes = 5;
+  double e_max = 1e-2;
+  for (int j = 1; j <= modes; ++j)
+    if (const fs::path dir = out / fmt::format("mode{}", j); has_branch(dir))
+      for (double e : Table::read_csv(dir / "branch.csv").column("energy"))
+        e_max = std::max(e_max, e);
+  const char* colours[] = {"black", "dark-green", "blue", "dark-violet", "dark-red"};
+  std::string curves;
+  for (int j = 1; j <= modes; ++j) {
+    const ContactFamily family(s.material, g0, j);
+    Table closed({"energy", "frequency"});
+    const double e_graze = family.grazing_energy();
+    for (int i = 0; i <= 400; ++i) {
+      const double e = e_graze * std::pow(e_max / e_graze, i / 400.0) * (1 + 1e-12);
+      closed.add_row({e, family.frequency(e)});
+    }
+    const fs::path csv = out / fmt::format("backbone_mode{}_closed_form.csv", j);
+    closed.write_csv(csv);
+    curves += fmt::format(
+        "{}{} using 'frequency':'energy' with lines lw 2 lc rgb '{}' title 'mode {}, closed form'",
+        curves.empty() ? "plot " : ", ", core::gnuplot_quote(csv), colours[j - 1], j);
+    if (const fs::path dir = out / fmt::format("mode{}", j); has_branch(dir))
+      curves += fmt::format(
+          ", {} using 'frequency':'energy' with points pt 7 ps 0.5 lc rgb '{}' title 'mode {}, "
+          "TD-BEM shooting'",
+          core::gnuplot_quote(dir / "branch.csv"), colours[j - 1], j);
+  }
+  if (fs::exists(out / "backbone_subharmonic.csv"))
+    curves += fmt::format(
+        ", {} using 'frequency_2d':'energy' with lines lw 10 lc rgb '#A0FF8C00' title "
+        "'subharmonic band of mode 2 ({{/Symbol w}}_2/2, 2D)'",
+        core::gnuplot_quote(out / "backbone_subharmonic.csv"));
+  int attached = 0;
+  const fs::path resonances = out / "mode1_resonances";
+  if (fs::exists(resonances))
+    for (const auto& entry : fs::directory_iterator(resonances))
+      if (entry.path().filename().string().rfind("branch_point_", 0) == 0 &&
+          has_branch(entry.path())) {
+        curves += fmt::format(
+            ", {} using 'frequency':'energy' with linespoints pt 1 ps 0.4 lw 2 lc rgb 'orange' "
+            "{}",
+            core::gnuplot_quote(entry.path() / "branch.csv"),
+            attached == 0 ? "title 'families attached to mode 1'" : "notitle");
+        ++attached;
+      }
+  const double w1 = ContactFamily(s.material, g0, 1).linear_frequency();
+  const double w_top = ContactFamily(s.material, g0, modes).asymptotic_frequency();
+  const std::string plot = fmt::format(
+      "set title 'Backbones of modes 1 to {} (g_0 = {} m, c = {} m/s, L = {} m)'\n"
+      "set xlabel 'frequency {{/Symbol w}} [rad/s]'\nset ylabel 'energy E [J]'\n"
+      "set logscale y\nset format y '10^{{%L}}'\nset grid\nset key below maxrows 5\n"
+      "set xrange [{}:{}]\n{}\n",
+      modes, g0, s.material.wave_speed(), s.material.length, 0.8 * w1, 1.05 * w_top, curves);
+  const fs::path png = out / "backbones_all.png";
+  report(core::render_png(png, plot, {1400, 900}), png);
   return 0;
 }
 
@@ -441,9 +505,12 @@ std::vector<cli::ProblemJob> figure_jobs(const FigureInputs& inputs) {
   return {
       {"backbones", "backbones.png: frequency-energy backbones of modes 1 and 2 (Fig. 4)",
        [inputs](const fs::path& out) { return draw_backbones(out, inputs); }},
+      {"backbones_all",
+       "backbones_all.png: modes 1 to 5, the subharmonic band and the attached families",
+       [inputs](const fs::path& out) { return draw_all_backbones(out, inputs); }},
       {"mode1_contact", "mode1_contact.png: contact end over one mode-1 period (Fig. 5)",
        [inputs](const fs::path& out) { return draw_mode1_contact(out, inputs); }},
-      {"spacetime", "mode1/mode2_spacetime.png: u(x, t) over one period (Figs. 6, 7)",
+      {"spacetime", "mode1/2/3_spacetime.png: u(x, t) over one period (Figs. 6, 7)",
        [inputs](const fs::path& out) { return draw_spacetime(out, inputs); }},
       {"subharmonic_continuum",
        "subharmonic_continuum.png: u(L, t) of the continuum's members and its NLopt grazing "

@@ -5,10 +5,15 @@
 //   backbones            backbones.png (Fig. 4): frequency-energy backbones, log energy axis,
 //                        the linear modes and the asymptotes 2 pi c / (3L) (mode 1) and
 //                        8 pi c / (5L) (mode 2) as vertical lines, closed forms of both modes
+//   backbones_all        backbones_all.png: Fig. 4 widened to modes 1 to 5 (closed forms from
+//                        grazing, OUT/modeJ's points), the subharmonic band of mode 2 and the
+//                        families attached to mode 1 (OUT/mode1_resonances/branch_point_K) as
+//                        vertical segments
 //   mode1_contact        mode1_contact.png (Fig. 5): contacting-end displacement and contact
 //                        force over one period of a mode-1 orbit (TD-BEM and the exact oracle)
-//   spacetime            mode1_spacetime.png, mode2_spacetime.png (Figs. 6, 7): u(x, t) over
-//                        one period (TD-BEM); mode 2 marks its node, where u0 changes sign
+//   spacetime            mode1_spacetime.png, mode2_spacetime.png (Figs. 6, 7) and
+//                        mode3_spacetime.png: u(x, t) over one period (TD-BEM); mode 2 marks
+//                        its node, where u0 changes sign
 //                        and, with OUT/subharmonic, the subharmonic backbone omega2 / 2 as a
 //                        band where its verified dimension is 2
 //   subharmonic_continuum  subharmonic_continuum.png (Fig. 8): u(L, t) over T = 2 T2 of the
@@ -49,6 +54,7 @@ struct FigureInputs {
 std::vector<cli::ProblemJob> figure_jobs(const FigureInputs& inputs = {});
 
 int draw_backbones(const std::filesystem::path& out, const FigureInputs& inputs);
+int draw_all_backbones(const std::filesystem::path& out, const FigureInputs& inputs);
 int draw_mode1_contact(const std::filesystem::path& out, const FigureInputs& inputs);
 int draw_spacetime(const std::filesystem::path& out, const FigureInputs& inputs);
 int draw_subharmonic_continuum(const std::filesystem::path& out, const FigureInputs& inputs);
