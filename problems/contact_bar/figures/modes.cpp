@@ -318,7 +318,7 @@ int draw_all_backbones(const fs::path& out, const FigureInputs& inputs) {
       const double e = e_graze * std::pow(e_max / e_graze, i / 400.0) * (1 + 1e-12);
       closed.add_row({e, family.frequency(e)});
     }
-    const fs::path csv = out / fmt::format("backbone_mode{}_closed_form.csv", j);
+    const fs::path csv = out / fmt::format("backbones_all_mode{}_closed_form.csv", j);
     closed.write_csv(csv);
     curves += fmt::format(
         "{}{} using 'frequency':'energy' with lines lw 2 lc rgb '{}' title 'mode {}, closed form'",

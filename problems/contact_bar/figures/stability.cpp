@@ -107,7 +107,8 @@ int write_stability_summary(const fs::path& out) {
   fmt::print("[figures] wrote {}\n{}", (folder / "summary.csv").string(), summary.aligned(4));
   const core::PlotResult r = core::render_png(
       folder / "max_modulus.png",
-      "set datafile separator ','\nset key autotitle columnhead\nset grid\nset logscale x\n"
+      "set datafile separator ','\nset key autotitle columnhead noenhanced\nset grid\nset logscale "
+      "x\nset format x '%.0e'\n"
       "set xlabel 'energy [J]'\nset ylabel 'largest non-trivial |mu|'\nset key outside right\n"
       "set title 'Bar modes: the largest Floquet multiplier by run (grid, c dt / dx)'\n" +
           curves + "\n");
