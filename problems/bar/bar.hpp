@@ -111,6 +111,9 @@ struct SnapshotRequest {
                              // the projection below for residuals)
   bool projected_u = false;  // int_0^L u(x, t) psi_i(x) dx, psi_i the hat function of node i
   bool projected_v = false;  // int_0^L v(x, t) psi_i(x) dx (exact for piecewise fields)
+  // Another node grid (increasing from 0 to L; elements is then its size - 1) for the nodal
+  // values and the hats psi_i: TD-BEM and the exact solver; the FEM refuses it (InputError).
+  std::vector<double> nodes;
 };
 
 struct FieldSnapshot {

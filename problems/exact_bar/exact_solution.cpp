@@ -480,10 +480,15 @@ bar::FieldSnapshot ExactBarSolution::snapshot(double t, const bar::SnapshotReque
   bar::FieldSnapshot snap;
   snap.t = t;
   const double L = setup_.material.length;
-  const int n = request.elements;
+  const bool uniform = request.nodes.empty();
+  const int n = uniform ? request.elements : static_cast<int>(request.nodes.size()) - 1;
   const auto nodes = static_cast<std::size_t>(n) + 1;
-  snap.x.resize(nodes);
-  for (std::size_t i = 0; i < nodes; ++i) snap.x[i] = L * static_cast<double>(i) / n;
+  if (uniform) {
+    snap.x.resize(nodes);
+    for (std::size_t i = 0; i < nodes; ++i) snap.x[i] = L * static_cast<double>(i) / n;
+  } else {
+    snap.x = request.nodes;
+  }
   if (!ok_) {
     snap.ok = false;
     snap.message = message_;
@@ -509,7 +514,11 @@ bar::FieldSnapshot ExactBarSolution::snapshot(double t, const bar::SnapshotReque
     if (request.projected_v) snap.v_projected.assign(nodes, 0.0);
     const double h = L / n;
     for (const Piece& p : pieces) {
-      auto j = static_cast<std::size_t>(std::clamp(std::floor(p.xa / h), 0.0, n - 1.0));
+      auto j = uniform
+                   ? static_cast<std::size_t>(std::clamp(std::floor(p.xa / h), 0.0, n - 1.0))
+                   : static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(
+                         std::upper_bound(snap.x.begin(), snap.x.end(), p.xa) - snap.x.begin() - 1,
+                         0, n - 1));
       if (j > 0 && snap.x[j] > p.xa) --j;
       for (; j < static_cast<std::size_t>(n) && snap.x[j] < p.xb; ++j) {
         const double a = std::max(p.xa, snap.x[j]), b = std::min(p.xb, snap.x[j + 1]);

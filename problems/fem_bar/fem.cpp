@@ -250,6 +250,8 @@ bar::FieldSnapshot FemBarSolver::snapshot(const bar::BarSetup& setup, double t,
   if (!std::isfinite(t) || t < 0) throw InputError("t", fmt::format("must be >= 0 (got {})", t));
   if (request.elements < 1)
     throw InputError("elements", fmt::format("must be >= 1 (got {})", request.elements));
+  if (!request.nodes.empty())
+    throw InputError("nodes", "fem: snapshots on the uniform mesh of `elements` only");
   if (!std::isfinite(request.dt) || !(request.dt > 0))
     throw InputError("dt", fmt::format("must be > 0 (got {})", request.dt));
   check_stability(setup, request.elements, request.dt);

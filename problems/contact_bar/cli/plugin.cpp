@@ -59,8 +59,8 @@ void register_plugin(cli::PluginRegistry& registry) {
        {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1e-3", "--out",
         "{out}/subharmonic_continuum_1e-3"}},
       // The stability study (problems/contact_bar/orbits/README.md, section 'Stability'): modes
-      // 1 and 2 with their multipliers at 40 and 80 intervals, at 40 with c dt / dx halved, and
-      // mode 2 at 160.
+      // 1 and 2 with their multipliers at 40 and 80 intervals, at 40 with c dt / dx halved and by
+      // the exact solver, and mode 2 at 160.
       {"stability_mode1_N40",
        "trace",
        {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40", "--stability",
@@ -82,6 +82,16 @@ void register_plugin(cli::PluginRegistry& registry) {
        "trace",
        {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "80", "--stability",
         "true", "--threads", "2", "--out", "{out}/stability/mode2_N80"}},
+      {"stability_mode1_N40_exact",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40", "--stability",
+        "true", "--shooting_solver", "exact", "--threads", "2", "--out",
+        "{out}/stability/mode1_N40_exact"}},
+      {"stability_mode2_N40_exact",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "40", "--stability",
+        "true", "--shooting_solver", "exact", "--threads", "2", "--out",
+        "{out}/stability/mode2_N40_exact"}},
       {"stability_mode2_N160",
        "trace",
        {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "160", "--stability",

@@ -9,7 +9,6 @@
 #include "core/errors.hpp"
 #include "core/job_queue.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
-#include "problems/contact_bar/solver/tdbem.hpp"
 
 namespace backbone::contact_bar {
 
@@ -99,24 +98,31 @@ EvalStatus full_state_map(const ContactBarOrbitProblem& problem, const std::vect
                           double period, double dt, const Vector& state, Vector& mapped) {
   const int n = static_cast<int>(nodes.size()) - 1;
   if (n < 1 || state.size() != 2 * n || !(period > 0)) return EvalStatus::failed;
-  const auto* tdbem = dynamic_cast<const TdbemSolver*>(&problem.solver());
-  if (!tdbem) return EvalStatus::failed;
   bar::BarSetup s = problem.setup_template();
   s.u0 = nodal_function(nodes, state.data());
   s.v0 = nodal_function(nodes, state.data() + n);
+  bar::SnapshotRequest request;
+  request.dt = dt;
+  request.elements = n;
+  request.nodes = nodes;
+  request.nodal_u = true;
+  request.projected_v = true;
+  bar::FieldSnapshot snap;
   try {
-    TdbemMarch march(s, dt, tdbem->method());
-    if (!march.advance_to(period)) return EvalStatus::non_finite;
-    mapped.resize(2 * n);
-    for (int i = 1; i <= n; ++i)
-      mapped[i - 1] = march.displacement(nodes[static_cast<std::size_t>(i)]);
-    const std::vector<double> b = march.projected_velocity(nodes);
-    Vector rhs(n);
-    for (int i = 1; i <= n; ++i) rhs[i - 1] = b[static_cast<std::size_t>(i)];
-    mapped.tail(n) = solve_mass(nodes, rhs);
+    snap = problem.solver().snapshot(s, period, request);
   } catch (const core::InputError&) {
     return EvalStatus::failed;
   }
+  if (!snap.ok || static_cast<int>(snap.u.size()) != n + 1 ||
+      static_cast<int>(snap.v_projected.size()) != n + 1)
+    return EvalStatus::failed;
+  mapped.resize(2 * n);
+  Vector rhs(n);
+  for (int i = 1; i <= n; ++i) {
+    mapped[i - 1] = snap.u[static_cast<std::size_t>(i)];
+    rhs[i - 1] = snap.v_projected[static_cast<std::size_t>(i)];
+  }
+  mapped.tail(n) = solve_mass(nodes, rhs);
   return mapped.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 

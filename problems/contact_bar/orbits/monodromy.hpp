@@ -60,8 +60,8 @@ double full_state_time_step(const ContactBarOrbitProblem& problem, double period
                             const std::vector<double>& nodes, double courant);
 
 // The period map of the representation at period T and time step dt: s -> [u(y_i, T) |
-// P v(., T)], by the TD-BEM march of the problem's solver (EvalStatus failed for another
-// solver or when the march fails).
+// P v(., T)], by the problem's bar solver on the node grid (TD-BEM or the exact solver; the
+// FEM refuses other grids: EvalStatus failed, as when the simulation fails).
 core::EvalStatus full_state_map(const ContactBarOrbitProblem& problem,
                                 const std::vector<double>& nodes, double period, double dt,
                                 const core::Vector& state, core::Vector& mapped);

@@ -835,7 +835,10 @@ bar::FieldSnapshot TdbemSolver::snapshot(const bar::BarSetup& setup, double t,
   bar::FieldSnapshot s;
   s.t = t;
   const int n = request.elements;
-  for (int i = 0; i <= n; ++i) s.x.push_back(setup.material.length * i / n);
+  if (request.nodes.empty())
+    for (int i = 0; i <= n; ++i) s.x.push_back(setup.material.length * i / n);
+  else
+    s.x = request.nodes;
   if (!march.advance_to(t)) {
     s.ok = false;
     s.message = fmt::format("tdbem: non-finite end values before t = {}", t);
@@ -845,8 +848,14 @@ bar::FieldSnapshot TdbemSolver::snapshot(const bar::BarSetup& setup, double t,
     for (double x : s.x) s.u.push_back(march.displacement(x));
   if (request.nodal_v)
     for (double x : s.x) s.v.push_back(march.velocity(x));
-  if (request.projected_u) s.u_projected = march.projected_displacement(n);
-  if (request.projected_v) s.v_projected = march.projected_velocity(n);
+  if (request.projected_u) {
+    if (!request.nodes.empty())
+      throw InputError("nodes", "tdbem: projected_u on another node grid is not built");
+    s.u_projected = march.projected_displacement(n);
+  }
+  if (request.projected_v)
+    s.v_projected =
+        request.nodes.empty() ? march.projected_velocity(n) : march.projected_velocity(s.x);
   for (const auto* field : {&s.u, &s.v, &s.u_projected, &s.v_projected})
     for (double value : *field)
       if (!std::isfinite(value)) {
