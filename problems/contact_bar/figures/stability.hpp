@@ -6,6 +6,12 @@
 //                      the largest |mu| of a real negative and of a complex multiplier; and
 //                      stability/max_modulus.png: the largest non-trivial |mu| against energy,
 //                      one curve per run (convergence under refinement)
+//   perturbation_growth  stability/perturbation_growth.csv: the closed-form orbits of modes 1
+//                      to 3 at 2, 20 and 200 times their grazing energy, perturbed at random by
+//                      1e-6 and simulated by the exact solver for 1000 periods
+//                      (orbits/monodromy.hpp, perturbation_growth): the largest distance to the
+//                      orbit (drift along it removed), at k <= 500 and at the end, and the
+//                      bound largest^(1/1000) on an excited multiplier's modulus
 //
 //   for (const cli::ProblemJob& job : contact_bar::stability_figure_jobs()) job.run("results");
 #pragma once
@@ -21,5 +27,6 @@ std::vector<cli::ProblemJob> stability_figure_jobs();
 
 // 0 when written, or skipped with a line when OUT/stability holds no run.
 int write_stability_summary(const std::filesystem::path& out);
+int write_perturbation_growth(const std::filesystem::path& out);
 
 }  // namespace backbone::contact_bar

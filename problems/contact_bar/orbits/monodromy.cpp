@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "core/errors.hpp"
 #include "core/job_queue.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
+#include "problems/exact_bar/exact_solution.hpp"
 
 namespace backbone::contact_bar {
 
@@ -155,6 +157,76 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
   for (EvalStatus s : status)
     if (s != EvalStatus::ok) return s;
   return M.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
+}
+
+PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period, int periods,
+                                       double relative_size, int elements, unsigned seed) {
+  PerturbationGrowth g;
+  if (!(period > 0) || periods < 1 || elements < 1) return g;
+  const double length = setup.material.length;
+  std::vector<double> nodes(static_cast<std::size_t>(elements) + 1);
+  for (int i = 0; i <= elements; ++i) nodes[static_cast<std::size_t>(i)] = length * i / elements;
+  double amplitude = 0;
+  for (double x : nodes) amplitude = std::max(amplitude, std::abs(setup.u0(x)));
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double size = relative_size * amplitude;
+  Vector state(2 * elements);
+  for (int i = 0; i < elements; ++i) {
+    state[i] = setup.u0(nodes[static_cast<std::size_t>(i) + 1]) + size * unit(random);
+    state[elements + i] = setup.v0(nodes[static_cast<std::size_t>(i) + 1]) + size * unit(random);
+  }
+  bar::BarSetup perturbed = setup;
+  perturbed.u0 = nodal_function(nodes, state.data());
+  perturbed.v0 = nodal_function(nodes, state.data() + elements);
+  const exact_bar::ExactBarSolution solution(perturbed, periods * period);
+  const exact_bar::ExactBarSolution orbit(setup, period);
+  if (!solution.ok() || !orbit.ok()) return g;
+  const int samples = 4 * elements;
+  // Distance of the perturbed state at t from the orbit's state at time tau (mod T).
+  const auto gap_at = [&](double t, double tau) {
+    tau = std::fmod(tau, period);
+    if (tau < 0) tau += period;
+    double d = 0;
+    for (int j = 0; j <= samples; ++j) {
+      const double x = length * j / samples;
+      d = std::max(d, std::abs(solution.u(x, t) - orbit.u(x, tau)));
+    }
+    return d / amplitude;
+  };
+  // The nearest state of the orbit: a perturbation of the energy moves the period, so the
+  // perturbed state drifts along the orbit (linearly in k: the trivial pair's Jordan block);
+  // that drift is no growth. A scan of +-window around k T, then golden sections.
+  const auto distance = [&](int k) {
+    const double t = k * period, window = std::min(0.25, 1e-2 + 10 * relative_size * k) * period;
+    double best = 0, best_d = gap_at(t, 0);
+    for (int i = -20; i <= 20; ++i) {
+      const double tau = window * i / 20, d = gap_at(t, tau);
+      if (d < best_d) best_d = d, best = tau;
+    }
+    double lo = best - window / 20, hi = best + window / 20;
+    const double r = 0.5 * (std::sqrt(5.0) - 1);
+    for (int it = 0; it < 40; ++it) {
+      const double m1 = hi - r * (hi - lo), m2 = lo + r * (hi - lo);
+      if (gap_at(t, m1) < gap_at(t, m2))
+        hi = m2;
+      else
+        lo = m1;
+    }
+    return std::min(best_d, gap_at(t, 0.5 * (lo + hi)));
+  };
+  g.initial = distance(0);
+  if (!(g.initial > 0)) return g;
+  for (int k = 1; k <= periods; k = k < 10 ? k + 1 : (k * 3) / 2) {
+    const double d = distance(k) / g.initial;
+    g.history.emplace_back(k, d);
+    g.largest = std::max(g.largest, d);
+  }
+  g.last = distance(periods) / g.initial;
+  g.largest = std::max(g.largest, g.last);
+  g.history.emplace_back(periods, g.last);
+  g.ok = std::isfinite(g.largest);
+  return g;
 }
 
 }  // namespace backbone::contact_bar

@@ -26,10 +26,12 @@
 //   core::EvalStatus st = contact_bar::full_state_monodromy(problem, x, o, M);   // 2N x 2N
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "core/problem.hpp"
 #include "core/types.hpp"
+#include "problems/bar/bar.hpp"
 
 namespace backbone::contact_bar {
 
@@ -69,5 +71,25 @@ core::EvalStatus full_state_map(const ContactBarOrbitProblem& problem,
 // M at the orbit x (2N x 2N).
 core::EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const core::Vector& x,
                                       const MonodromyOptions& options, core::Matrix& M);
+
+// The check that needs no representation: the orbit's state plus a random perturbation (u and
+// v continuous and piecewise linear on `elements` uniform intervals, nodal values uniform in
+// [-1, 1] times relative_size times max|u0|, u = v = 0 at x = 0), simulated by the exact
+// characteristics solver for `periods` periods of T. At t = k T (k = 1..10, then growing by
+// half, and the last) the distance to the orbit is taken: min over tau of
+// max_x |u(x, k T) - u_orbit(x, tau)| (on 4 elements + 1 points), so that the drift along the
+// orbit of a perturbed energy (the trivial pair's Jordan block, linear in k) is not counted.
+// A multiplier of modulus 1 + d in a direction the perturbation excites grows it like
+// (1 + d)^k; without growth every excited multiplier has |mu| <= largest^(1 / periods)
+// (README.md, section 'Stability').
+struct PerturbationGrowth {
+  double initial = 0;  // distance at t = 0 (relative to max|u0|)
+  double largest = 0;  // largest distance over the sampled k, over the initial one
+  double last = 0;     // the distance at k = periods, over the initial one
+  std::vector<std::pair<int, double>> history;  // (k, distance over the initial one)
+  bool ok = false;
+};
+PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period, int periods,
+                                       double relative_size, int elements, unsigned seed);
 
 }  // namespace backbone::contact_bar
