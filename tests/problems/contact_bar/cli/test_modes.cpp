@@ -3,6 +3,8 @@
 // the closed form at its own energy and against the exact oracle (closed_form_check.csv).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numeric>
 #include <string>
 
 #include "core/io/table.hpp"
@@ -50,6 +52,58 @@ TEST(ModesCli, AModeNeedsTwoIntervalsPerKinkAndNamesLikeModeJ) {
     EXPECT_NE(r.err.find("modeJ for every J >= 1"), std::string::npos) << r.err;
   }
   EXPECT_FALSE(std::filesystem::exists(out / "branch.csv"));
+}
+
+}  // namespace
+
+namespace {
+
+// The law of the families attached to mode 1 (problems/contact_bar/orbits/README.md, section
+// 'Attached families: the law'): a branch point lies at T = 2q L / (p c) with p/q in lowest
+// terms, at E = EA p^2 g0^2 / (2L (2q - 3p)^2); a grid of N intervals verifies it iff p divides
+// 2N (and 2N/p >= 3), with attached dimension ceil(N/p) - 1. Every candidate the detection
+// locates on mode 1 at 40 intervals up to 3e-5 J is checked against it: located to 1e-7 in
+// period (the location's tolerance is 1e-8 of T; measured about 4e-9), and verified exactly
+// when p divides 80.
+TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
+  const std::string scene =
+      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
+  const auto out = cli::scratch("modes", "law");
+  const cli::Run r = cli::run("trace",
+                              scene +
+                                  " --branch mode1 --shooting_elements 40 --energy_max 3e-5 "
+                                  "--detect_branch_points true",
+                              out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Table b = Table::read_csv(out / "branch_points.csv");
+  const auto period = b.column("period"), energy = b.column("energy"),
+             verified = b.column("verified"), dimension = b.column("dimension");
+  ASSERT_GE(period.size(), 3u);
+  const int n = 40;
+  int checked = 0;
+  for (std::size_t i = 0; i < period.size(); ++i) {
+    // The nearest 2q/p with p <= 60 (c = L = 1 on the paper scene).
+    int best_p = 0, best_q = 0;
+    double best = 1e300;
+    for (int p = 1; p <= 60; ++p) {
+      const int q = static_cast<int>(std::lround(period[i] * p / 2));
+      if (std::gcd(p, q) != 1) continue;
+      const double d = std::abs(period[i] - 2.0 * q / p);
+      if (d < best) best = d, best_p = p, best_q = q;
+    }
+    const bool divides = (2 * n) % best_p == 0 && 2 * n / best_p >= 3;
+    if (verified[i] == 1) {
+      EXPECT_LT(best, 1e-7) << "T " << period[i];
+      EXPECT_TRUE(divides) << "T " << period[i] << " p " << best_p;
+      EXPECT_EQ(dimension[i], (n + best_p - 1) / best_p - 1) << "T " << period[i];
+      const double g0 = 1e-3, k = 2.0 * best_q - 3.0 * best_p;
+      EXPECT_NEAR(energy[i] / (best_p * best_p * g0 * g0 / (2 * k * k)), 1, 1e-6);
+      ++checked;
+    } else {
+      EXPECT_FALSE(divides && best < 1e-7) << "an unverified candidate on the law: T " << period[i];
+    }
+  }
+  EXPECT_GE(checked, 2);
 }
 
 }  // namespace
