@@ -317,7 +317,9 @@ void describe_mode(cli::TraceSetup& s, const ContactBarOrbitProblem* p,
     const AttachedContent c =
         attached_content(*p, on_branch, attached, exact_bar::ExactBarSolver());
     return core::Observables{{"frequency_ratio", c.frequency_ratio},
-                             {"oscillations_per_period", c.oscillations_per_period}};
+                             {"oscillations_per_period", c.oscillations_per_period},
+                             {"content_wavenumber", c.content_wavenumber},
+                             {"resonance_order", c.resonance_order}};
   };
   s.describe_point = [family](const continuation::BranchPoint& point) {
     const double exact = family.frequency(point.observable("energy"));

@@ -24,6 +24,13 @@ struct AttachedContent {
   double frequency_ratio = 0;          // dominant harmonic of the difference (NaN: failed)
   double oscillations_per_period = 0;  // zero crossings of the difference / 2
   double amplitude = 0;                // max |difference| [m]
+  // The content's spatial wavenumber p (README.md, 'Attached families: the law'): the attached
+  // u0 is a warp of the branch's, |u0_a'| = s X' with X' - 1 made of cos(j p pi x / L); p is the
+  // gcd of the harmonics n >= 1 of X' - 1 above 1e-3 of the largest (exact integrals of the
+  // piecewise-constant slope; a grid's aliases 2N +- p are multiples of p when p divides 2N).
+  // resonance_order = p T c / (2L): q of the law, an integer on a branch point (NaN: failed).
+  double content_wavenumber = 0;
+  double resonance_order = 0;
 };
 
 AttachedContent attached_content(const ContactBarOrbitProblem& problem,

@@ -77,7 +77,8 @@ TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
   ASSERT_EQ(r.code, 0) << r.err;
   const Table b = Table::read_csv(out / "branch_points.csv");
   const auto period = b.column("period"), energy = b.column("energy"),
-             verified = b.column("verified"), dimension = b.column("dimension");
+             verified = b.column("verified"), dimension = b.column("dimension"),
+             wavenumber = b.column("content_wavenumber"), order = b.column("resonance_order");
   ASSERT_GE(period.size(), 3u);
   const int n = 40;
   int checked = 0;
@@ -98,6 +99,10 @@ TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
       EXPECT_EQ(dimension[i], (n + best_p - 1) / best_p - 1) << "T " << period[i];
       const double g0 = 1e-3, k = 2.0 * best_q - 3.0 * best_p;
       EXPECT_NEAR(energy[i] / (best_p * best_p * g0 * g0 / (2 * k * k)), 1, 1e-6);
+      // The measured content (attached_content.hpp): its wavenumber is p and its resonance
+      // order p T / 2 is q, to the location's 1e-8 of T.
+      EXPECT_EQ(wavenumber[i], best_p) << "T " << period[i];
+      EXPECT_NEAR(order[i], best_q, 1e-6) << "T " << period[i];
       ++checked;
     } else {
       EXPECT_FALSE(divides && best < 1e-7) << "an unverified candidate on the law: T " << period[i];
