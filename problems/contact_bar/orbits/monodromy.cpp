@@ -143,16 +143,30 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
   const double dt = full_state_time_step(problem, period, nodes, options.courant);
   M.resize(2 * n, 2 * n);
   std::vector<EvalStatus> status(static_cast<std::size_t>(2 * n), EvalStatus::ok);
+  // A state on the wall (the subharmonic members start there): a step of u(L) or v(L) towards
+  // the wall leaves the admissible set, and the map has a kink there (Signorini). Those two
+  // columns take the one-sided difference away from the wall, (F(s) - F(s - h)) / h.
+  const bar::End& right = problem.setup_template().right;
+  const bool on_wall =
+      right.type == bar::EndType::contact && std::abs(base[n - 1] - right.gap) <= 1e-12 * u_scale;
+  Vector f_base;
+  if (on_wall) {
+    const EvalStatus st = full_state_map(problem, nodes, period, dt, base, f_base);
+    if (st != EvalStatus::ok) return st;
+  }
   core::run_tasks(2 * n, options.threads, [&](int j) {
     const double h = j < n ? h_u : h_v;
+    const bool one_sided = on_wall && (j == n - 1 || j == 2 * n - 1);
     Vector plus = base, minus = base, f_plus, f_minus;
     plus[j] += h;
     minus[j] -= h;
-    EvalStatus a = full_state_map(problem, nodes, period, dt, plus, f_plus);
+    EvalStatus a =
+        one_sided ? EvalStatus::ok : full_state_map(problem, nodes, period, dt, plus, f_plus);
     EvalStatus b =
         a == EvalStatus::ok ? full_state_map(problem, nodes, period, dt, minus, f_minus) : a;
     status[static_cast<std::size_t>(j)] = b;
-    if (b == EvalStatus::ok) M.col(j) = (f_plus - f_minus) / (2 * h);
+    if (b != EvalStatus::ok) return;
+    M.col(j) = one_sided ? Vector((f_base - f_minus) / h) : Vector((f_plus - f_minus) / (2 * h));
   });
   for (EvalStatus s : status)
     if (s != EvalStatus::ok) return s;

@@ -16,7 +16,9 @@
 // of the map is the problem's, or courant dx / c when smaller (T / dt an integer). Measured on the
 // free bar after 4L/c (tests/problems/contact_bar/orbits/test_monodromy.cpp): the v columns of M
 // are off by 0.46 (c dt / dx)^2, the u columns by round-off.
-// M = d(map)/ds by central differences, 4N simulations of one period (on `threads` threads). The
+// M = d(map)/ds by central differences, 4N simulations of one period (on `threads` threads);
+// for a state on the wall, the columns of u(L) and v(L) are the one-sided differences away from
+// it (the map has a kink there). The
 // period map is affine while the contact sequence and the grid cells holding its instants' fronts
 // stay the same, so the differences are exact up to the round-off of each simulation divided by the
 // step (relative_step times the orbit's scale).
