@@ -3,7 +3,10 @@
 // main job, `backbone reproduce`.
 #include "continuation/cli/plugin.hpp"
 
+#include <algorithm>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/peers.hpp"
@@ -13,6 +16,39 @@
 #include "problems/contact_bar/figures/stability.hpp"
 
 namespace backbone::contact_bar {
+
+namespace {
+
+// The stability study (problems/contact_bar/orbits/README.md, section 'Stability'): modes 1 and
+// 2 with their multipliers at 40 and 80 intervals, at 40 with c dt / dx halved and by the exact
+// solver, and mode 2 at 160, into {out}/stability/<branch>_<run>.
+std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
+  const std::vector<std::string> n40{"--shooting_elements", "40"};
+  const std::vector<std::pair<std::string, std::vector<std::string>>> runs{
+      {"N40", n40},
+      {"N80", {"--shooting_elements", "80"}},
+      {"N160", {"--shooting_elements", "160"}},
+      {"N40_dt_half", {"--shooting_elements", "40", "--stability_courant", "0.015625"}},
+      {"N40_exact", {"--shooting_elements", "40", "--shooting_solver", "exact"}}};
+  // The main job's order of the steps (mode 2 alone at 160).
+  const std::vector<std::pair<std::string, std::string>> order{
+      {"mode1", "N40"},       {"mode1", "N80"},  {"mode1", "N40_dt_half"},
+      {"mode2", "N40"},       {"mode2", "N80"},  {"mode1", "N40_exact"},
+      {"mode2", "N40_exact"}, {"mode2", "N160"}, {"mode2", "N40_dt_half"}};
+  std::vector<cli::ReproduceStep> steps;
+  for (const auto& [branch, run] : order) {
+    std::vector<std::string> args{scenes + "paper.ini", "--branch", branch};
+    for (const auto& [name, extra] : runs)
+      if (name == run) args.insert(args.end(), extra.begin(), extra.end());
+    for (const char* word : {"--stability", "true", "--threads", "2", "--out"})
+      args.push_back(word);
+    args.push_back("{out}/stability/" + branch + "_" + run);
+    steps.push_back({"stability_" + branch + "_" + run, "trace", std::move(args)});
+  }
+  return steps;
+}
+
+}  // namespace
 
 void register_plugin(cli::PluginRegistry& registry) {
   cli::ProblemPlugin p = trace_plugin();
@@ -58,49 +94,6 @@ void register_plugin(cli::PluginRegistry& registry) {
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1e-3", "--out",
         "{out}/subharmonic_continuum_1e-3"}},
-      // The stability study (problems/contact_bar/orbits/README.md, section 'Stability'): modes
-      // 1 and 2 with their multipliers at 40 and 80 intervals, at 40 with c dt / dx halved and by
-      // the exact solver, and mode 2 at 160.
-      {"stability_mode1_N40",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40", "--stability",
-        "true", "--threads", "2", "--out", "{out}/stability/mode1_N40"}},
-      {"stability_mode1_N80",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "80", "--stability",
-        "true", "--threads", "2", "--out", "{out}/stability/mode1_N80"}},
-      {"stability_mode1_N40_dt_half",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40",
-        "--stability_courant", "0.015625", "--stability", "true", "--threads", "2", "--out",
-        "{out}/stability/mode1_N40_dt_half"}},
-      {"stability_mode2_N40",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "40", "--stability",
-        "true", "--threads", "2", "--out", "{out}/stability/mode2_N40"}},
-      {"stability_mode2_N80",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "80", "--stability",
-        "true", "--threads", "2", "--out", "{out}/stability/mode2_N80"}},
-      {"stability_mode1_N40_exact",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40", "--stability",
-        "true", "--shooting_solver", "exact", "--threads", "2", "--out",
-        "{out}/stability/mode1_N40_exact"}},
-      {"stability_mode2_N40_exact",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "40", "--stability",
-        "true", "--shooting_solver", "exact", "--threads", "2", "--out",
-        "{out}/stability/mode2_N40_exact"}},
-      {"stability_mode2_N160",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "160", "--stability",
-        "true", "--threads", "2", "--out", "{out}/stability/mode2_N160"}},
-      {"stability_mode2_N40_dt_half",
-       "trace",
-       {scenes + "paper.ini", "--branch", "mode2", "--shooting_elements", "40",
-        "--stability_courant", "0.015625", "--stability", "true", "--threads", "2", "--out",
-        "{out}/stability/mode2_N40_dt_half"}},
       // Other scenes, the bar changed (and u0, period and dt with it, so that each scene.ini
       // simulates too): the closed forms must hold there as well.
       {"mode1_short_bar",
@@ -136,6 +129,12 @@ void register_plugin(cli::PluginRegistry& registry) {
       {"figures", "figures", {"--out", "{out}"}},
       {"bench", "bench", {"--problem", "contact_bar", "--out", "{out}/bench"}},
   };
+  // The stability study after the paper scene's branches, before the other bars.
+  const auto other_bars =
+      std::find_if(p.reproduce.begin(), p.reproduce.end(),
+                   [](const cli::ReproduceStep& r) { return r.name == "mode1_short_bar"; });
+  const std::vector<cli::ReproduceStep> study = stability_steps(scenes);
+  p.reproduce.insert(other_bars, study.begin(), study.end());
   registry.add(std::move(p));
 }
 

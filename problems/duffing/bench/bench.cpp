@@ -67,6 +67,25 @@ double median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
+// What a traced branch says, timed from (wall_start, cpu_start): seconds, points, stop, counts,
+// and the worst relative period error against the elliptic integral.
+BackboneRun measured_run(const continuation::Branch& branch, const Duffing& duffing,
+                         std::chrono::steady_clock::time_point wall_start, double cpu_start) {
+  BackboneRun run;
+  run.cpu_seconds = cpu_now() - cpu_start;
+  run.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  run.points = static_cast<int>(branch.points.size());
+  run.message = branch.message;
+  run.residuals = duffing.counters().residuals;
+  run.jacobians = duffing.counters().jacobians;
+  for (const continuation::BranchPoint& p : branch.points) {
+    const double exact = exact_period(p.x[0]);
+    run.max_error = std::max(run.max_error, std::abs(p.x[1] - exact) / exact);
+  }
+  return run;
+}
+
 }  // namespace
 
 std::filesystem::path peers_folder() {
@@ -101,22 +120,11 @@ BackboneRun trace_backbone(const BackboneSettings& settings) {
   const double cpu_start = cpu_now();
   const continuation::Branch branch =
       continuation::pseudo_arclength(duffing, guess, direction, *corrector, options);
-  BackboneRun run;
-  run.cpu_seconds = cpu_now() - cpu_start;
-  run.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  BackboneRun run = measured_run(branch, duffing, wall_start, cpu_start);
   run.settings = settings;
-  run.points = static_cast<int>(branch.points.size());
-  run.message = branch.message;
   run.complete =
       branch.reason == continuation::StopReason::bound_reached && !branch.points.empty() &&
       std::abs(branch.points.back().x[0] - settings.amplitude_end) <= 1e-9 * settings.amplitude_end;
-  run.residuals = duffing.counters().residuals;
-  run.jacobians = duffing.counters().jacobians;
-  for (const continuation::BranchPoint& p : branch.points) {
-    const double exact = exact_period(p.x[0]);
-    run.max_error = std::max(run.max_error, std::abs(p.x[1] - exact) / exact);
-  }
   return run;
 }
 
@@ -226,25 +234,14 @@ BackboneRun trace_scene_defaults() {
   const double cpu_start = cpu_now();
   const continuation::Branch branch =
       cli::run_continuation(duffing, guess, direction, run, *corrector, {}).branch;
-  BackboneRun result;
-  result.cpu_seconds = cpu_now() - cpu_start;
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  BackboneRun result = measured_run(branch, duffing, wall_start, cpu_start);
   result.settings.relative_tolerance = duffing_options.relative_tolerance;
   result.settings.ds = run.options.ds;
   result.settings.ds_max = run.options.ds_max;
   result.settings.newton_tolerance = run.newton_options.residual_tolerance;
   result.settings.rank_check_every = run.options.rank_check_every;
   result.label = "CLI defaults (duffing.ini), rank reports, multipliers";
-  result.points = static_cast<int>(branch.points.size());
-  result.message = branch.message;
   result.complete = branch.reason == continuation::StopReason::bound_reached;
-  result.residuals = duffing.counters().residuals;
-  result.jacobians = duffing.counters().jacobians;
-  for (const continuation::BranchPoint& p : branch.points) {
-    const double exact = exact_period(p.x[0]);
-    result.max_error = std::max(result.max_error, std::abs(p.x[1] - exact) / exact);
-  }
   return result;
 }
 
