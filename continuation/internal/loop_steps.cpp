@@ -69,8 +69,21 @@ void LoopSteps::attach(BranchPoint& point, std::shared_ptr<LoopState> state) con
 
 void LoopSteps::report_first(std::shared_ptr<LoopState> state) {
   BranchPoint& first = branch_.points.back();
+  if (first_pending_) {
+    if (state) first_direction_ = state->tangent;
+    attach(first, std::move(state));
+    return;
+  }
   if (state && state->tangent.size() > 0) recorder_.recheck_dimension(first, state->tangent);
   attach(first, std::move(state));
+  if (hooks_.on_point) hooks_.on_point(first);
+}
+
+void LoopSteps::flush_first(const core::Vector* neighbour) {
+  if (!first_pending_) return;
+  first_pending_ = false;
+  BranchPoint& first = branch_.points[first_position_];
+  recorder_.verify_deferred(first, first_direction_, neighbour);
   if (hooks_.on_point) hooks_.on_point(first);
 }
 
@@ -111,6 +124,7 @@ void LoopSteps::push(BranchPoint point) {
 }
 
 Branch LoopSteps::take() {
+  flush_first(nullptr);
   if (pending_branch_points_) {
     for (BranchPointReport& report : pending_branch_points_()) add_branch_point(std::move(report));
     pending_branch_points_ = nullptr;
@@ -154,7 +168,11 @@ bool LoopSteps::start(const core::Problem& system, core::Vector& z, const std::s
                     describe(z), rejection);
     return false;
   }
+  recorder_.defer_verification(defer_first_);
   push_back(recorder_.finish(z, first_index_, s.iterations, 0.0, arclength_, true));
+  recorder_.defer_verification(false);
+  first_pending_ = defer_first_ && branch_.points.back().rank.has_value();
+  first_position_ = branch_.points.size() - 1;
   return true;
 }
 
@@ -190,6 +208,7 @@ bool LoopSteps::record(const core::Vector& x, const core::Vector& y, const core:
     land_on_bound(*bound, bound_value, x, y, forward, ds, arclength_at_x);
     return false;
   }
+  flush_first(&y);
   attach(point, std::move(state));
   push(std::move(point));
   return true;
@@ -214,15 +233,22 @@ void LoopSteps::land_on_bound(const Bound& bound, double value, const core::Vect
                                   bound.observable, value, index - 1);
     return;
   }
+  // From the crossing point first, then from the last point inside the bound.
+  land(bound, value, {&y, &x}, x, forward, ds, arclength_at_x);
+}
+
+bool LoopSteps::land(const Bound& bound, double value,
+                     std::initializer_list<const core::Vector*> starts, const core::Vector& x,
+                     const core::Vector& forward, double ds, double arclength_at_x) {
+  const int index = next_index();
   recorder_.begin();
   const core::BorderedSystem on_bound(problem_,
                                       {core::BorderRow::observable(bound.observable, value)});
-  // From the crossing point first, then from the last point inside the bound.
   core::Vector z;
   core::NewtonSummary s;
   std::string rejection;
   bool landed = false;
-  for (const core::Vector* start : {&y, &x}) {
+  for (const core::Vector* start : starts) {
     z = *start;
     s = corrector_.solve(on_bound, z);
     const bool ahead = s.converged() && (z - x).dot(forward) > 0;
@@ -231,12 +257,38 @@ void LoopSteps::land_on_bound(const Bound& bound, double value, const core::Vect
     if (hooks_.on_attempt) hooks_.on_attempt({index, ds, landed, s, rejection});
     if (s.converged()) break;
   }
-  if (!landed) return;
+  if (!landed) return false;
   const double chord = (z - x).norm();
-  push(recorder_.finish(z, index, s.iterations, chord, arclength_at_x + chord, true,
-                        core::Vector(z - x), &x));
+  BranchPoint landed_point = recorder_.finish(z, index, s.iterations, chord,
+                                              arclength_at_x + chord, true, core::Vector(z - x), &x);
+  flush_first(&z);
+  push(std::move(landed_point));
+  branch_.reason = StopReason::bound_reached;
   branch_.message = fmt::format("{} reached its bound {:.6g} (point {} lies on it)",
                                 bound.observable, value, index);
+  return true;
+}
+
+const Bound* LoopSteps::bound_within(double ds, double& value, double& ds_to_bound) const {
+  if (!options_.land_on_bounds || branch_.points.size() < 2) return nullptr;
+  const BranchPoint& a = branch_.points[branch_.points.size() - 2];
+  const BranchPoint& b = branch_.points.back();
+  const double chord = b.arclength - a.arclength;
+  if (!(chord > 0) || b.index != a.index + 1) return nullptr;
+  for (const Bound& bound : options_.bounds) {
+    const double va = a.observable(bound.observable), vb = b.observable(bound.observable);
+    if (!std::isfinite(va) || !std::isfinite(vb)) continue;
+    const double slope = (vb - va) / chord;
+    const double target = slope > 0 ? bound.max : bound.min;
+    if (!std::isfinite(target) || slope == 0) continue;
+    const double to_bound = (target - vb) / slope;
+    if (to_bound > 0 && to_bound <= ds) {
+      value = target;
+      ds_to_bound = to_bound;
+      return &bound;
+    }
+  }
+  return nullptr;
 }
 
 }  // namespace backbone::continuation

@@ -35,6 +35,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <utility>
 #include <vector>
@@ -157,6 +158,11 @@ class LoopSteps {
   // did not converge". The loop then reports it with report_first, with its state when it has
   // one.
   bool start(const core::Problem& system, core::Vector& z, const std::string& where);
+  // The first point's null directions are then verified by the next recorded point, a known
+  // neighbour, instead of probes of their own (or by probes when the branch ends first); the
+  // point is reported just before that next one. For a loop whose first step leaves along the
+  // first point's tangent.
+  void verify_first_by_next() { defer_first_ = true; }
   void report_first(std::shared_ptr<LoopState> state);
 
   // In place of start: continues from a saved state (its index and arclength). record: the
@@ -206,6 +212,20 @@ class LoopSteps {
               int newton_iterations, double ds, bool force_rank, std::shared_ptr<LoopState> state,
               const core::Vector* curve_direction = nullptr);
 
+  // The bound whose observable, extrapolated along the chord of the last two recorded points,
+  // reaches it within ds of the last point (null: none, or fewer than two points): its value
+  // and the distance to it. The loop then aims its step at the bound (land_ahead) instead of
+  // crossing it and landing back.
+  const Bound* bound_within(double ds, double& value, double& ds_to_bound) const;
+  // F plus the bound's observable row corrected from `predicted`, a point ds ahead of the last
+  // point x: true, with the branch ended (bound_reached) and the solution recorded, when it
+  // converges ahead of x along `forward` and hooks.reject_point accepts it; false, with nothing
+  // recorded, otherwise (the loop then steps as usual).
+  bool land_ahead(const Bound& bound, double value, const core::Vector& x,
+                  const core::Vector& predicted, const core::Vector& forward, double ds) {
+    return land(bound, value, {&predicted}, x, forward, ds, arclength_);
+  }
+
   // Ends the branch: sets reason and message, returns the branch.
   Branch end(StopReason reason, std::string message);
   // The branch, each point converted to the problem's unknowns with the units it was
@@ -216,10 +236,15 @@ class LoopSteps {
   std::string describe(const core::Vector& z) const;
 
  private:
+  // Verifies and reports the first point when its verification was deferred (neighbour: the
+  // point recorded last, or null for probes).
+  void flush_first(const core::Vector* neighbour);
   void push(BranchPoint point);
   void push_back(BranchPoint point);  // adds without reporting
   void attach(BranchPoint& point, std::shared_ptr<LoopState> state) const;
   std::string rejection_of(const core::Vector& z) const;
+  bool land(const Bound& bound, double value, std::initializer_list<const core::Vector*> starts,
+            const core::Vector& x, const core::Vector& forward, double ds, double arclength_at_x);
   void land_on_bound(const Bound& bound, double value, const core::Vector& x, const core::Vector& y,
                      const core::Vector& forward, double ds, double arclength_at_x);
 
@@ -233,6 +258,9 @@ class LoopSteps {
   int first_index_ = 0;
   double arclength_ = 0;
   int switch_index_ = -1;
+  bool defer_first_ = false, first_pending_ = false;
+  std::size_t first_position_ = 0;
+  core::Vector first_direction_;
   std::function<std::vector<BranchPointReport>()> pending_branch_points_;
 };
 

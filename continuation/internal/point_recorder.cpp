@@ -36,6 +36,11 @@ void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_dir
   rank.full_spectrum = false;  // sigma_max and the values around the threshold suffice here
   core::RankReport report = core::rank_report(J, rank);
   const core::Matrix* nearby = options_.chord_corrections ? &J : nullptr;
+  if (verifier_ && defer_) {
+    point.dimension = report.nullity;
+    point.rank = std::move(report);
+    return;
+  }
   if (verifier_) {
     core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, report,
                                  nearby, previous, known_residual(previous));
@@ -45,6 +50,15 @@ void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_dir
   }
   point.rank = std::move(report);
   recheck_dimension(point, curve_direction, nearby, previous);
+}
+
+void PointRecorder::verify_deferred(BranchPoint& point, const core::Vector& curve_direction,
+                                    const core::Vector* neighbour) {
+  if (!verifier_ || !point.rank) return;
+  core::verify_null_directions(problem_, point.x, *verifier_, options_.verification, *point.rank,
+                               nullptr, neighbour, known_residual(neighbour));
+  point.dimension = point.rank->verified_dimension;
+  recheck_dimension(point, curve_direction, nullptr, neighbour);
 }
 
 void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,

@@ -46,6 +46,14 @@ class PointRecorder {
   // Rank report (and verification) at an already recorded point.
   void check_rank(BranchPoint& point, const core::Vector& curve_direction = {},
                   const core::Vector* previous = nullptr);
+  // While set, finish() computes the rank report without verifying its null directions
+  // (BranchPoint::dimension is then the nullity); verify_deferred() does that later.
+  void defer_verification(bool defer) { defer_ = defer; }
+  // Verifies a report finish() deferred, with `neighbour` (the point recorded last, whose ||F||
+  // is known: no evaluation when it confirms a direction) or by probes when null, then the
+  // re-check along curve_direction.
+  void verify_deferred(BranchPoint& point, const core::Vector& curve_direction,
+                       const core::Vector* neighbour);
   // With a verified dimension below 1 and a verifier: probes curve_direction; when it is real,
   // the dimension is 1 plus the verified candidate directions orthogonal to it (flag
   // rechecked), else the flag says unconfirmed. Nothing happens at a point of dimension >= 1.
@@ -66,6 +74,7 @@ class PointRecorder {
   // verification's known neighbour), else NaN.
   double known_residual(const core::Vector* x) const;
 
+  bool defer_ = false;
   const core::Problem& problem_;
   const core::Problem& counted_;
   const ContinuationOptions& options_;

@@ -108,6 +108,12 @@ class ArclengthLoop {
   // One step from x; a Branch when the loop ends.
   std::optional<Branch> step();
   Prediction predict() const;
+  // The predicted point at step ds.
+  core::Vector predicted_at(const Prediction& p, double ds) const;
+  // When a bound lies within the step (LoopSteps::bound_within): the point on it, corrected
+  // from the prediction at the distance to it, ends the branch (true). A step that crossed the
+  // bound instead costs its own correction and then the landing's.
+  bool land_ahead(const Prediction& p);
   // The bordered Jacobian at x on the nearby base Jacobian (empty: none to start from).
   core::Matrix chord_matrix() const;
   CorrectedStep correct(const Prediction& p, const core::Matrix& bordered_nearby, core::Vector& y);
@@ -253,6 +259,7 @@ std::optional<Branch> ArclengthLoop::begin_from_guess(const core::Vector& guess,
     }
   }
   core::BorderedSystem first(problem_, {core::BorderRow::linear(hint, s_.x, 0.0, "arclength")});
+  if (options_.max_points > 1) steps_.verify_first_by_next();
   if (!steps_.start(first, s_.x, "")) return steps_.take();
   if (problem_.jacobian(s_.x, s_.J) != core::EvalStatus::ok ||
       tangent_from_jacobian(s_.J, hint, threshold_, s_.tangent) != core::EvalStatus::ok) {
@@ -279,6 +286,7 @@ std::optional<Branch> ArclengthLoop::begin_from_guess(const core::Vector& guess,
 std::optional<Branch> ArclengthLoop::step() {
   const int index = steps_.next_index();
   const Prediction p = predict();
+  if (land_ahead(p)) return steps_.take();
   system_->set_anchor(0, s_.x);
   system_->set_direction(0, p.direction);
   const core::Matrix bordered_nearby = chord_matrix();
@@ -310,6 +318,21 @@ std::optional<Branch> ArclengthLoop::step() {
   detect(index, y, next_tangent, steps_.arclength());
   advance(y, next_tangent, *state);
   return std::nullopt;
+}
+
+bool ArclengthLoop::land_ahead(const Prediction& p) {
+  double value = 0, ds_to_bound = 0;
+  const Bound* bound = steps_.bound_within(s_.ds, value, ds_to_bound);
+  if (!bound) return false;
+  return steps_.land_ahead(*bound, value, s_.x, predicted_at(p, ds_to_bound), p.direction,
+                           ds_to_bound);
+}
+
+core::Vector ArclengthLoop::predicted_at(const Prediction& p, double ds) const {
+  core::Vector predicted = s_.x + ds * p.direction;
+  if (p.bend.size() > 0 && 0.5 * ds * p.bend.norm() <= 0.25)
+    predicted += 0.5 * ds * ds * p.bend;
+  return predicted;
 }
 
 Prediction ArclengthLoop::predict() const {
@@ -353,9 +376,7 @@ CorrectedStep ArclengthLoop::correct(const Prediction& p, const core::Matrix& bo
   return steps_.correct(
       s_.ds, y,
       [&](double ds_try, core::Vector& predicted) {
-        predicted = s_.x + ds_try * p.direction;
-        if (p.bend.size() > 0 && 0.5 * ds_try * p.bend.norm() <= 0.25)
-          predicted += 0.5 * ds_try * ds_try * p.bend;
+        predicted = predicted_at(p, ds_try);
         system_->set_value(0, ds_try);
         return bordered_nearby.size() > 0 ? corrector_.solve(*system_, predicted, bordered_nearby)
                                           : corrector_.solve(*system_, predicted);

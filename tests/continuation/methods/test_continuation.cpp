@@ -523,9 +523,10 @@ TEST(Continuation, QuadraticPredictorStartsCloserOnACircle) {
 
 // The rank verification runs with the corrector options.verification describes: probes 0.05
 // along the circle's tangent start 1.25e-3 off the circle, and one Newton iteration (quadratic:
-// to ~1e-6) cannot reach the verifier's 1e-10, while the default 60 can (3 iterations). Only
-// point 0 is probed: at the later points the previous point verifies the tangent (a chord of
-// 0.1 rad leaves it by tan 0.05 of its length, within drift_ratio 0.1), whatever the corrector.
+// to ~1e-6) cannot reach the verifier's 1e-10, while the default 60 can (3 iterations). A
+// branch of one point is probed. On a longer branch every point has a neighbour that verifies
+// its tangent (a chord of 0.1 rad leaves it by tan 0.05 of its length, within drift_ratio 0.1),
+// whatever the corrector: point 0 by point 1, the others by the point before.
 TEST(Continuation, VerificationUsesTheVerifyOptionsCorrector) {
   algebraic::Circle circle;
   auto newton = core::make_corrector("eigen", core::NewtonOptions{});
@@ -541,8 +542,35 @@ TEST(Continuation, VerificationUsesTheVerifyOptionsCorrector) {
   ASSERT_EQ(capped.points.size(), 6u);
   for (std::size_t i = 0; i < 6; ++i) {
     EXPECT_EQ(verified.points[i].dimension, 1) << i;
-    EXPECT_EQ(capped.points[i].dimension, i == 0 ? 0 : 1) << i;
+    EXPECT_EQ(capped.points[i].dimension, 1) << i;
   }
+  opt.max_points = 1;
+  const Branch alone_capped =
+      continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  opt.verification.max_iterations = core::VerifyOptions{}.max_iterations;
+  const Branch alone = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  ASSERT_EQ(alone_capped.points.size(), 1u);
+  ASSERT_EQ(alone.points.size(), 1u);
+  EXPECT_EQ(alone_capped.points[0].dimension, 0);
+  EXPECT_EQ(alone.points[0].dimension, 1);
+}
+
+// The first point's tangent is verified by the second point, at no evaluation of its own: the
+// residual evaluations of point 0 are those of its correction alone (the guess and the
+// corrected point), where a probe adds at least a stepped point and its correction.
+TEST(Continuation, TheFirstPointIsVerifiedByTheSecond) {
+  algebraic::Circle circle;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(3);
+  opt.rank_check_every = 1;
+  const Branch two = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  opt.max_points = 1;
+  const Branch one = continuation::pseudo_arclength(circle, vec(1, 0), vec(0, 1), *newton, opt);
+  ASSERT_EQ(two.points.size(), 3u);
+  ASSERT_EQ(one.points.size(), 1u);
+  EXPECT_EQ(two.points[0].dimension, 1);
+  EXPECT_EQ(one.points[0].dimension, 1);
+  EXPECT_LT(two.points[0].residual_evaluations, one.points[0].residual_evaluations);
 }
 
 namespace {
