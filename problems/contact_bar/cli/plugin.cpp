@@ -94,6 +94,20 @@ void register_plugin(cli::PluginRegistry& registry) {
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1e-3", "--out",
         "{out}/subharmonic_continuum_1e-3"}},
+      // The continuum of mode 4 over two periods (problems/contact_bar/orbits/README.md,
+      // 'Subharmonic continuum of mode J'): its backbone at N and 2N, and the members at one
+      // energy (strain 9 g0 / L) from limit to limit.
+      {"subharmonic4",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic4", "--out", "{out}/subharmonic4"}},
+      {"subharmonic4_N40",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic4", "--shooting_elements", "40", "--out",
+        "{out}/subharmonic4_N40"}},
+      {"subharmonic_continuum4",
+       "trace",
+       {scenes + "paper.ini", "--branch", "subharmonic_continuum4", "--out",
+        "{out}/subharmonic_continuum4"}},
       // Other scenes, the bar changed (and u0, period and dt with it, so that each scene.ini
       // simulates too): the closed forms must hold there as well.
       {"mode1_short_bar",

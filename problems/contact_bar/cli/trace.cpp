@@ -75,6 +75,29 @@ int mode_number(const std::string& branch) {
   return std::stoi(branch.substr(4));
 }
 
+// The subharmonic branch names: subharmonic, subharmonic_continuum, subharmonic_manifold (mode 2)
+// and the same with a mode number J >= 3 appended (subharmonic4, subharmonic_continuum4, ...).
+// kind is empty for any other name; mode is J (odd J too: the setup refuses it, with the reason).
+struct SubharmonicBranch {
+  std::string kind;  // "subharmonic", "subharmonic_continuum" or "subharmonic_manifold"
+  int mode = 0;
+};
+
+SubharmonicBranch subharmonic_branch(const std::string& branch) {
+  for (const char* kind : {"subharmonic_continuum", "subharmonic_manifold", "subharmonic"}) {
+    const std::string k = kind;
+    if (branch.rfind(k, 0) != 0) continue;
+    const std::string digits = branch.substr(k.size());
+    if (digits.empty()) return {k, 2};
+    if (digits.size() > 5 || digits[0] == '0' ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      return {};
+    const int mode = std::stoi(digits);
+    return mode >= 3 ? SubharmonicBranch{k, mode} : SubharmonicBranch{};
+  }
+  return {};
+}
+
 // The monodromy's grid, difference step and threads (keys stability_elements, stability_step,
 // threads); InputError naming the key.
 MonodromyOptions monodromy_options(const core::Scene& scene) {
@@ -346,7 +369,7 @@ void describe_mode(cli::TraceSetup& s, const ContactBarOrbitProblem* p,
 }
 
 cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
-  if (branch.rfind("subharmonic", 0) == 0) return setup_subharmonic(scene, branch);
+  if (!subharmonic_branch(branch).kind.empty()) return setup_subharmonic(scene, branch);
   // A subharmonic key given to a mode would be ignored in silence.
   const po::options_description subharmonic = subharmonic_keys();
   for (const auto& option : subharmonic.options()) {
@@ -415,7 +438,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
 //  - ds = ds_max = 1/40 of the closed-form path length in the scaled step norm, so every
 //    energy has about 40 members (the path grows like sqrt(E) / g0 in that norm), unless the
 //    scene gives ds or ds_max;
-//  - a window on the shape from shape_end = 1e-6 L / ((1 - 3b) L) to 1 (to 1 - shape_end when
+//  - a window on the shape from shape_end = 1e-6 L / (D L) (D L = (1 - 3b) L for mode 2) to 1 (to 1 - shape_end when
 //    the branch goes up from a first member below 1/2): the shape-0 limit has
 //    its second kink at x = L, where the two-knot chart degenerates (the forward-difference
 //    step of the last knot, 1.5e-8 L, crosses L once L - k2 is smaller), so the branch lands
@@ -428,7 +451,10 @@ std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)> co
   const double g0 = problem.displacement_scale();
   const double s = std::sqrt(2 * energy / (material.axial_stiffness() * material.length));
   const double b = 0.25 * (1 + g0 / (s * material.length));
-  const double shape_end = 1e-6 / (1 - 3 * b);
+  // 1e-6 L of kink travel over D L, the members' kink range (J = 2: D = 1 - 3b).
+  const double j = problem.options().subharmonic_mode, gamma = g0 / (s * material.length);
+  const double contact = j == 2 ? 1 - 3 * b : (1 - (2 * j - 1) * gamma) / (j * j);
+  const double shape_end = 1e-6 / contact;
   // The closed-form path length from `shape` to the end, in the loop's scaled unknowns: 40
   // steps to twice shape_end, so that no planned member falls on the bound itself (a member on
   // it leaves no landing ahead of it).
@@ -460,6 +486,7 @@ std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)> co
 // Where a subharmonic branch starts: the members' energy (continuum) or the backbone's first
 // energy near the mode-2 grazing energy (end amplitude (1 + start_offset) g0), and the shape.
 struct SubharmonicStart {
+  int mode = 2;  // J: the continuum of mode J over two periods
   bool manifold = false, continuum = false;
   double energy = 0;        // of the continuum's members
   double shape = 0;         // kept (subharmonic) or of the first member (continuum)
@@ -467,14 +494,18 @@ struct SubharmonicStart {
   SubharmonicMember first;  // the closed-form member there
 };
 
-SubharmonicStart subharmonic_start(const core::Scene& scene, const std::string& branch,
+SubharmonicStart subharmonic_start(const core::Scene& scene, const SubharmonicBranch& branch,
                                    const bar::Material& material, double g0) {
   SubharmonicStart st;
+  st.mode = branch.mode;
+  const double j = st.mode;
   // The manifold's seed is a member of the continuum at sqrt(energy_min energy_max) (manifold.hpp).
-  st.manifold = branch == "subharmonic_manifold";
-  st.continuum = branch == "subharmonic_continuum" || st.manifold;
+  st.manifold = branch.kind == "subharmonic_manifold";
+  st.continuum = branch.kind == "subharmonic_continuum" || st.manifold;
   st.energy = scene.non_negative("energy");
-  if (st.energy == 0) st.energy = 0.5 * material.axial_stiffness() * 25 * g0 * g0 / material.length;
+  // Default: strain (2J + 1) g0 / L, above the grazing strain (2J - 1) g0 / L (mode 2: 5 g0 / L).
+  if (st.energy == 0)
+    st.energy = 0.5 * material.axial_stiffness() * std::pow((2 * j + 1) * g0, 2) / material.length;
   if (st.manifold) st.energy = manifold_seed_energy(scene);
   const double shape_key = scene.number("shape");
   if (shape_key != -1 && !(shape_key > 0 && shape_key <= 1))
@@ -483,10 +514,11 @@ SubharmonicStart subharmonic_start(const core::Scene& scene, const std::string& 
                                                 shape_key));
   st.shape = shape_key > 0 ? shape_key : (st.continuum && !st.manifold ? 1.0 : 0.3);
   const double ratio = 1 + scene.positive("start_offset");
+  // End amplitude ratio g0 of mode J at strain s: sL = (J ratio + J - 1) g0 (family.hpp).
   st.start_energy = st.continuum ? st.energy
                                  : 0.5 * material.axial_stiffness() *
-                                       std::pow((2 * ratio + 1) * g0, 2) / material.length;
-  st.first = subharmonic_member(material, g0, st.start_energy, st.shape);
+                                       std::pow((j * ratio + j - 1) * g0, 2) / material.length;
+  st.first = subharmonic_member(material, g0, st.start_energy, st.shape, st.mode);
   return st;
 }
 
@@ -496,18 +528,31 @@ OrbitOptions subharmonic_chart(const core::Scene& scene, const bar::Material& ma
                                const SubharmonicStart& st) {
   OrbitOptions options = shooting_grid(scene);
   options.start_on_wall = true;
+  options.subharmonic_mode = st.mode;
   const long knots = scene.integer("free_knots", -1);
-  options.free_knots = knots < 0 ? 2 : static_cast<int>(knots);
-  if (options.free_knots < 2)
+  options.free_knots = knots < 0 ? st.mode : static_cast<int>(knots);
+  if (st.mode == 2 && options.free_knots < 2)
     throw core::InputError("free_knots", "the subharmonic members have two kinks: >= 2 or -1");
+  if (st.mode > 2 && options.free_knots != st.mode)
+    throw core::InputError("free_knots", fmt::format("the members of subharmonic{} have {} kinks, "
+                                                     "one per knot: {} or -1",
+                                                     st.mode, st.mode, st.mode));
+  if (options.elements < 2 * st.mode)
+    throw core::InputError("shooting_elements",
+                           fmt::format("must be >= {} for the {} kinks of the subharmonic{} "
+                                       "members (got {})",
+                                       2 * st.mode, st.mode, st.mode, options.elements));
   // Knot 1 on the node nearest the first kink; the last knot on node N - 1: beyond the second
   // kink u0 is linear up to L for every member, and that segment shrinks to nothing at the
   // shape-0 limit, where interior nodes would be free of the residual (spurious roots).
   // Further knots (free_knots > 2) spread between the two.
+  // Mode J > 2: the first J - 1 knots on the nodes nearest the first J - 1 kinks.
   const SubharmonicMember& first = st.first;
   std::vector<double> at{first.kinks[0]};
   for (int j = 1; j + 1 < options.free_knots; ++j)
-    at.push_back(first.kinks[0] + (first.kinks[1] - first.kinks[0]) * j / (options.free_knots - 1));
+    at.push_back(st.mode > 2 ? first.kinks[static_cast<std::size_t>(j)]
+                             : first.kinks[0] + (first.kinks[1] - first.kinks[0]) * j /
+                                                    (options.free_knots - 1));
   options.knot_nodes = nearest_knot_nodes(options.elements, material.length, at);
   options.knot_nodes.push_back(options.elements - 1);
   if (options.knot_nodes.size() >= 2 &&
@@ -534,13 +579,15 @@ std::function<void(const std::filesystem::path&, const continuation::Branch&)> s
   const double rank_threshold = scene.positive("rank_threshold");
   const bool continuum = st.continuum;
   const double energy = st.energy;
-  return [p, mode2, dimension_check, rank_threshold, continuum, energy](
+  const int mode = st.mode;
+  return [p, mode2, dimension_check, rank_threshold, continuum, energy, mode](
              const std::filesystem::path& out, const continuation::Branch& b) {
     write_subharmonic_outputs(*p, mode2, b, out, dimension_check ? rank_threshold : std::nan(""));
     if (!continuum) return;
     GrazingLimitOptions o;
     o.elements = p->options().elements;
     o.steps_per_period = p->options().steps_per_period;
+    o.mode = mode;
     const GrazingLimits g = grazing_limits(p->setup_template(), p->solver(), energy, o);
     grazing_limit_table(g).write_csv(out / "limits.csv");
     for (const GrazingLimit& l : g.limits)
@@ -549,8 +596,8 @@ std::function<void(const std::filesystem::path&, const continuation::Branch&)> s
           "{:.2e} s, residual {:.1e}, exact return {:.1e}, {} ({:.2f} s)\n",
           l.name, l.structure.contact_phases, l.structure.grazing_instants, l.phase_duration,
           l.residual, l.return_error, l.message, l.seconds);
-    fmt::print("grazing limits: shape_1 simulated by T2 = {:.9g} s vs shape_0: {:.2e} relative\n",
-               g.half_period, g.shift_distance);
+    fmt::print("grazing limits: shape_1 simulated by T{} = {:.9g} s vs shape_0: {:.2e} relative\n",
+               mode, g.half_period, g.shift_distance);
   };
 }
 
@@ -562,11 +609,19 @@ std::function<void(const std::filesystem::path&, const continuation::Branch&)> s
 // limit on).
 cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& branch) {
   bar::BarSetup setup = bar_from_scene(scene);
+  const SubharmonicBranch which = subharmonic_branch(branch);
+  if (which.mode % 2 != 0)
+    throw core::InputError(
+        "branch", fmt::format("{}: mode {} has no subharmonic continuum over two periods (an odd "
+                              "mode's shift by 2L/c locks its two contact phases T_{} apart; "
+                              "problems/contact_bar/orbits/README.md, 'Subharmonic continuum of "
+                              "mode J')",
+                              branch, which.mode, which.mode));
   check_orbit_ends(setup, "the subharmonic branches");
   check_simulation_keys(scene);
   const bar::Material& material = setup.material;
-  const ContactFamily mode2(material, setup.right.gap, 2);
-  const SubharmonicStart st = subharmonic_start(scene, branch, material, setup.right.gap);
+  const ContactFamily mode2(material, setup.right.gap, which.mode);
+  const SubharmonicStart st = subharmonic_start(scene, which, material, setup.right.gap);
   const OrbitOptions options = subharmonic_chart(scene, material, st);
 
   auto problem = std::make_unique<ContactBarOrbitProblem>(setup, shooting_solver(scene), options);
@@ -590,7 +645,7 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
   s.reject_point = return_check(scene, problem.get(), 1000);
   s.describe_point = [mode2](const continuation::BranchPoint& point) {
     const double exact = 2 * mode2.period(point.observable("energy"));
-    return fmt::format("T / (2 T2) - 1 = {:.2e}, shape {:.4f}",
+    return fmt::format("T / (2 T{}) - 1 = {:.2e}, shape {:.4f}", mode2.mode(),
                        point.observable("period") / exact - 1, point.observable("shape"));
   };
   s.write_extra_outputs = subharmonic_outputs(scene, problem.get(), mode2, st);
@@ -617,8 +672,12 @@ cli::ProblemPlugin trace_plugin() {
   p.summary = "elastic bar fixed at x = 0, rigid wall at gap g0 beyond x = L (Signorini contact)";
   p.scene_keys = &trace_keys;
   p.branches = {"mode1", "mode2", "subharmonic", "subharmonic_continuum", "subharmonic_manifold"};
-  p.branch_family = [](const std::string& name) { return mode_number(name) >= 1; };
-  p.branch_family_text = "modeJ for every J >= 1";
+  p.branch_family = [](const std::string& name) {
+    return mode_number(name) >= 1 || !subharmonic_branch(name).kind.empty();
+  };
+  p.branch_family_text =
+      "modeJ for every J >= 1; subharmonicJ, subharmonic_continuumJ and subharmonic_manifoldJ "
+      "for every even J >= 4";
   p.setup = &setup_trace;
   p.simulate_keys = &simulate_keys;
   p.simulate = &simulate_scene;

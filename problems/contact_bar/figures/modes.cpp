@@ -334,6 +334,24 @@ int draw_all_backbones(const fs::path& out, const FigureInputs& inputs) {
         ", {} using 'frequency_2d':'energy' with lines lw 10 lc rgb '#A0FF8C00' title "
         "'subharmonic band of mode 2 ({{/Symbol w}}_2/2, 2D)'",
         core::gnuplot_quote(out / "backbone_subharmonic.csv"));
+  // Mode 4's band: its traced backbone where F alone has dimension 2, every point drawn.
+  if (const fs::path sub4 = out / "subharmonic4"; has_branch(sub4)) {
+    const Table b = Table::read_csv(sub4 / "branch.csv");
+    const auto w = b.column("frequency"), e = b.column("energy"), d = b.column("dimension");
+    Table band({"frequency", "energy", "frequency_2d"});
+    int two = 0;
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      const bool is_2d = i < d.size() && d[i] == 2;
+      two += is_2d ? 1 : 0;
+      band.add_row({w[i], e[i], is_2d ? w[i] : std::nan("")});
+    }
+    band.write_csv(out / "backbones_all_subharmonic4.csv");
+    curves += fmt::format(
+        ", {0} using 'frequency_2d':'energy' with lines lw 10 lc rgb '#A08B008B' title "
+        "'subharmonic band of mode 4 ({{/Symbol w}}_4/2, 2D at {1} of {2} points)', {0} using "
+        "'frequency':'energy' with points pt 9 ps 0.5 lc rgb 'dark-magenta' notitle",
+        core::gnuplot_quote(out / "backbones_all_subharmonic4.csv"), two, w.size());
+  }
   int attached = 0;
   const fs::path resonances = out / "mode1_resonances";
   if (fs::exists(resonances))

@@ -122,33 +122,63 @@ double node_of(const bar::PiecewiseLinear& u0) {
 // wall. Marching the free / closed reflections over T = 2 (1 + b) returns the state for every c
 // in [b, 1 - 2b]: contact phases of 2 (c - b) around t = 0 and 2 (1 - 2b - c) around T / 2.
 SubharmonicMember subharmonic_member(const bar::Material& material, double gap, double energy,
-                                     double shape) {
+                                     double shape, int mode) {
+  if (mode < 2 || mode % 2 != 0)
+    throw core::InputError("mode", fmt::format("the subharmonic continuum over two periods "
+                                               "exists for even modes only (got {})",
+                                               mode));
   const double length = material.length;
   const double s = std::sqrt(2 * energy / (material.axial_stiffness() * length));
-  if (!(s * length >= 3 * gap) || !std::isfinite(s))
+  if (!(s * length >= (2 * mode - 1) * gap) || !std::isfinite(s))
     throw core::InputError("energy",
-                           fmt::format("the subharmonic continuum needs E >= the mode-2 "
+                           fmt::format("the subharmonic continuum needs E >= the mode-{} "
                                        "grazing energy {} (got {})",
-                                       ContactFamily(material, gap, 2).grazing_energy(), energy));
+                                       mode, ContactFamily(material, gap, mode).grazing_energy(),
+                                       energy));
   if (!(shape >= 0 && shape <= 1))
     throw core::InputError("shape", fmt::format("must be in [0, 1] (got {})", shape));
-  const double b = 0.25 * (1 + gap / (s * length));
-  const double c = b + shape * (1 - 3 * b);
-  const double x1 = (1 - c - b) * length, x2 = (1 - c + b) * length;
-  std::vector<double> knots{0.0, x1}, values{0.0, -s * x1};
-  if (x2 < length) {
-    knots.push_back(x2);
-    values.push_back(values.back() + s * (x2 - x1));
-  }
-  values.push_back(gap);  // s (4b - 1) L = g0 exactly (the sum of the slopes rounds)
-  knots.push_back(length);
   const double tau = length / material.wave_speed();
-  SubharmonicMember m{bar::PiecewiseLinear(std::move(knots), std::move(values)),
-                      2 * (1 + b) * tau,
-                      2 * (c - b) * tau,
-                      2 * (1 - 2 * b - c) * tau,
-                      {x1, x2}};
-  return m;
+  if (mode == 2) {
+    const double b = 0.25 * (1 + gap / (s * length));
+    const double c = b + shape * (1 - 3 * b);
+    const double x1 = (1 - c - b) * length, x2 = (1 - c + b) * length;
+    std::vector<double> knots{0.0, x1}, values{0.0, -s * x1};
+    if (x2 < length) {
+      knots.push_back(x2);
+      values.push_back(values.back() + s * (x2 - x1));
+    }
+    values.push_back(gap);  // s (4b - 1) L = g0 exactly (the sum of the slopes rounds)
+    knots.push_back(length);
+    return {bar::PiecewiseLinear(std::move(knots), std::move(values)), 2 * (1 + b) * tau,
+            2 * (c - b) * tau, 2 * (1 - 2 * b - c) * tau, {x1, x2}};
+  }
+  // Mode J even (README.md, 'Subharmonic continuum of mode J'), lengths in L: gamma = g0 / (sL),
+  // B = (1 + gamma) / J, A = (J + 1 - (J - 1) gamma) / J^2, T_J = A + B, D = A - B. Kinks at
+  // L - x = o_k + k T_J and o_k + k T_J + B for k = 0 .. J/2 - 1, o_k = shape D (k even) or
+  // (1 - shape) D (k odd); slopes -s, +s, ..., -s from x = 0; u0(L) = g0.
+  const double j = mode;
+  const double gamma = gap / (s * length);
+  const double B = (1 + gamma) / j, A = (j + 1 - (j - 1) * gamma) / (j * j);
+  const double T = A + B, D = A - B;
+  std::vector<double> kinks;
+  for (int k = 0; k < mode / 2; ++k) {
+    const double o = (k % 2 == 0 ? shape : 1 - shape) * D + k * T;
+    kinks.push_back((1 - o) * length);
+    kinks.push_back((1 - o - B) * length);
+  }
+  std::sort(kinks.begin(), kinks.end());
+  std::vector<double> knots{0.0}, values{0.0};
+  double slope = -s;
+  for (const double x : kinks) {
+    if (x >= length) break;  // shape 0: the kink nearest the end sits on it
+    values.push_back(values.back() + slope * (x - knots.back()));
+    knots.push_back(x);
+    slope = -slope;
+  }
+  knots.push_back(length);
+  values.push_back(gap);  // the slopes sum to g0 (README.md), up to rounding
+  return {bar::PiecewiseLinear(std::move(knots), std::move(values)), 2 * T * tau,
+          2 * shape * D * tau, 2 * (1 - shape) * D * tau, std::move(kinks)};
 }
 
 }  // namespace backbone::contact_bar

@@ -66,22 +66,24 @@ class ContactFamily {
 // ContactFamily::node.
 double node_of(const bar::PiecewiseLinear& u0);
 
-// One member of the subharmonic continuum near omega2 / 2 (README.md, section 'Subharmonic
-// continuum'): period T = 2 T2 (mode 2 taken over two periods), started at rest at the centre
-// of a contact phase, so u0(L) = g0 with a compressive strain there. With b = (1 + g0/(sL))/4
-// and c = b + shape (1 - 3b), u0 has slopes -s, +s, -s with kinks at (1 - c - b) L and
-// (1 - c + b) L. shape in [0, 1]: 0 and 1 are the grazing limits (one contact phase, one
-// grazing instant; the same orbit shifted by T2), 1/2 is mode 2 shifted by T2 / 2 (two equal
-// phases). Energy EA L s^2 / 2 and period are those of mode 2 (x2), whatever the shape.
+// One member of the subharmonic continuum of an even mode J (README.md, sections 'Subharmonic
+// continuum' for J = 2 and 'Subharmonic continuum of mode J'): period T = 2 T_J (mode J taken over
+// two periods), started at rest at the centre of a contact phase, so u0(L) = g0 with a
+// compressive strain there. u0 has slopes -s, +s, ..., -s from x = 0 with J kinks; for J = 2,
+// with b = (1 + g0/(sL))/4 and c = b + shape (1 - 3b), at (1 - c - b) L and (1 - c + b) L.
+// shape in [0, 1]: 0 and 1 are the grazing limits (one contact phase, one grazing instant; the
+// same orbit shifted by T_J), 1/2 is mode J shifted by T_J / 2 (two equal phases). Energy
+// EA L s^2 / 2 and period are those of mode J (x2), whatever the shape.
 struct SubharmonicMember {
   bar::PiecewiseLinear u0;
   double period = 0;
   double first_contact = 0;   // duration of the phase centred at t = 0 [s]
   double second_contact = 0;  // duration of the phase centred at t = T / 2 [s]
-  double kinks[2] = {0, 0};   // positions of the two kinks of u0 [m] (the second may be L)
+  std::vector<double> kinks;  // the J kinks of u0, increasing [m] (the last is L at shape 0)
 };
-// InputError "energy" below the mode-2 grazing energy, "shape" outside [0, 1].
+// InputError "mode" for an odd mode (no continuum over two periods), "energy" below the
+// mode-J grazing energy, "shape" outside [0, 1].
 SubharmonicMember subharmonic_member(const bar::Material& material, double gap, double energy,
-                                     double shape);
+                                     double shape, int mode = 2);
 
 }  // namespace backbone::contact_bar

@@ -32,6 +32,11 @@ void GrazingLimitOptions::validate() const {
   if (max_evaluations < 1)
     throw core::InputError("max_evaluations",
                            fmt::format("must be >= 1 (got {})", max_evaluations));
+  if (mode < 2 || mode % 2 != 0)
+    throw core::InputError("mode", fmt::format("must be even and >= 2 (got {})", mode));
+  if (elements < 2 * mode)
+    throw core::InputError("elements", fmt::format("must be >= 2 mode = {} (got {})", 2 * mode,
+                                                   elements));
 }
 
 namespace {
@@ -210,9 +215,12 @@ OrbitOptions chart(const GrazingLimitOptions& o, const bar::Material& material,
   chart.steps_per_period = o.steps_per_period;
   chart.start_on_wall = true;
   chart.free_knots = knots;
-  // As the continuum: the first knot on the node nearest the first kink, the second on N - 1.
-  chart.knot_nodes = nearest_knot_nodes(o.elements, material.length, {start.kinks[0]});
-  if (knots == 2) chart.knot_nodes.push_back(o.elements - 1);
+  chart.subharmonic_mode = o.mode;
+  // As the continuum: knots on the nodes nearest the first J - 1 kinks, the last on N - 1.
+  chart.knot_nodes = nearest_knot_nodes(
+      o.elements, material.length,
+      std::vector<double>(start.kinks.begin(), start.kinks.begin() + (o.mode - 1)));
+  if (knots == o.mode) chart.knot_nodes.push_back(o.elements - 1);
   chart.test_elements = 2 * chart.state_size();
   return chart;
 }
@@ -223,7 +231,8 @@ core::Vector start_unknowns(const ContactBarOrbitProblem& problem, const Subharm
                             double energy, const GrazingLimitOptions& o, bool shape_one) {
   core::Vector x0(problem.num_unknowns());
   if (shape_one) return problem.subharmonic_guess(energy, 1 - o.start_distance);
-  x0[problem.knot_index(0)] = start.kinks[0];
+  for (int j = 0; j + 1 < o.mode; ++j)
+    x0[problem.knot_index(j)] = start.kinks[static_cast<std::size_t>(j)];
   const core::Vector y = problem.node_positions(x0);
   for (int i = 1; i <= problem.options().nodal_unknowns(); ++i) x0[i - 1] = start.u0(y[i - 1]);
   x0[problem.period_index()] = start.period;
@@ -377,9 +386,10 @@ GrazingLimit locate(const bar::BarSetup& setup, const bar::BarSolver& solver, do
                     const GrazingLimitOptions& o, bool shape_one) {
   const auto started = std::chrono::steady_clock::now();
   const bar::Material& material = setup.material;
-  const SubharmonicMember start = subharmonic_member(
-      material, setup.right.gap, energy, shape_one ? 1 - o.start_distance : o.start_distance);
-  const int knots = shape_one ? 2 : 1;
+  const SubharmonicMember start =
+      subharmonic_member(material, setup.right.gap, energy,
+                         shape_one ? 1 - o.start_distance : o.start_distance, o.mode);
+  const int knots = shape_one ? o.mode : o.mode - 1;
   const ContactBarOrbitProblem problem(setup, solver, chart(o, material, start, knots));
   const core::Vector x0 = start_unknowns(problem, start, energy, o, shape_one);
   LimitProblem p;
@@ -423,7 +433,7 @@ GrazingLimits grazing_limits(const bar::BarSetup& setup, const bar::BarSolver& s
   options.validate();
   if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
     throw core::InputError("right", "the grazing limits need right = contact and gap > 0");
-  ContactFamily(setup.material, setup.right.gap, 2);
+  ContactFamily(setup.material, setup.right.gap, options.mode);
   GrazingLimits g;
   for (const bool shape_one : {true, false}) {
     // A start that SLSQP leaves for another root (the shape-0 start, its second kink cut off,

@@ -44,6 +44,7 @@ struct GrazingLimitOptions {
   double tolerance = 1e-12;            // NLopt: relative tolerance on x and on the objective
   double constraint_tolerance = 1e-8;  // of each projected equality row (units of g0)
   int max_evaluations = 400;           // objective evaluations per limit (each an FD gradient)
+  int mode = 2;                        // J of the continuum (even): charts of J and J - 1 knots
   void validate() const;               // InputError naming the field
 };
 

@@ -133,9 +133,10 @@ ManifoldRun cover_subharmonic_manifold(const ContactBarOrbitProblem& problem,
     return !(return_tolerance > 0) || return_error(f, x, oracle, 1000).worst() <= return_tolerance;
   };
   ManifoldRun run;
+  run.mode = problem.options().subharmonic_mode;
   run.atlas = continuation::cover_manifold(f, seed, *corrector, options, inside, {}, accept);
   const bar::BarSetup& setup = problem.setup_template();
-  const ContactFamily mode2(setup.material, setup.right.gap, 2);
+  const ContactFamily mode2(setup.material, setup.right.gap, problem.options().subharmonic_mode);
   run.energy_low = 1e300;
   run.energy_high = 0;
   for (const continuation::Chart& c : run.atlas.charts) {
@@ -214,17 +215,16 @@ void write_manifold_figure(const std::filesystem::path& out, const ManifoldRun& 
           "'10^{{%L}}'\nset xlabel 'shape (first contact phase / "
           "total contact time)'\nset ylabel 'energy [J]'\nset xrange [-0.02:1.02]\n"
           "set yrange [{:g}:{:g}]\nset key below horizontal maxcols 3 samplen 2\nset bmargin 6\n"
-          "set title 'subharmonic orbits near {{/Symbol w}}_2/2: atlas of {} charts{} (period 2 "
-          "T_2 "
-          "at every point)'\n"
+          "set title 'subharmonic orbits near {{/Symbol w}}_{}/2: atlas of {} charts{} (period 2 "
+          "T_{} at every point)'\n"
           "set arrow from 0,graph 0 to 0,graph 1 nohead dt 2 lc rgb 'gray40'\n"
           "set arrow from 1,graph 0 to 1,graph 1 nohead dt 2 lc rgb 'gray40'\n"
           "plot $edges using 1:2 with lines lc rgb '#8fa8cc' lw 1 title 'chart cells', "
           "$charts using 1:2 with points pt 7 ps 0.6 lc rgb '#1f4e9a' title 'chart centres', "
           "$rim using 1:2 with points pt 7 ps 0.7 lc rgb '#c0392b' title 'on the boundary (bounds, "
           "refused corrections)'\n",
-          energy_min / 1.15, energy_max * 1.15, cs.size(),
-          run.atlas.complete ? "" : " (incomplete)");
+          energy_min / 1.15, energy_max * 1.15, run.mode, cs.size(),
+          run.atlas.complete ? "" : " (incomplete)", run.mode);
   const core::PlotResult r = core::render_png(out / "manifold.png", script, {1100, 800});
   if (!r.ok) fmt::print(stderr, "manifold.png skipped: {}\n", r.message);
 }
@@ -264,14 +264,14 @@ void add_manifold_outputs(const core::Scene& scene, cli::TraceSetup& setup,
         "manifold: {} charts ({} on the boundary), energy {:.3e} .. {:.3e} J, {} corrections ({} "
         "failed: {} not converged, {} too far or turned, {} rejected by the exact return; {} "
         "outside the bounds; {} directions closed by failure), {:.1f} s; worst exact return "
-        "{:.1e}, worst period vs 2 T2 {:.1e}; largest gap {:.2f} chart radii (2000 closed-form "
+        "{:.1e}, worst period vs 2 T_{} {:.1e}; largest gap {:.2f} chart radii (2000 closed-form "
         "members); {}\n",
         a.charts.size(),
         std::count_if(a.charts.begin(), a.charts.end(),
                       [](const continuation::Chart& c) { return c.on_boundary; }),
         run.energy_low, run.energy_high, a.corrections, a.failed_corrections, a.not_converged,
         a.too_far, a.rejected, a.outside, a.closed_by_failure, a.seconds, run.worst_return,
-        run.worst_period, run.largest_gap, run.atlas.message);
+        run.mode, run.worst_period, run.largest_gap, run.atlas.message);
   };
 }
 

@@ -37,9 +37,10 @@ boost::program_options::options_description manifold_keys();
 double manifold_seed_energy(const core::Scene& scene);
 
 struct ManifoldRun {
+  int mode = 2;  // J of the continuum (period 2 T_J)
   continuation::Atlas atlas;
   double worst_return = 0;                 // exact oracle over T, relative (ReturnError::worst)
-  double worst_period = 0;                 // |T / (2 T2(E)) - 1| against the closed form
+  double worst_period = 0;                 // |T / (2 T_J(E)) - 1| against the closed form
   double energy_low = 0, energy_high = 0;  // range of the chart energies
   // Over 2000 random closed-form members inside the bounds: the largest distance to the nearest
   // chart centre in units of that chart's radius (<= 1: no holes).

@@ -55,10 +55,13 @@ void OrbitOptions::validate() const {
   if (!std::isfinite(fixed_energy) || fixed_energy < 0)
     throw InputError("energy",
                      fmt::format("must be > 0, or 0 for no energy row (got {})", fixed_energy));
-  if (fixed_shape >= 0 && (fixed_shape > 1 || !start_on_wall || free_knots < 2))
-    throw InputError("shape", fmt::format("must be in [0, 1], with start_on_wall and two free "
+  if (subharmonic_mode < 2 || subharmonic_mode % 2 != 0)
+    throw InputError("subharmonic_mode",
+                     fmt::format("must be even and >= 2 (got {})", subharmonic_mode));
+  if (fixed_shape >= 0 && (fixed_shape > 1 || !start_on_wall || free_knots < subharmonic_mode))
+    throw InputError("shape", fmt::format("must be in [0, 1], with start_on_wall and {} free "
                                           "knots (got {})",
-                                          fixed_shape));
+                                          subharmonic_mode, fixed_shape));
   if (!std::isfinite(fixed_dt) || fixed_dt < 0)
     throw InputError("fixed_dt", fmt::format("must be >= 0 (0: dt = T / steps_per_period; "
                                              "got {})",
@@ -202,11 +205,24 @@ double ContactBarOrbitProblem::energy(const Vector& x) const {
   return 0.5 * setup_.material.axial_stiffness() * sum;
 }
 
+namespace {
+
+// D / L of the members' contact phases (README.md, 'Subharmonic continuum of mode J') from the
+// width B / L = k_J - k_J-1 of the pulse between the last two kinks: (2 - (2J - 1) B) / J
+// (J = 2: 1 - 3B/2, the same bits).
+double contact_fraction(int mode, double pulse) {
+  const double j = mode;
+  return 2.0 / j - (2.0 * j - 1) / j * pulse;
+}
+
+}  // namespace
+
 double ContactBarOrbitProblem::subharmonic_shape(const Vector& x) const {
-  if (options_.free_knots < 2) return std::nan("");
+  const int j = options_.subharmonic_mode;
+  if (options_.free_knots < j) return std::nan("");
   const double length = setup_.material.length;
-  const double k1 = x[knot_index(0)] / length, k2 = x[knot_index(1)] / length;
-  return (1 - k2) / (1 - 1.5 * (k2 - k1));
+  const double k1 = x[knot_index(j - 2)] / length, k2 = x[knot_index(j - 1)] / length;
+  return (1 - k2) / contact_fraction(j, k2 - k1);
 }
 
 core::Observables ContactBarOrbitProblem::observables(const Vector& x) const {
@@ -485,11 +501,13 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
   if (rows > 0 && options_.fixed_energy > 0)
     r[row++] = (energy(x) - options_.fixed_energy) / options_.fixed_energy;
   if (rows > 0 && options_.fixed_shape >= 0) {
-    const double k1 = x[knot_index(0)] / length, k2 = x[knot_index(1)] / length;
+    const int j = options_.subharmonic_mode;
+    const double k1 = x[knot_index(j - 2)] / length, k2 = x[knot_index(j - 1)] / length;
     // In units of g0 like the residual rows (a knot moved by dk moves u0 by about s dk): in
     // units of L the row weighs 1e-3 of them and the rank report counts it as null.
     r[row++] =
-        (1 - k2 - options_.fixed_shape * (1 - 1.5 * (k2 - k1))) * length / displacement_scale();
+        (1 - k2 - options_.fixed_shape * contact_fraction(j, k2 - k1)) * length /
+        displacement_scale();
   }
   const double u_scale = displacement_scale();
   if (paper) {
@@ -598,22 +616,24 @@ Vector ContactBarOrbitProblem::mode_guess(int mode, double ratio, Vector x) cons
 }
 
 Vector ContactBarOrbitProblem::subharmonic_guess(double energy, double shape) const {
-  if (!options_.start_on_wall || options_.free_knots < 2)
-    throw InputError("free_knots",
-                     "the subharmonic members start on the wall (start_on_wall) "
-                     "and have two kinks (free_knots >= 2)");
+  const int mode = options_.subharmonic_mode;
+  if (!options_.start_on_wall || options_.free_knots < mode)
+    throw InputError("free_knots", fmt::format("the subharmonic members start on the wall "
+                                               "(start_on_wall) and have {} kinks (free_knots "
+                                               ">= {})",
+                                               mode, mode));
   if (!(shape > 0 && shape <= 1))
     throw InputError("shape", fmt::format("must be in (0, 1] (got {}): at 0 the second kink "
                                           "reaches x = L",
                                           shape));
-  const SubharmonicMember member = subharmonic_member(setup_.material, gap(), energy, shape);
+  const SubharmonicMember member =
+      subharmonic_member(setup_.material, gap(), energy, shape, mode);
   const double length = setup_.material.length;
   const int n = options_.elements;
   Vector x(num_unknowns());
   const std::vector<int> m = reference_knot_nodes();
   for (int j = 0; j < options_.free_knots; ++j) x[knot_index(j)] = length * m[j] / n;
-  x[knot_index(0)] = member.kinks[0];
-  x[knot_index(1)] = member.kinks[1];
+  for (int j = 0; j < mode; ++j) x[knot_index(j)] = member.kinks[static_cast<std::size_t>(j)];
   for (int j = 1; j < options_.free_knots; ++j)
     if (!(x[knot_index(j)] > x[knot_index(j - 1)]))
       throw InputError("knot_nodes", "the subharmonic kinks do not fit between the other knots");

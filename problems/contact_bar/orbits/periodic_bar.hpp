@@ -71,9 +71,11 @@ struct OrbitOptions {
   // drops them, e.g. to measure the dimension of the periodicity residual alone.
   double fixed_energy = 0;  // > 0: (energy(x) - fixed_energy) / fixed_energy = 0
   double fixed_shape = -1;  // in [0, 1]: the subharmonic shape (first contact phase / total
-                            // contact time) fixed, a linear row in knots 1 and 2 (needs
-                            // start_on_wall, K >= 2): 1 - k2 = shape (1 - 3 (k2 - k1) / 2)
-                            // (knots in units of L), times L / g0 as the residual rows
+                            // contact time) fixed, a linear row in the knots of the last two
+                            // kinks, k_J-1 and k_J (needs start_on_wall, K >= J):
+                            // 1 - k_J = shape (2 - (2J - 1) (k_J - k_J-1)) / J (knots in units
+                            // of L; J = 2: knots 1 and 2), times L / g0 as the residual rows
+  int subharmonic_mode = 2;  // J of the subharmonic members (even): their kinks are knots 1..J
   // Units that follow the orbit (continuation::LocalScale): above the gap, the unit of u0 in
   // continuation is the orbit's amplitude (its L2 norm over the bar), not g0, so that a step
   // is relative and the rank report's column scaling does not degrade as the amplitude grows
@@ -110,8 +112,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // Path rows on (default) or off: off, the residual is the periodicity residual F alone.
   void set_path_rows(bool enabled) { path_rows_enabled_ = enabled; }
   bool path_rows_enabled() const { return path_rows_enabled_; }
-  // The subharmonic shape of x from its first two knots (README.md, 'Subharmonic continuum'):
-  // (1 - k2) / (1 - 3 (k2 - k1) / 2) with lengths in units of L. NaN without two knots.
+  // The subharmonic shape of x from the knots of its last two kinks (README.md, 'Subharmonic
+  // continuum of mode J'): (1 - k_J) J / (2 - (2J - 1) (k_J - k_J-1)) with lengths in units of
+  // L, J = options.subharmonic_mode. NaN with fewer than J knots.
   double subharmonic_shape(const core::Vector& x) const;
   // Potential energy of u0: 1/2 int EA u0_x^2 dx (v0 = 0), exact for piecewise-linear u0.
   double energy(const core::Vector& x) const override;
@@ -184,8 +187,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // at b L, b = (1 + g0/(s L))/4, slope +-s, T = (1 + b) L / c; 'Mode J': J - 1 kinks on the
   // J - 1 free knots), sampled on the grid. Any mode >= 1.
   core::Vector contact_family_guess(int mode, double amplitude_ratio) const;
-  // The subharmonic member of family.hpp at this energy and shape in (0, 1], T = 2 T2; needs
-  // start_on_wall and K >= 2 free knots (its two kinks are the first two knots). InputError.
+  // The subharmonic member of family.hpp at this energy and shape in (0, 1], T = 2 T_J
+  // (J = options.subharmonic_mode); needs start_on_wall and K >= J free knots (its J kinks are
+  // the first J knots). InputError.
   core::Vector subharmonic_guess(double energy, double shape) const;
   // u0 at node i = 1..N (the wall position g0 at node N with start_on_wall).
   double node_value(const core::Vector& x, int i) const;

@@ -117,8 +117,12 @@ TEST(ContactFamily, ModeJReturnsToItsClosedFormAfterItsPeriod) {
           EXPECT_NEAR(std::abs(slope) / s, 1, 1e-11) << "mode " << mode << " segment " << k;
         }
         EXPECT_NEAR(u0(length), -(s * length - (mode - 1) * gap) / mode, 1e-14 * length);
-        if (mode == 1) EXPECT_NEAR(u0(0.5 * length), -s * 0.5 * length, 1e-15);
-        if (mode == 2) EXPECT_NEAR(u0.knots()[1], 0.25 * (1 + gap / (s * length)) * length, 1e-15);
+        if (mode == 1) {
+          EXPECT_NEAR(u0(0.5 * length), -s * 0.5 * length, 1e-15);
+        }
+        if (mode == 2) {
+          EXPECT_NEAR(u0.knots()[1], 0.25 * (1 + gap / (s * length)) * length, 1e-15);
+        }
         setup.u0 = u0;
         bar::SnapshotRequest r;
         r.elements = 200;

@@ -52,6 +52,48 @@ TEST(SubharmonicContinuum, ClosedFormMembersArePeriodic) {
     }
 }
 
+// The members of the even modes J = 4 and 6 (README.md, 'Subharmonic continuum of mode J'):
+// J kinks, period 2 T_J of family.hpp whatever the shape, and under the exact solver a return to
+// u0 and v0 = 0 after T (round-off: 1e-11 relative, the J = 2 bound of 1e-12 times the ~5x more
+// reflections a period of mode 6 holds; measured 1.2e-12 at worst), with the contact structure of
+// the closed form: two phases of 2 shape D and 2 (1 - shape) D inside, one phase and one grazing
+// instant at the limits (event times to 1e-12). Energies from just above the mode's grazing
+// energy EA ((2J - 1) g0)^2 / (2L) to 1e-3 J.
+TEST(SubharmonicContinuum, MembersOfModesFourAndSixArePeriodic) {
+  const bar::Material m;
+  for (int mode : {4, 6}) {
+    const ContactFamily family(m, 1e-3, mode);
+    for (double energy : {1.02 * family.grazing_energy(), 1e-4, 1e-3})
+      for (double shape : {0.0, 0.2, 0.5, 0.9, 1.0}) {
+        const SubharmonicMember member = subharmonic_member(m, 1e-3, energy, shape, mode);
+        ASSERT_EQ(member.kinks.size(), static_cast<std::size_t>(mode));
+        EXPECT_NEAR(member.period / (2 * family.period(energy)), 1, 1e-14);
+        const bar::BarSetup s = paper_setup(member.u0);
+        EXPECT_NEAR(s.u0(1.0), 1e-3, 1e-15) << "starts on the wall";
+        const exact_bar::ExactBarSolution sol(s, member.period);
+        ASSERT_TRUE(sol.ok());
+        double du = 0, dv = 0, u_max = 0;
+        for (int i = 0; i <= 400; ++i) {
+          const double x = i / 400.0;
+          u_max = std::max(u_max, std::abs(s.u0(x)));
+          du = std::max(du, std::abs(sol.u(x, member.period) - s.u0(x)));
+          dv = std::max(dv, std::abs(sol.v(x, member.period)));
+        }
+        EXPECT_LT(du / u_max, 1e-11) << mode << " " << energy << " " << shape;
+        EXPECT_LT(dv / u_max, 1e-11) << mode << " " << energy << " " << shape;
+        const ContactStructure c = contact_structure(s, member.period);
+        ASSERT_TRUE(c.ok);
+        const bool limit = shape == 0.0 || shape == 1.0;
+        EXPECT_EQ(c.contact_phases, limit ? 1 : 2) << mode << " " << shape;
+        EXPECT_EQ(c.grazing_instants, limit ? 1 : 0) << mode << " " << shape;
+        EXPECT_NEAR(c.first_contact, member.first_contact, 1e-12) << mode << " " << shape;
+      }
+  }
+  // Odd modes have no continuum over two periods, and no member below grazing.
+  EXPECT_THROW(subharmonic_member(m, 1e-3, 1e-3, 0.3, 3), core::InputError);
+  EXPECT_THROW(subharmonic_member(m, 1e-3, 2e-5, 0.3, 4), core::InputError);
+}
+
 // The contact structure (problems/contact_bar/orbits/README.md, 'Subharmonic continuum'): interior
 // members have two contact phases per period of the closed-form durations (the first one split
 // across t = 0 and t = T); at the limits one phase has shrunk to a grazing instant. Durations are
