@@ -18,9 +18,9 @@ void TraceSetup::apply_branch_options(ContinuationOptions& options,
   newton.validate();
 }
 
-bool ProblemPlugin::has_branch(const std::string& name) const {
-  return std::find(branches.begin(), branches.end(), name) != branches.end() ||
-         (branch_family && branch_family(name));
+bool ProblemPlugin::has_branch(const std::string& branch) const {
+  return std::find(branches.begin(), branches.end(), branch) != branches.end() ||
+         (branch_family && branch_family(branch));
 }
 
 std::string ProblemPlugin::branch_list() const {
