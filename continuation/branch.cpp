@@ -18,6 +18,8 @@ const char* to_string(StopReason r) {
       return "max_points";
     case StopReason::bound_reached:
       return "bound_reached";
+    case StopReason::boundary_reached:
+      return "boundary_reached";
     case StopReason::step_floor:
       return "step_floor";
     case StopReason::newton_failed:

@@ -75,6 +75,8 @@ struct BranchPoint {
 enum class StopReason {
   max_points,         // the requested number of points was reached
   bound_reached,      // an observable left its [min, max] window
+  boundary_reached,   // the corrections stalled at the boundary of the solution set
+                      // (ContinuationOptions::boundary)
   step_floor,         // Newton kept failing after shrinking ds to ds_min
   newton_failed,      // the very first point did not converge
   evaluation_failed,  // the residual returned NaN/Inf or failed where a point was needed
@@ -129,9 +131,10 @@ struct Branch {
   // run's rows below it stand; write_after_run merges them); -1 when the run did not resume.
   int branch_points_from = -1;
   // True when the branch ended for a reason other than reaching its planned end
-  // (max_points or a bound).
+  // (max_points, a bound, or the boundary of the solution set).
   bool ended_early() const {
-    return reason != StopReason::max_points && reason != StopReason::bound_reached;
+    return reason != StopReason::max_points && reason != StopReason::bound_reached &&
+           reason != StopReason::boundary_reached;
   }
 };
 

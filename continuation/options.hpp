@@ -28,6 +28,16 @@
 
 namespace backbone::continuation {
 
+// Where the solution set ends: an observable that falls to 0 at its boundary (a nonsmooth edge,
+// beyond which no solution exists or F cannot be evaluated). A branch that ends with step_floor
+// or evaluation_failed at a point where the observable is at most `within` has reached that
+// boundary: it ends with
+// StopReason::boundary_reached, a planned end. Empty observable: none.
+struct Boundary {
+  std::string observable;
+  double within = 0;
+};
+
 // natural_then_arclength: natural until it stalls, then pseudo-arclength (switching.hpp).
 enum class Method { natural, arclength, natural_then_arclength };
 enum class Predictor { secant, tangent, quadratic };
@@ -101,6 +111,7 @@ struct ContinuationOptions {
   bool scale_unknowns = true;
   std::vector<Bound> bounds;
   bool land_on_bounds = true;  // re-correct the crossing point onto the bound
+  Boundary boundary;
   // Rank report of the problem's Jacobian at every k-th point (and always at the first and
   // last); 0 disables it. verify: also step along the candidate null directions.
   int rank_check_every = 1;

@@ -143,6 +143,18 @@ void LoopSteps::add_branch_point(BranchPointReport report) {
 Branch LoopSteps::end(StopReason reason, std::string message) {
   branch_.reason = reason;
   branch_.message = std::move(message);
+  const Boundary& boundary = options_.boundary;
+  const bool stalled = reason == StopReason::step_floor || reason == StopReason::evaluation_failed;
+  if (stalled && !boundary.observable.empty() &&
+      !branch_.points.empty()) {
+    const double value = branch_.points.back().observable(boundary.observable);
+    if (value <= boundary.within) {
+      branch_.reason = StopReason::boundary_reached;
+      branch_.message = fmt::format("{} = {:.3g} at point {}: the boundary of the solution set ({})",
+                                    boundary.observable, value, branch_.points.back().index,
+                                    branch_.message);
+    }
+  }
   return take();
 }
 

@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <limits>
 #include <functional>
 #include <memory>
 
@@ -419,6 +420,13 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
 
   cli::TraceSetup s;
   if (options.amplitude_units) s.branch_options = amplitude_unit_options(scene);
+  // A followed family attached to the mode is a family of warps of the mode's u0, bounded by
+  // the warps whose slope vanishes on an interval (orbits/README.md, 'Attached families: the
+  // law'). A path that stalls there has reached the family's boundary: a planned end.
+  if (scene.text("follow") != "none")
+    s.branch_options = [](continuation::ContinuationOptions& o, core::NewtonOptions&) {
+      o.boundary = {"min_slope", 1e-3};
+    };
   s.guess = problem->contact_family_guess(mode, ratio);
   check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
   // Energy grows along the family: the direction of the contact family's own tangent.

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -225,11 +226,34 @@ double ContactBarOrbitProblem::subharmonic_shape(const Vector& x) const {
   return (1 - k2) / contact_fraction(j, k2 - k1);
 }
 
+double ContactBarOrbitProblem::min_slope(const Vector& x) const {
+  // Any x a continuation evaluates, knots out of order (no u0) included: NaN there.
+  const int n = options_.elements;
+  const Vector y = node_positions(x);
+  Vector coordinates(n + 1), values(n + 1);
+  coordinates[0] = values[0] = 0;
+  for (int i = 1; i <= n; ++i) {
+    coordinates[i] = y[i - 1];
+    values[i] = node_value(x, i);
+  }
+  const double length = setup_.material.length;
+  coordinates[n] = length;
+  const double s = std::sqrt(2 * energy(x) / (setup_.material.axial_stiffness() * length));
+  double smallest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 1; i < coordinates.size(); ++i) {
+    const double dx = coordinates[i] - coordinates[i - 1];
+    if (!(dx >= 0)) return std::nan("");
+    if (dx > 0) smallest = std::min(smallest, std::abs((values[i] - values[i - 1]) / dx));
+  }
+  return s > 0 ? smallest / s : std::nan("");
+}
+
 core::Observables ContactBarOrbitProblem::observables(const Vector& x) const {
   core::Observables o = PeriodicOrbitProblem::observables(x);
   if (options_.free_knots >= 2 && options_.start_on_wall)
     o.emplace_back("shape", subharmonic_shape(x));
   o.emplace_back("end_amplitude", std::abs(node_value(x, options_.elements)));
+  o.emplace_back("min_slope", min_slope(x));
   if (options_.free_knots == 1) o.emplace_back("knot", x[knot_index(0)]);
   if (options_.free_knots > 1)
     for (int j = 0; j < options_.free_knots; ++j)

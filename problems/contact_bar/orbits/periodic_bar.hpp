@@ -127,7 +127,12 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // them), so the written orbit is exactly the piecewise-linear u0 the residual simulated.
   void initial_state_samples(const core::Vector& x, core::Vector& coordinates,
                              core::Vector& values) const override;
-  // period, frequency, energy, end_amplitude (= |u0(L)|), plus knot (K = 1) or knot_1..knot_K,
+  // The smallest |u0'| over the segments of u0, over the rms slope s = sqrt(2E / (EA L)): 1 for
+  // the modes and the subharmonic members (slopes +-s), below 1 for the families attached to
+  // a mode, which end where it reaches 0 (README.md, 'Attached families: the law').
+  double min_slope(const core::Vector& x) const;
+  // period, frequency, energy, end_amplitude (= |u0(L)|), min_slope, plus knot (K = 1) or
+  // knot_1..knot_K,
   // and shape with K >= 2 on the wall (the subharmonic members). (The contact structure of a member
   // costs an exact simulation: subharmonic.hpp adds it to branch.csv after the trace, not per
   // observable call.)

@@ -575,6 +575,60 @@ TEST(Continuation, TheFirstPointIsVerifiedByTheSecond) {
 
 namespace {
 
+// The line y = x, whose solutions end at x = 1: beyond, F cannot be evaluated (the domain of a
+// problem that ends at a nonsmooth edge, as a family of warps does where a slope vanishes).
+// Observable room = 1 - x.
+class EndingLine : public core::Problem {
+ public:
+  int num_unknowns() const override { return 2; }
+  int num_equations() const override { return 1; }
+  core::Observables observables(const core::Vector& x) const override {
+    return {{"room", 1 - x[0]}};
+  }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    if (x[0] > 1) return core::EvalStatus::failed;
+    r.resize(1);
+    r[0] = x[1] - x[0];
+    return core::EvalStatus::ok;
+  }
+};
+
+}  // namespace
+
+// The branch stalls at the edge: the shrinking steps bring its last point within a few ds_min
+// (1e-8 scaled) of x = 1 before ds falls below ds_min, and the last attempt fails to evaluate.
+// With a boundary on `room` that admits it (1e-6), that is the planned end boundary_reached;
+// without one, or with one it does not reach (1e-12, below the stall's distance), it stays
+// evaluation_failed, an early end.
+TEST(Continuation, AStallAtTheBoundaryIsAPlannedEnd) {
+  EndingLine line;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(200);
+  opt.ds = opt.ds_max = 0.1;
+  opt.rank_check_every = 0;
+  const Branch plain = continuation::pseudo_arclength(line, vec(0, 0), vec(1, 1), *newton, opt);
+  EXPECT_EQ(plain.reason, continuation::StopReason::evaluation_failed);
+  EXPECT_TRUE(plain.ended_early());
+  const double room = 1 - plain.points.back().x[0];
+  EXPECT_LT(room, 1e-6);
+  EXPECT_GT(room, 1e-12);
+  opt.boundary = {"room", 1e-6};
+  const Branch ended = continuation::pseudo_arclength(line, vec(0, 0), vec(1, 1), *newton, opt);
+  EXPECT_EQ(ended.reason, continuation::StopReason::boundary_reached);
+  EXPECT_FALSE(ended.ended_early());
+  EXPECT_EQ(ended.points.size(), plain.points.size());
+  opt.boundary = {"room", 1e-12};
+  const Branch short_of =
+      continuation::pseudo_arclength(line, vec(0, 0), vec(1, 1), *newton, opt);
+  EXPECT_EQ(short_of.reason, continuation::StopReason::evaluation_failed);
+  opt.boundary = {"room", -1};
+  EXPECT_THROW(opt.validate(), core::InputError);
+}
+
+namespace {
+
 // The unit circle whose continuation norm counts both unknowns `weight` times (step_weights).
 class WeightedCircle : public core::Problem {
  public:

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <numeric>
 #include <string>
 
@@ -109,6 +111,44 @@ TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
     }
   }
   EXPECT_GE(checked, 2);
+}
+
+// A followed attached family ends at its boundary, and the run says so with exit 0. At 10
+// intervals the family attached at T = 16/5 (p = 5) has dimension ceil(10/5) - 1 = 1: warps
+// whose X - x is the one content sin(5 pi x) the grid holds, sampled at its nodes as 0, +-1,
+// so X' = 1 +- a on alternate pairs of intervals and E / E_pq = 1 + a^2. The family ends where
+// X' = 1 - a vanishes (orbits/README.md, 'Attached families: the law'): at E = 2 E_pq =
+// 2.5e-5 J, with min_slope 0 there. The path's last point stops within the boundary's 1e-3 of
+// it, so its energy is 2 E_pq to 1e-3 (measured: 2e-8), at a period held to 1e-9.
+TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
+  const std::string scene =
+      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
+  const auto out = cli::scratch("modes_cli", "family_boundary");
+  const cli::Run r = cli::run("trace",
+                              scene +
+                                  " --branch mode1 --shooting_elements 10 "
+                                  "--detect_branch_points true --follow all --energy_max 3e-5",
+                              out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Table points = Table::read_csv(out / "branch_points.csv");
+  const auto period = points.column("period"), verified = points.column("verified");
+  int followed = 0;
+  for (std::size_t i = 0; i < period.size(); ++i) {
+    if (verified[i] != 1) continue;
+    ASSERT_NEAR(period[i], 3.2, 1e-7);
+    const auto dir = out / ("branch_point_" + std::to_string(i + 1));
+    const Table b = Table::read_csv(dir / "branch.csv");
+    const auto energy = b.column("energy"), slope = b.column("min_slope");
+    const auto branch_period = b.column("period");
+    EXPECT_NEAR(energy.back() / 2.5e-5, 1, 1e-3);
+    EXPECT_LE(slope.back(), 1e-3);
+    for (double t : branch_period) EXPECT_NEAR(t / 3.2, 1, 1e-9);
+    std::ifstream in(dir / "summary.txt");
+    const std::string summary((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_NE(summary.find("stop_reason boundary_reached"), std::string::npos) << summary;
+    ++followed;
+  }
+  EXPECT_EQ(followed, 1);
 }
 
 }  // namespace
