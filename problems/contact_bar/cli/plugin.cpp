@@ -81,6 +81,14 @@ void register_plugin(cli::PluginRegistry& registry) {
        {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40", "--energy_max",
         "3e-5", "--follow", "all", "--follow_max_points", "100", "--out",
         "{out}/mode1_resonances"}},
+      // The family of resonance order 12 attached at T = 24/7 L/c (the paper's "about 12
+      // times", figures/README.md): 70 intervals resolve it (7 divides 140), and steps of 0.05
+      // sample the test function finely enough to locate it (the third candidate).
+      {"mode1_resonance_twelve",
+       "trace",
+       {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "70",
+        "--detect_branch_points", "true", "--ds", "0.05", "--ds_max", "0.05", "--energy_max",
+        "3e-5", "--follow", "3", "--out", "{out}/mode1_resonance_twelve"}},
       {"subharmonic",
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic", "--out", "{out}/subharmonic"}},

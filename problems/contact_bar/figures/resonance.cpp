@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <string>
 
 #include "core/io/plot.hpp"
@@ -21,6 +23,11 @@ namespace {
 // The main job's mode-1 trace with --follow (plugin.cpp, reproduce step mode1_resonances): at
 // 40 intervals, where the family attached at T = 3.2 L/c is resolved.
 constexpr const char* resonances_folder = "mode1_resonances";
+// The orbit the paper's "about 12 times" most likely describes (figures/README.md): the family
+// of resonance order q = 12 attached at T = 24/7 L/c, followed at 70 intervals (reproduce step
+// mode1_resonance_twelve). Figs. 10 and 11 are drawn from it when it is there.
+constexpr const char* twelve_folder = "mode1_resonance_twelve";
+constexpr double twelve_order = 12;
 
 std::vector<fs::path> followed_branches(const fs::path& mode1) {
   std::vector<fs::path> attached;
@@ -33,10 +40,44 @@ std::vector<fs::path> followed_branches(const fs::path& mode1) {
   return attached;
 }
 
+// The followed branches of the q = 12 family in OUT/mode1_resonance_twelve (the rows of its
+// branch_points.csv with resonance_order 12 to 1e-3), else those of OUT/mode1_resonances.
+std::vector<fs::path> figure_branches(const fs::path& out) {
+  const fs::path twelve = out / twelve_folder;
+  std::vector<fs::path> chosen;
+  if (fs::exists(twelve / "branch_points.csv")) {
+    const core::Table points = core::Table::read_csv(twelve / "branch_points.csv");
+    const auto order = points.column("resonance_order");
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const fs::path dir = twelve / fmt::format("branch_point_{}", i + 1);
+      if (std::abs(order[i] - twelve_order) < 1e-3 && fs::exists(dir / "branch.csv"))
+        chosen.push_back(dir);
+    }
+  }
+  return chosen.empty() ? followed_branches(out / resonances_folder) : chosen;
+}
+
+// The amplitude of harmonic k (k omega, omega = 2 pi / T) of u samples over one period (the
+// last sample closes the period and is left out), k = 1 .. kmax.
+std::vector<double> harmonics(const std::vector<double>& u, int kmax) {
+  const std::size_t n = u.size() - 1;
+  std::vector<double> a(static_cast<std::size_t>(kmax) + 1, 0.0);
+  for (int k = 1; k <= kmax; ++k) {
+    double re = 0, im = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const double phase = 2 * std::numbers::pi * k * static_cast<double>(j) / n;
+      re += u[j] * std::cos(phase);
+      im -= u[j] * std::sin(phase);
+    }
+    a[static_cast<std::size_t>(k)] = 2 * std::hypot(re, im) / static_cast<double>(n);
+  }
+  return a;
+}
+
 }  // namespace
 
 int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
-  const std::vector<fs::path> attached = followed_branches(out / resonances_folder);
+  const std::vector<fs::path> attached = figure_branches(out);
   if (attached.empty()) {
     fmt::print("[figures] resonant_end skipped: no followed branch in {} (trace --follow)\n",
                (out / resonances_folder).string());
@@ -48,8 +89,9 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
   const double L = s.material.length, c = s.material.wave_speed(), g0 = s.right.gap;
   std::string plot =
       "set grid\nset xlabel 't / T'\nset ylabel 'u(L,t) [m]'\nset key outside right\n";
-  std::string curves;
+  std::string curves, spectra;
   for (const fs::path& dir : attached) {
+    std::vector<double> attached_end;
     // The highest-energy orbit of the followed branch, and mode 1 at its period: the closed form
     // u0 = eps x with T = (3 L + g0 / |eps|) / c (problems/contact_bar/orbits/README.md, 'Mode 1').
     const auto orbit = load_traced_orbit(dir, 1e300, L);
@@ -66,7 +108,28 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
       s.v0 = bar::PiecewiseLinear::zero(L);
       const fs::path csv =
           out / fmt::format("resonant_end_{}_{}.csv", k, resonant ? "attached" : "mode1");
-      exact_bar::ExactBarSolver().simulate(s, o).to_table().write_csv(csv);
+      const bar::History h = exact_bar::ExactBarSolver().simulate(s, o);
+      h.to_table().write_csv(csv);
+      if (resonant) {
+        attached_end = h.u_contact;
+      } else if (attached_end.size() == h.u_contact.size()) {
+        // What the attached orbit adds at the end, u_attached(L, t) - u_mode1(L, t) (same
+        // period, same u0(L)), in harmonics of the orbit's own frequency: its content sits
+        // around the resonance order q (figures/README.md).
+        std::vector<double> added(h.u_contact.size());
+        for (std::size_t j = 0; j < added.size(); ++j) added[j] = attached_end[j] - h.u_contact[j];
+        const std::vector<double> a = harmonics(added, 40);
+        core::Table spectrum({"harmonic", "amplitude"});
+        for (int j = 1; j <= 40; ++j)
+          spectrum.add_row({static_cast<double>(j), a[static_cast<std::size_t>(j)]});
+        const fs::path spectrum_csv = out / fmt::format("resonant_end_{}_spectrum.csv", k);
+        spectrum.write_csv(spectrum_csv);
+        spectra += fmt::format(
+            "{}{} using 'harmonic':'amplitude' with impulses lw 4 title 'attached at branch "
+            "point {}, T = {:.6g} s'",
+            spectra.empty() ? "plot " : ", ", core::gnuplot_quote(spectrum_csv), k,
+            orbit->period);
+      }
       curves += fmt::format(
           "{}{} using (column('t')/{}):'u_contact' with lines lw {} title '{}'",
           curves.empty() ? "plot " : ", ", core::gnuplot_quote(csv), orbit->period,
@@ -84,11 +147,26 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
     fmt::print("[figures] wrote {}\n", png.string());
   else
     fmt::print(stderr, "[figures] {}\n", r.message);
+  if (spectra.empty()) return 0;
+  const fs::path spectrum_png = out / "resonant_end_spectrum.png";
+  const core::PlotResult rs = core::render_png(
+      spectrum_png,
+      "set title 'What the attached orbit adds at the contacting end, u_{attached}(L,t) - "
+      "u_{mode 1}(L,t): amplitude of each harmonic k {/Symbol w} = 2{/Symbol p}k/T (exact "
+      "oracle)'\nset xlabel 'harmonic k'\n"
+      "set ylabel 'amplitude [m]'\nset logscale y\nset format y '10^{%L}'\nset grid\n"
+      "set xrange [0:41]\nset key top right\n" +
+          spectra + "\n",
+      {1200, 600});
+  if (rs.ok)
+    fmt::print("[figures] wrote {}\n", spectrum_png.string());
+  else
+    fmt::print(stderr, "[figures] {}\n", rs.message);
   return 0;
 }
 
 int draw_resonant_spacetime(const fs::path& out, const fs::path& scene_path) {
-  const std::vector<fs::path> attached = followed_branches(out / resonances_folder);
+  const std::vector<fs::path> attached = figure_branches(out);
   if (attached.empty()) {
     fmt::print("[figures] resonant_spacetime skipped: no followed branch in {} (trace --follow)\n",
                (out / resonances_folder).string());
