@@ -361,6 +361,15 @@ c("trace_start_guess_bogus", "trace", ["{S}", "--start_guess", "random"] + SMALL
   "start_guess")
 c("trace_free_knots_negative", "trace", ["{S}", "--free_knots", "-2"] + SMALL, "free_knots")
 c("trace_free_knots_huge", "trace", ["{S}", "--free_knots", "1000"] + SMALL, "free_knots")
+c("trace_knot_nodes_text", "trace", ["{S}", "--branch", "mode2", "--knot_nodes", "abc"],
+  "knot_nodes")
+c("trace_knot_nodes_decreasing", "trace",
+  ["{S}", "--branch", "mode3", "--shooting_elements", "46", "--knot_nodes", "26 10"],
+  "knot_nodes")
+c("trace_knot_nodes_count", "trace", ["{S}", "--branch", "mode2", "--knot_nodes", "10 20"],
+  "knot_nodes")
+c("trace_knot_nodes_beyond", "trace", ["{S}", "--branch", "mode2", "--knot_nodes", "20"],
+  "knot_nodes")
 c("trace_energy_max_nan", "trace", ["{S}", "--branch", "mode1", "--energy_max", "nan"],
   "energy_max")
 c("trace_energy_max_negative", "trace", ["{S}", "--branch", "mode1", "--energy_max", "-1"],

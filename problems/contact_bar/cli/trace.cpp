@@ -133,6 +133,10 @@ po::options_description trace_keys() {
       ("free_knots", po::value<long>()->default_value(-1),
        "movable knots of the u0 grid, kept ordered: K >= 0, or -1 = auto (one per kink of the "
        "branch's exact u0: J - 1 for modeJ, 2 for the subharmonic branches)")                 //
+      ("knot_nodes", po::value<std::string>()->default_value(""),
+       "modes: the reference nodes of the free knots, increasing in 1..N-1, separated by spaces "
+       "or commas (empty: nearest the kinks at the start; mode 2: round(N / 3)); the grid is "
+       "mapped so that node knot_nodes[j] sits on knot j")  //
       ("energy_max", po::value<double>()->default_value(1e-2), "stop above this energy [J]")  //
       ("max_points", po::value<long>()->default_value(1000),
        "points on the branch, first included")  //
@@ -404,6 +408,33 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
           options.elements, setup.material.length,
           family.kinks(0.5 * setup.material.axial_stiffness() * setup.material.length * s0 * s0));
     }
+  }
+  if (const std::string nodes = scene.text("knot_nodes"); !nodes.empty()) {
+    options.knot_nodes.clear();
+    std::string token;
+    for (const char ch : nodes + " ") {
+      if (ch == ' ' || ch == ',') {
+        if (token.empty()) continue;
+        std::size_t used = 0;
+        long value = 0;
+        try {
+          value = std::stol(token, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != token.size() || value < 1 || value >= options.elements)
+          throw core::InputError("knot_nodes", fmt::format("'{}' is no node in 1..{}", token,
+                                                           options.elements - 1));
+        options.knot_nodes.push_back(static_cast<int>(value));
+        token.clear();
+      } else {
+        token += ch;
+      }
+    }
+    if (static_cast<int>(options.knot_nodes.size()) != options.free_knots)
+      throw core::InputError("knot_nodes", fmt::format("needs one node per free knot ({}; got {})",
+                                                       options.free_knots,
+                                                       options.knot_nodes.size()));
   }
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements = static_cast<int>(

@@ -151,4 +151,53 @@ TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
   EXPECT_EQ(followed, 1);
 }
 
+// The law on modes 2 and 3 (orbits/README.md, 'Attached families: the law'): mode J's branch
+// points lie at T = 2q/p with strain s = g0 p / (2 J^2 q - (2J + 1) p) and kinks at multiples
+// of L/p; a grid of N intervals with p | 2N whose knots' reference nodes sit on the kinks
+// there (uniform at the branch point) verifies the family, of dimension ceil(N/p) - 1. Mode 2
+// at T = 9/7 (p = 14, q = 9: s = 7 g0, crest at 2/7 L) on 35 intervals, knot node 10;
+// mode 3 at T = 18/23 (p = 23, q = 9: s = 23 g0, kinks at 5/23 and 13/23) on 46, nodes 10
+// and 26. Located to the location's 1e-8 of T (1e-7 here), energy EA L s^2 / 2 to 1e-6.
+TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
+  const std::string scene =
+      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
+  struct Case {
+    const char* branch;
+    int elements;
+    const char* knots;
+    const char* energy_max;
+    int mode, p, q;
+  };
+  for (const Case& c : {Case{"mode2", 35, "10", "4e-5", 2, 14, 9},
+                        Case{"mode3", 46, "10,26", "4e-4", 3, 23, 9}}) {
+    const auto out = cli::scratch("modes_cli", std::string("law_") + c.branch);
+    const cli::Run r = cli::run(
+        "trace",
+        scene + " --branch " + c.branch + " --shooting_elements " +
+            std::to_string(c.elements) + " --knot_nodes " + c.knots +
+            " --detect_branch_points true --amplitude_units false --ds 0.05 --ds_max 0.05 "
+            "--energy_max " + c.energy_max + " --follow all",
+        out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const Table points = Table::read_csv(out / "branch_points.csv");
+    const auto period = points.column("period"), energy = points.column("energy");
+    const auto verified = points.column("verified"), dimension = points.column("dimension");
+    const double t = 2.0 * c.q / c.p, g0 = 1e-3;
+    const double s = g0 * c.p / (2.0 * c.mode * c.mode * c.q - (2.0 * c.mode + 1) * c.p);
+    int found = 0;
+    for (std::size_t i = 0; i < period.size(); ++i) {
+      if (verified[i] != 1) continue;
+      EXPECT_NEAR(period[i], t, 1e-7) << c.branch;
+      EXPECT_NEAR(energy[i] / (0.5 * s * s), 1, 1e-6) << c.branch;
+      EXPECT_EQ(dimension[i], (c.elements + c.p - 1) / c.p - 1) << c.branch;
+      const Table followed =
+          Table::read_csv(out / ("branch_point_" + std::to_string(i + 1)) / "branch.csv");
+      for (double tf : followed.column("period")) EXPECT_NEAR(tf / t, 1, 1e-9) << c.branch;
+      EXPECT_GE(followed.rows(), 2u);
+      ++found;
+    }
+    EXPECT_EQ(found, 1) << c.branch;
+  }
+}
+
 }  // namespace
