@@ -126,18 +126,36 @@ std::vector<FollowedBranch> follow_branch_points(
       std::filesystem::create_directories(dir);
       f = follow_attached(problem, report, run.observable, corrector, o, hooks);
     } else {
-      // A start whose branch ends early is retried from the next fastest probe (the files are
-      // rewritten: they hold the last attempt).
-      for (int attempt = 0; attempt < std::max(1, run.start_attempts); ++attempt) {
-        if (attempt > 0 && !attached_start(problem, report, run.observable, attempt)) break;
+      // A start whose branch ends early, or at the family's boundary (a face of a family of
+      // several dimensions, where another start may reach the budget), is retried from the next
+      // fastest probe. The files hold the last attempt, or the first that ended at the
+      // boundary when every later one ended early (followed again: the same bits).
+      auto attempt_from = [&](int attempt) {
         BranchWriter writer(dir, periodic);
         ContinuationHooks h = hooks;
         h.on_point = [&](const BranchPoint& p) { writer.append(p); };
         h.on_branch_point = nullptr;
         h.on_attempt = nullptr;
-        f = follow_attached(problem, report, run.observable, corrector, o, h, attempt);
-        f.attempts = attempt + 1;
-        if (!f.branch.ended_early() || (h.cancel_requested && h.cancel_requested())) break;
+        FollowedBranch g = follow_attached(problem, report, run.observable, corrector, o, h, attempt);
+        g.attempts = attempt + 1;
+        return g;
+      };
+      int at_boundary = -1, attempts = 0;
+      for (int attempt = 0; attempt < std::max(1, run.start_attempts); ++attempt) {
+        if (attempt > 0 && !attached_start(problem, report, run.observable, attempt)) break;
+        f = attempt_from(attempt);
+        attempts = attempt + 1;
+        if (hooks.cancel_requested && hooks.cancel_requested()) break;
+        if (f.branch.reason == StopReason::boundary_reached) {
+          if (at_boundary < 0) at_boundary = attempt;
+          continue;
+        }
+        if (!f.branch.ended_early()) break;
+      }
+      if (f.branch.ended_early() && at_boundary >= 0 &&
+          !(hooks.cancel_requested && hooks.cancel_requested())) {
+        f = attempt_from(at_boundary);
+        f.attempts = attempts;
       }
     }
     f.branch_point = k;
