@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
+#include <map>
+#include <fstream>
 #include <string>
 
 #include "core/io/plot.hpp"
@@ -28,6 +31,9 @@ constexpr const char* resonances_folder = "mode1_resonances";
 // mode1_resonance_twelve). Figs. 10 and 11 are drawn from it when it is there.
 constexpr const char* twelve_folder = "mode1_resonance_twelve";
 constexpr double twelve_order = 12;
+// Mode 1 with branch-point detection on fine steps (reproduce step mode1_law): the located
+// candidates against the law (mode1_law.csv).
+constexpr const char* law_folder = "mode1_law";
 
 std::vector<fs::path> followed_branches(const fs::path& mode1) {
   std::vector<fs::path> attached;
@@ -259,6 +265,91 @@ int draw_attached_branches(const fs::path& out) {
   return 0;
 }
 
+int write_law_table(const fs::path& out) {
+  const fs::path dir = out / law_folder;
+  if (!fs::exists(dir / "branch_points.csv") || !fs::exists(dir / "scene.ini")) {
+    fmt::print("[figures] mode1_law skipped: no {}\n", (dir / "branch_points.csv").string());
+    return 0;
+  }
+  // The run's resolved scene: its bar, and the grid and energy bound the step set.
+  std::map<std::string, std::string> run;
+  {
+    std::ifstream in(dir / "scene.ini");
+    for (std::string line; std::getline(in, line);) {
+      const auto eq = line.find(" = ");
+      if (line.empty() || line[0] == '#' || eq == std::string::npos) continue;
+      run[line.substr(0, eq)] = line.substr(eq + 3);
+    }
+  }
+  double L = 0, c = 0, g0 = 0, ea = 0, e_max = 0, offset = 0.05;
+  int n = 0;
+  try {
+    L = std::stod(run.at("length"));
+    c = std::sqrt(std::stod(run.at("youngs_modulus")) / std::stod(run.at("density")));
+    g0 = std::stod(run.at("gap"));
+    ea = std::stod(run.at("youngs_modulus")) * std::stod(run.at("area"));
+    n = std::stoi(run.at("shooting_elements"));
+    e_max = std::stod(run.at("energy_max"));
+    if (run.count("start_offset")) offset = std::stod(run.at("start_offset"));
+  } catch (const std::exception&) {
+    fmt::print(stderr, "[figures] mode1_law: {} lacks length, youngs_modulus, density, gap, "
+                       "area, shooting_elements or energy_max\n",
+               (dir / "scene.ini").string());
+    return 1;
+  }
+  const double e_min = ea * std::pow((1 + offset) * g0, 2) / (2 * L);  // the branch's start
+  const core::Table points = core::Table::read_csv(dir / "branch_points.csv");
+  const auto period = points.column("period"), energy = points.column("energy");
+  const auto verified = points.column("verified"), dimension = points.column("dimension");
+  // Every p/q of the law whose family this grid holds (p | 2N, 2N/p >= 3), T in (3, 4) L/c,
+  // between the branch's first energy and energy_max (orbits/README.md, 'Attached families:
+  // the law'), against the candidate located within 1e-4 L/c of it.
+  core::Table table({"p", "q", "period_law", "energy_law", "dimension_law", "period_found",
+                     "energy_found", "verified", "dimension_found", "period_error",
+                     "energy_error"});
+  double worst_period = 0, worst_energy = 0;
+  int predicted = 0, found = 0;
+  std::vector<bool> matched(period.size(), false);
+  for (int p = 1; 2 * n / p >= 3; ++p) {
+    if ((2 * n) % p != 0) continue;
+    for (int q = (3 * p) / 2 + 1; 2 * q < 4 * p; ++q) {
+      if (std::gcd(p, q) != 1) continue;
+      const double t = 2.0 * q / p * L / c, k = 2.0 * q - 3.0 * p;
+      const double e = ea * p * p * g0 * g0 / (2 * L * k * k);
+      if (e < e_min || e > e_max) continue;
+      ++predicted;
+      const double nan = std::nan("");
+      std::vector<double> row{static_cast<double>(p), static_cast<double>(q), t, e,
+                              std::ceil(static_cast<double>(n) / p) - 1, nan, nan, 0, nan, nan,
+                              nan};
+      for (std::size_t i = 0; i < period.size(); ++i)
+        if (std::abs(period[i] - t) < 1e-4 * L / c) {
+          matched[i] = true;
+          row[5] = period[i];
+          row[6] = energy[i];
+          row[7] = verified[i];
+          row[8] = dimension[i];
+          row[9] = std::abs(period[i] / t - 1);
+          row[10] = std::abs(energy[i] / e - 1);
+          if (verified[i] == 1) {
+            ++found;
+            worst_period = std::max(worst_period, row[9]);
+            worst_energy = std::max(worst_energy, row[10]);
+          }
+        }
+      table.add_row(row);
+    }
+  }
+  table.write_csv(out / "mode1_law.csv");
+  const auto off_law = std::count(matched.begin(), matched.end(), false);
+  fmt::print(
+      "[figures] mode1_law.csv: {} families of the law on {} intervals between {:.3g} and {:.3g} "
+      "J, {} located and verified (worst relative difference: period {:.1e}, energy {:.1e}), "
+      "{} candidates off the law\n",
+      predicted, n, e_min, e_max, found, worst_period, worst_energy, off_law);
+  return 0;
+}
+
 std::vector<cli::ProblemJob> resonance_figure_jobs() {
   return {{"attached_branches",
            "attached_branches.png: mode 1 with its followed attached branches (Fig. 4 d)",
@@ -268,6 +359,10 @@ std::vector<cli::ProblemJob> resonance_figure_jobs() {
            [](const fs::path& out) {
              return draw_resonant_spacetime(out, "problems/contact_bar/scenes/paper.ini");
            }},
+          {"mode1_law",
+           "mode1_law.csv: the families the law of the attached periods predicts on mode 1 "
+           "against those located and verified (OUT/mode1_law)",
+           write_law_table},
           {"resonant_end",
            "resonant_end.png: contacting end of an attached orbit beside mode 1 at its period "
            "(Fig. 11)",
