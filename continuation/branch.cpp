@@ -132,7 +132,8 @@ core::Table branch_point_table(const Branch& branch, const core::Observables& te
   columns.push_back("dimension");
   columns.insert(columns.end(), described.begin(), described.end());
   for (const char* c :
-       {"tangent_angle", "verified", "nullity", "after_point", "arclength", "test_value",
+       {"tangent_angle", "verified", "nullity", "candidates", "probed", "after_point",
+        "arclength", "test_value",
         "sign_change", "location_steps", "jacobian_evaluations", "residual_evaluations"})
     columns.push_back(c);
   core::Table table(columns);
@@ -146,6 +147,7 @@ core::Table branch_point_table(const Branch& branch, const core::Observables& te
     row.insert(
         row.end(),
         {r.tangent_angle, r.verified() ? 1.0 : 0.0, static_cast<double>(r.nullity),
+         static_cast<double>(r.candidates), static_cast<double>(r.probed),
          static_cast<double>(r.after_point), r.arclength, r.test_value, r.sign_change ? 1.0 : 0.0,
          static_cast<double>(r.location_steps), static_cast<double>(r.jacobian_evaluations),
          static_cast<double>(r.residual_evaluations)});

@@ -107,6 +107,9 @@ struct BranchPointReport {
   // options.branch_points.max_probes probed): the dimension of the attached family at this
   // resolution; verified_dimension = 1 + attached_dimension (the traced tangent counted).
   int attached_dimension = 0;
+  // Candidate directions beyond the tangent, and how many were probed (at most
+  // BranchPointOptions::max_probes): with fewer probed, attached_dimension is a lower bound.
+  int candidates = 0, probed = 0;
   int verified_dimension = -1;
   // Angle [degrees] between the traced tangent and the closest secant to a probed point of the
   // attached family (90: it leaves at right angles); NaN when none was found.

@@ -51,7 +51,9 @@ void Locator::verify(BranchPointReport& report, const core::Vector& z, const cor
   double smallest = std::numeric_limits<double>::infinity();
   int attached = 0;
   Probing probing(z.size());
-  for (int i = 0; i < std::min(candidates, options_.branch_points.max_probes); ++i) {
+  report.candidates = candidates;
+  report.probed = std::min(candidates, options_.branch_points.max_probes);
+  for (int i = 0; i < report.probed; ++i) {
     const core::Vector d = directions.col(i);
     const core::Vector stepped = z + h * d;
     core::Vector y;

@@ -56,6 +56,9 @@ std::string branch_point_line(const BranchPointReport& r) {
   std::string verdict = r.verified() ? fmt::format("verified, attached dimension {} (nullity {})",
                                                    r.attached_dimension, r.nullity)
                                      : fmt::format("not verified (nullity {})", r.nullity);
+  if (r.probed < r.candidates)
+    verdict += fmt::format(" [a lower bound: {} of {} candidate directions probed, max_probes]",
+                           r.probed, r.candidates);
   if (r.verified())
     for (const auto& [key, value] : r.attached_description)
       verdict += fmt::format(" {} {:.6g}", key, value);

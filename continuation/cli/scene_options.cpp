@@ -86,6 +86,10 @@ po::options_description continuation_keys(const po::options_description& problem
       "DIR/period_doubling_K/");
   add("follow_max_points", po::value<long>()->default_value(30),
       "points of each followed branch (>= 1; with the energy bound)");
+  add("max_probes", po::value<long>()->default_value(24),
+      "branch points: candidate directions probed at a located point (1 to 10000); with more "
+      "candidates the attached dimension is a lower bound (branch_points.csv: candidates, "
+      "probed)");
   add("max_turn_degrees", po::value<double>()->default_value(20),
       "arclength: refuse a correction whose step turns by more than this many degrees (>= 0) "
       "from the predictor direction (it landed on another family); 0: off");
@@ -184,6 +188,7 @@ RunSettings read_run_settings(const core::Scene& scene) {
                 : o.branch_points.detect ? Predictor::tangent
                                          : Predictor::quadratic;
   o.branch_points.max_turn_degrees = scene.non_negative("max_turn_degrees");
+  o.branch_points.max_probes = static_cast<int>(scene.integer("max_probes", 1, 10000));
   o.branch_points.background = scene.flag("locate_in_background");
   read_bounds(scene, o);
   o.validate();
