@@ -200,4 +200,36 @@ TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
   }
 }
 
+// The attached dimension is counted by probing each candidate direction, at most max_probes of
+// them. At 200 intervals the family at T = 7/2 (p = 4) has dimension ceil(200/4) - 1 = 49 by the
+// law: the default 24 probes give a lower bound the row says is one (probed < candidates), 60
+// probes give the law's number.
+TEST(ModesCli, TheAttachedDimensionReachesTheLawWithEnoughProbes) {
+  const std::string scene =
+      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
+  for (const int probes : {24, 60}) {
+    const auto out = cli::scratch("modes_cli", "probes_" + std::to_string(probes));
+    const cli::Run r = cli::run("trace",
+                                scene +
+                                    " --branch mode1 --shooting_elements 200 "
+                                    "--detect_branch_points true --energy_max 2.5e-6 "
+                                    "--max_probes " +
+                                    std::to_string(probes),
+                                out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const Table points = Table::read_csv(out / "branch_points.csv");
+    const auto period = points.column("period"), dimension = points.column("dimension");
+    const auto candidates = points.column("candidates"), probed = points.column("probed");
+    int found = 0;
+    for (std::size_t i = 0; i < period.size(); ++i) {
+      if (std::abs(period[i] - 3.5) > 1e-7) continue;
+      ++found;
+      EXPECT_EQ(candidates[i], 49);
+      EXPECT_EQ(probed[i], std::min(49, probes));
+      EXPECT_EQ(dimension[i], std::min(49, probes));
+    }
+    EXPECT_EQ(found, 1) << probes;
+  }
+}
+
 }  // namespace
