@@ -45,6 +45,12 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
     args.push_back("{out}/stability/" + branch + "_" + run);
     steps.push_back({"stability_" + branch + "_" + run, "trace", std::move(args)});
   }
+  // The family attached to mode 1 at T = 3.2 L/c, followed with its multipliers.
+  steps.push_back({"stability_mode1_resonances_N40",
+                   "trace",
+                   {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40",
+                    "--energy_max", "3e-5", "--follow", "all", "--stability", "true", "--threads",
+                    "2", "--out", "{out}/stability/mode1_resonances_N40"}});
   return steps;
 }
 

@@ -59,9 +59,16 @@ int write_stability_summary(const fs::path& out) {
   const fs::path folder = out / "stability";
   std::vector<fs::path> runs;
   if (fs::exists(folder))
-    for (const auto& entry : fs::directory_iterator(folder))
+    for (const auto& entry : fs::directory_iterator(folder)) {
       if (fs::exists(entry.path() / "branch.csv") && fs::exists(entry.path() / "multipliers.csv"))
         runs.push_back(entry.path());
+      // The families a run followed (--follow): branch_point_K/ with their own multipliers.
+      if (entry.is_directory())
+        for (const auto& sub : fs::directory_iterator(entry.path()))
+          if (sub.path().filename().string().rfind("branch_point_", 0) == 0 &&
+              fs::exists(sub.path() / "multipliers.csv"))
+            runs.push_back(sub.path());
+    }
   if (runs.empty()) {
     fmt::print("[figures] stability_summary skipped: no trace with --stability true in {}\n",
                folder.string());
@@ -91,9 +98,13 @@ int write_stability_summary(const fs::path& out) {
       if (im[i] == 0 && re[i] < 0) negative.push_back(modulus[i]);
       if (im[i] != 0) complex.push_back(modulus[i]);
     }
-    const std::string name = run.filename().string();
-    const std::string elements = scene_value(run / "scene.ini", "shooting_elements");
-    const std::string courant = scene_value(run / "scene.ini", "stability_courant");
+    const bool followed = run.filename().string().rfind("branch_point_", 0) == 0;
+    const fs::path scene_dir = followed ? run.parent_path() : run;
+    const std::string name = followed ? scene_dir.filename().string() + "/" +
+                                            run.filename().string()
+                                      : run.filename().string();
+    const std::string elements = scene_value(scene_dir / "scene.ini", "shooting_elements");
+    const std::string courant = scene_value(scene_dir / "scene.ini", "stability_courant");
     summary.add_cells({name, name.substr(0, name.find('_')),
                        elements.empty() ? std::nan("") : std::stod(elements),
                        courant.empty() ? std::nan("") : std::stod(courant), double(stable.size()),
