@@ -135,6 +135,13 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
   if (!(period > 0) || !std::isfinite(period)) return EvalStatus::failed;
   const std::vector<double> nodes = full_state_nodes(problem, x, options.elements);
   const int n = static_cast<int>(nodes.size()) - 1;
+  // Bounded cost: the time step follows the shortest interval (c dt <= courant dx), so a grid
+  // with an interval under 1/64 of the uniform one (a free knot a hair from the end, as the
+  // subharmonic members next to their grazing limit) would take over 64 times the steps and
+  // the memory of the simulations: refused before any of them, the point's stability undecided.
+  double shortest = problem.setup_template().material.length;
+  for (std::size_t i = 1; i < nodes.size(); ++i) shortest = std::min(shortest, nodes[i] - nodes[i - 1]);
+  if (!(shortest * 64 * n >= problem.setup_template().material.length)) return EvalStatus::failed;
   const Vector base = full_state(problem, x, nodes);
   const bar::Material& material = problem.setup_template().material;
   const double u_scale = std::max(base.head(n).cwiseAbs().maxCoeff(), problem.displacement_scale());

@@ -70,7 +70,8 @@ core::EvalStatus full_state_map(const ContactBarOrbitProblem& problem,
                                 const std::vector<double>& nodes, double period, double dt,
                                 const core::Vector& state, core::Vector& mapped);
 
-// M at the orbit x (2N x 2N).
+// M at the orbit x (2N x 2N). EvalStatus failed, before any simulation, when the node grid has
+// an interval under L / (64 N): the time step follows it, and the cost with it.
 core::EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const core::Vector& x,
                                       const MonodromyOptions& options, core::Matrix& M);
 

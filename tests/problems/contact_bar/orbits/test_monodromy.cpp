@@ -83,6 +83,31 @@ TEST(ContactBarMonodromy, ModeOnesMultipliersLieOnTheUnitCircleWithTheTrivialPai
   }
 }
 
+// The cost is bounded before any simulation: a subharmonic member a hair from its grazing limit
+// (shape 1e-7: its last knot 1e-7 D L from the end, an interval far under L / (64 N)) is refused
+// at once, where its time step (c dt <= dx / 32) would take some 1e8 steps per simulation. The
+// member at shape 0.3 on the same chart has its monodromy.
+TEST(ContactBarMonodromy, AGridWithAHairlineIntervalIsRefusedBeforeAnySimulation) {
+  const bar::BarSetup setup = test_support::paper_setup();
+  const contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
+  contact_bar::OrbitOptions o;
+  o.elements = 20;
+  o.free_knots = 2;
+  o.start_on_wall = true;
+  const double energy = 1e-3;
+  const contact_bar::SubharmonicMember member =
+      contact_bar::subharmonic_member(setup.material, setup.right.gap, energy, 0.3);
+  o.knot_nodes = contact_bar::nearest_knot_nodes(o.elements, 1.0, {member.kinks[0]});
+  o.knot_nodes.push_back(o.elements - 1);
+  const contact_bar::ContactBarOrbitProblem orbit(setup, tdbem, o);
+  contact_bar::MonodromyOptions mo;
+  core::Matrix M;
+  EXPECT_EQ(contact_bar::full_state_monodromy(orbit, orbit.subharmonic_guess(energy, 1e-7), mo, M),
+            core::EvalStatus::failed);
+  EXPECT_EQ(contact_bar::full_state_monodromy(orbit, orbit.subharmonic_guess(energy, 0.3), mo, M),
+            core::EvalStatus::ok);
+}
+
 // A snapshot on a given node grid (SnapshotRequest::nodes) is the uniform one when the grid is
 // uniform, for both solvers that take one; on a graded grid the projections of v still sum to
 // int_0^L v dx (the hats are a partition of unity), the same number on every grid.
