@@ -131,10 +131,9 @@ core::Table branch_point_table(const Branch& branch, const core::Observables& te
   std::vector<std::string> columns = observables;
   columns.push_back("dimension");
   columns.insert(columns.end(), described.begin(), described.end());
-  for (const char* c :
-       {"tangent_angle", "verified", "nullity", "candidates", "probed", "after_point",
-        "arclength", "test_value",
-        "sign_change", "location_steps", "jacobian_evaluations", "residual_evaluations"})
+  for (const char* c : {"tangent_angle", "verified", "nullity", "candidates", "probed",
+                        "after_point", "arclength", "test_value", "sign_change", "location_steps",
+                        "jacobian_evaluations", "residual_evaluations"})
     columns.push_back(c);
   core::Table table(columns);
   for (const BranchPointReport& r : branch.branch_points) {

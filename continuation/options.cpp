@@ -49,8 +49,8 @@ void require_positive(const char* key, double v) {
 
 void ContinuationOptions::validate() const {
   if (!boundary.observable.empty() && !(boundary.within >= 0 && std::isfinite(boundary.within)))
-    throw core::InputError("boundary", fmt::format("within must be finite and >= 0 (got {})",
-                                                   boundary.within));
+    throw core::InputError("boundary",
+                           fmt::format("within must be finite and >= 0 (got {})", boundary.within));
   require_positive("ds", ds);
   require_positive("ds_min", ds_min);
   require_positive("ds_max", ds_max);

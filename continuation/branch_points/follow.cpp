@@ -136,7 +136,8 @@ std::vector<FollowedBranch> follow_branch_points(
         h.on_point = [&](const BranchPoint& p) { writer.append(p); };
         h.on_branch_point = nullptr;
         h.on_attempt = nullptr;
-        FollowedBranch g = follow_attached(problem, report, run.observable, corrector, o, h, attempt);
+        FollowedBranch g =
+            follow_attached(problem, report, run.observable, corrector, o, h, attempt);
         g.attempts = attempt + 1;
         return g;
       };

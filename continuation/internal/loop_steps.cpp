@@ -145,14 +145,13 @@ Branch LoopSteps::end(StopReason reason, std::string message) {
   branch_.message = std::move(message);
   const Boundary& boundary = options_.boundary;
   const bool stalled = reason == StopReason::step_floor || reason == StopReason::evaluation_failed;
-  if (stalled && !boundary.observable.empty() &&
-      !branch_.points.empty()) {
+  if (stalled && !boundary.observable.empty() && !branch_.points.empty()) {
     const double value = branch_.points.back().observable(boundary.observable);
     if (value <= boundary.within) {
       branch_.reason = StopReason::boundary_reached;
-      branch_.message = fmt::format("{} = {:.3g} at point {}: the boundary of the solution set ({})",
-                                    boundary.observable, value, branch_.points.back().index,
-                                    branch_.message);
+      branch_.message =
+          fmt::format("{} = {:.3g} at point {}: the boundary of the solution set ({})",
+                      boundary.observable, value, branch_.points.back().index, branch_.message);
     }
   }
   return take();
@@ -271,8 +270,8 @@ bool LoopSteps::land(const Bound& bound, double value,
   }
   if (!landed) return false;
   const double chord = (z - x).norm();
-  BranchPoint landed_point = recorder_.finish(z, index, s.iterations, chord,
-                                              arclength_at_x + chord, true, core::Vector(z - x), &x);
+  BranchPoint landed_point = recorder_.finish(z, index, s.iterations, chord, arclength_at_x + chord,
+                                              true, core::Vector(z - x), &x);
   flush_first(&z);
   push(std::move(landed_point));
   branch_.reason = StopReason::bound_reached;

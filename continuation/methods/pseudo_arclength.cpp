@@ -330,8 +330,7 @@ bool ArclengthLoop::land_ahead(const Prediction& p) {
 
 core::Vector ArclengthLoop::predicted_at(const Prediction& p, double ds) const {
   core::Vector predicted = s_.x + ds * p.direction;
-  if (p.bend.size() > 0 && 0.5 * ds * p.bend.norm() <= 0.25)
-    predicted += 0.5 * ds * ds * p.bend;
+  if (p.bend.size() > 0 && 0.5 * ds * p.bend.norm() <= 0.25) predicted += 0.5 * ds * ds * p.bend;
   return predicted;
 }
 

@@ -21,8 +21,8 @@
 #include <unistd.h>
 
 #include <cmath>
-#include <limits>
 #include <functional>
+#include <limits>
 #include <memory>
 
 #include "core/errors.hpp"
@@ -132,11 +132,11 @@ po::options_description trace_keys() {
        "first orbit: end amplitude (1 + start_offset) * gap, just inside contact")  //
       ("free_knots", po::value<long>()->default_value(-1),
        "movable knots of the u0 grid, kept ordered: K >= 0, or -1 = auto (one per kink of the "
-       "branch's exact u0: J - 1 for modeJ, 2 for the subharmonic branches)")                 //
+       "branch's exact u0: J - 1 for modeJ, 2 for the subharmonic branches)")  //
       ("knot_nodes", po::value<std::string>()->default_value(""),
        "modes: the reference nodes of the free knots, increasing in 1..N-1, separated by spaces "
        "or commas (empty: nearest the kinks at the start; mode 2: round(N / 3)); the grid is "
-       "mapped so that node knot_nodes[j] sits on knot j")  //
+       "mapped so that node knot_nodes[j] sits on knot j")                                    //
       ("energy_max", po::value<double>()->default_value(1e-2), "stop above this energy [J]")  //
       ("max_points", po::value<long>()->default_value(1000),
        "points on the branch, first included")  //
@@ -423,8 +423,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
           used = 0;
         }
         if (used != token.size() || value < 1 || value >= options.elements)
-          throw core::InputError("knot_nodes", fmt::format("'{}' is no node in 1..{}", token,
-                                                           options.elements - 1));
+          throw core::InputError(
+              "knot_nodes", fmt::format("'{}' is no node in 1..{}", token, options.elements - 1));
         options.knot_nodes.push_back(static_cast<int>(value));
         token.clear();
       } else {
@@ -432,9 +432,9 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
       }
     }
     if (static_cast<int>(options.knot_nodes.size()) != options.free_knots)
-      throw core::InputError("knot_nodes", fmt::format("needs one node per free knot ({}; got {})",
-                                                       options.free_knots,
-                                                       options.knot_nodes.size()));
+      throw core::InputError(
+          "knot_nodes", fmt::format("needs one node per free knot ({}; got {})", options.free_knots,
+                                    options.knot_nodes.size()));
   }
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements = static_cast<int>(
@@ -477,7 +477,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
 //  - ds = ds_max = 1/40 of the closed-form path length in the scaled step norm, so every
 //    energy has about 40 members (the path grows like sqrt(E) / g0 in that norm), unless the
 //    scene gives ds or ds_max;
-//  - a window on the shape from shape_end = 1e-6 L / (D L) (D L = (1 - 3b) L for mode 2) to 1 (to 1 - shape_end when
+//  - a window on the shape from shape_end = 1e-6 L / (D L) (D L = (1 - 3b) L for mode 2) to 1 (to 1
+//  - shape_end when
 //    the branch goes up from a first member below 1/2): the shape-0 limit has
 //    its second kink at x = L, where the two-knot chart degenerates (the forward-difference
 //    step of the last knot, 1.5e-8 L, crosses L once L - k2 is smaller), so the branch lands

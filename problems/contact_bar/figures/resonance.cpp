@@ -4,10 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <map>
 #include <numbers>
 #include <numeric>
-#include <map>
-#include <fstream>
 #include <string>
 
 #include "core/io/plot.hpp"
@@ -133,8 +133,7 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
         spectra += fmt::format(
             "{}{} using 'harmonic':'amplitude' with impulses lw 4 title 'attached at branch "
             "point {}, T = {:.6g} s'",
-            spectra.empty() ? "plot " : ", ", core::gnuplot_quote(spectrum_csv), k,
-            orbit->period);
+            spectra.empty() ? "plot " : ", ", core::gnuplot_quote(spectrum_csv), k, orbit->period);
       }
       curves += fmt::format(
           "{}{} using (column('t')/{}):'u_contact' with lines lw {} title '{}'",
@@ -292,8 +291,9 @@ int write_law_table(const fs::path& out) {
     e_max = std::stod(run.at("energy_max"));
     if (run.count("start_offset")) offset = std::stod(run.at("start_offset"));
   } catch (const std::exception&) {
-    fmt::print(stderr, "[figures] mode1_law: {} lacks length, youngs_modulus, density, gap, "
-                       "area, shooting_elements or energy_max\n",
+    fmt::print(stderr,
+               "[figures] mode1_law: {} lacks length, youngs_modulus, density, gap, "
+               "area, shooting_elements or energy_max\n",
                (dir / "scene.ini").string());
     return 1;
   }
@@ -319,8 +319,16 @@ int write_law_table(const fs::path& out) {
       if (e < e_min || e > e_max) continue;
       ++predicted;
       const double nan = std::nan("");
-      std::vector<double> row{static_cast<double>(p), static_cast<double>(q), t, e,
-                              std::ceil(static_cast<double>(n) / p) - 1, nan, nan, 0, nan, nan,
+      std::vector<double> row{static_cast<double>(p),
+                              static_cast<double>(q),
+                              t,
+                              e,
+                              std::ceil(static_cast<double>(n) / p) - 1,
+                              nan,
+                              nan,
+                              0,
+                              nan,
+                              nan,
                               nan};
       for (std::size_t i = 0; i < period.size(); ++i)
         if (std::abs(period[i] - t) < 1e-4 * L / c) {

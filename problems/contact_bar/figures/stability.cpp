@@ -100,9 +100,9 @@ int write_stability_summary(const fs::path& out) {
     }
     const bool followed = run.filename().string().rfind("branch_point_", 0) == 0;
     const fs::path scene_dir = followed ? run.parent_path() : run;
-    const std::string name = followed ? scene_dir.filename().string() + "/" +
-                                            run.filename().string()
-                                      : run.filename().string();
+    const std::string name = followed
+                                 ? scene_dir.filename().string() + "/" + run.filename().string()
+                                 : run.filename().string();
     const std::string elements = scene_value(scene_dir / "scene.ini", "shooting_elements");
     const std::string courant = scene_value(scene_dir / "scene.ini", "stability_courant");
     summary.add_cells({name, name.substr(0, name.find('_')),

@@ -130,11 +130,10 @@ SubharmonicMember subharmonic_member(const bar::Material& material, double gap, 
   const double length = material.length;
   const double s = std::sqrt(2 * energy / (material.axial_stiffness() * length));
   if (!(s * length >= (2 * mode - 1) * gap) || !std::isfinite(s))
-    throw core::InputError("energy",
-                           fmt::format("the subharmonic continuum needs E >= the mode-{} "
-                                       "grazing energy {} (got {})",
-                                       mode, ContactFamily(material, gap, mode).grazing_energy(),
-                                       energy));
+    throw core::InputError(
+        "energy", fmt::format("the subharmonic continuum needs E >= the mode-{} "
+                              "grazing energy {} (got {})",
+                              mode, ContactFamily(material, gap, mode).grazing_energy(), energy));
   if (!(shape >= 0 && shape <= 1))
     throw core::InputError("shape", fmt::format("must be in [0, 1] (got {})", shape));
   const double tau = length / material.wave_speed();
@@ -149,8 +148,11 @@ SubharmonicMember subharmonic_member(const bar::Material& material, double gap, 
     }
     values.push_back(gap);  // s (4b - 1) L = g0 exactly (the sum of the slopes rounds)
     knots.push_back(length);
-    return {bar::PiecewiseLinear(std::move(knots), std::move(values)), 2 * (1 + b) * tau,
-            2 * (c - b) * tau, 2 * (1 - 2 * b - c) * tau, {x1, x2}};
+    return {bar::PiecewiseLinear(std::move(knots), std::move(values)),
+            2 * (1 + b) * tau,
+            2 * (c - b) * tau,
+            2 * (1 - 2 * b - c) * tau,
+            {x1, x2}};
   }
   // Mode J even (README.md, 'Subharmonic continuum of mode J'), lengths in L: gamma = g0 / (sL),
   // B = (1 + gamma) / J, A = (J + 1 - (J - 1) gamma) / J^2, T_J = A + B, D = A - B. Kinks at

@@ -35,8 +35,8 @@ void GrazingLimitOptions::validate() const {
   if (mode < 2 || mode % 2 != 0)
     throw core::InputError("mode", fmt::format("must be even and >= 2 (got {})", mode));
   if (elements < 2 * mode)
-    throw core::InputError("elements", fmt::format("must be >= 2 mode = {} (got {})", 2 * mode,
-                                                   elements));
+    throw core::InputError("elements",
+                           fmt::format("must be >= 2 mode = {} (got {})", 2 * mode, elements));
 }
 
 namespace {

@@ -140,7 +140,8 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
   // subharmonic members next to their grazing limit) would take over 64 times the steps and
   // the memory of the simulations: refused before any of them, the point's stability undecided.
   double shortest = problem.setup_template().material.length;
-  for (std::size_t i = 1; i < nodes.size(); ++i) shortest = std::min(shortest, nodes[i] - nodes[i - 1]);
+  for (std::size_t i = 1; i < nodes.size(); ++i)
+    shortest = std::min(shortest, nodes[i] - nodes[i - 1]);
   if (!(shortest * 64 * n >= problem.setup_template().material.length)) return EvalStatus::failed;
   const Vector base = full_state(problem, x, nodes);
   const bar::Material& material = problem.setup_template().material;

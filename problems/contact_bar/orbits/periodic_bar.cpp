@@ -529,9 +529,8 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
     const double k1 = x[knot_index(j - 2)] / length, k2 = x[knot_index(j - 1)] / length;
     // In units of g0 like the residual rows (a knot moved by dk moves u0 by about s dk): in
     // units of L the row weighs 1e-3 of them and the rank report counts it as null.
-    r[row++] =
-        (1 - k2 - options_.fixed_shape * contact_fraction(j, k2 - k1)) * length /
-        displacement_scale();
+    r[row++] = (1 - k2 - options_.fixed_shape * contact_fraction(j, k2 - k1)) * length /
+               displacement_scale();
   }
   const double u_scale = displacement_scale();
   if (paper) {
@@ -650,8 +649,7 @@ Vector ContactBarOrbitProblem::subharmonic_guess(double energy, double shape) co
     throw InputError("shape", fmt::format("must be in (0, 1] (got {}): at 0 the second kink "
                                           "reaches x = L",
                                           shape));
-  const SubharmonicMember member =
-      subharmonic_member(setup_.material, gap(), energy, shape, mode);
+  const SubharmonicMember member = subharmonic_member(setup_.material, gap(), energy, shape, mode);
   const double length = setup_.material.length;
   const int n = options_.elements;
   Vector x(num_unknowns());

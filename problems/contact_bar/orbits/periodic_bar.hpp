@@ -69,12 +69,12 @@ struct OrbitOptions {
   // Path rows: equations appended after the M residual rows that pick a path on a manifold of
   // orbits (README.md, 'Subharmonic continuum'); ContactBarOrbitProblem::set_path_rows(false)
   // drops them, e.g. to measure the dimension of the periodicity residual alone.
-  double fixed_energy = 0;  // > 0: (energy(x) - fixed_energy) / fixed_energy = 0
-  double fixed_shape = -1;  // in [0, 1]: the subharmonic shape (first contact phase / total
-                            // contact time) fixed, a linear row in the knots of the last two
-                            // kinks, k_J-1 and k_J (needs start_on_wall, K >= J):
-                            // 1 - k_J = shape (2 - (2J - 1) (k_J - k_J-1)) / J (knots in units
-                            // of L; J = 2: knots 1 and 2), times L / g0 as the residual rows
+  double fixed_energy = 0;   // > 0: (energy(x) - fixed_energy) / fixed_energy = 0
+  double fixed_shape = -1;   // in [0, 1]: the subharmonic shape (first contact phase / total
+                             // contact time) fixed, a linear row in the knots of the last two
+                             // kinks, k_J-1 and k_J (needs start_on_wall, K >= J):
+                             // 1 - k_J = shape (2 - (2J - 1) (k_J - k_J-1)) / J (knots in units
+                             // of L; J = 2: knots 1 and 2), times L / g0 as the residual rows
   int subharmonic_mode = 2;  // J of the subharmonic members (even): their kinks are knots 1..J
   // Units that follow the orbit (continuation::LocalScale): above the gap, the unit of u0 in
   // continuation is the orbit's amplitude (its L2 norm over the bar), not g0, so that a step

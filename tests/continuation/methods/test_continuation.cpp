@@ -620,8 +620,7 @@ TEST(Continuation, AStallAtTheBoundaryIsAPlannedEnd) {
   EXPECT_FALSE(ended.ended_early());
   EXPECT_EQ(ended.points.size(), plain.points.size());
   opt.boundary = {"room", 1e-12};
-  const Branch short_of =
-      continuation::pseudo_arclength(line, vec(0, 0), vec(1, 1), *newton, opt);
+  const Branch short_of = continuation::pseudo_arclength(line, vec(0, 0), vec(1, 1), *newton, opt);
   EXPECT_EQ(short_of.reason, continuation::StopReason::evaluation_failed);
   opt.boundary = {"room", -1};
   EXPECT_THROW(opt.validate(), core::InputError);

@@ -168,16 +168,17 @@ TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
     const char* energy_max;
     int mode, p, q;
   };
-  for (const Case& c : {Case{"mode2", 35, "10", "4e-5", 2, 14, 9},
-                        Case{"mode3", 46, "10,26", "4e-4", 3, 23, 9}}) {
+  for (const Case& c :
+       {Case{"mode2", 35, "10", "4e-5", 2, 14, 9}, Case{"mode3", 46, "10,26", "4e-4", 3, 23, 9}}) {
     const auto out = cli::scratch("modes_cli", std::string("law_") + c.branch);
-    const cli::Run r = cli::run(
-        "trace",
-        scene + " --branch " + c.branch + " --shooting_elements " +
-            std::to_string(c.elements) + " --knot_nodes " + c.knots +
-            " --detect_branch_points true --amplitude_units false --ds 0.05 --ds_max 0.05 "
-            "--energy_max " + c.energy_max + " --follow all",
-        out);
+    const cli::Run r =
+        cli::run("trace",
+                 scene + " --branch " + c.branch + " --shooting_elements " +
+                     std::to_string(c.elements) + " --knot_nodes " + c.knots +
+                     " --detect_branch_points true --amplitude_units false --ds 0.05 --ds_max 0.05 "
+                     "--energy_max " +
+                     c.energy_max + " --follow all",
+                 out);
     ASSERT_EQ(r.code, 0) << r.err;
     const Table points = Table::read_csv(out / "branch_points.csv");
     const auto period = points.column("period"), energy = points.column("energy");
