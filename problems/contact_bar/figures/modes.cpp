@@ -352,27 +352,46 @@ int draw_all_backbones(const fs::path& out, const FigureInputs& inputs) {
         "'frequency':'energy' with points pt 9 ps 0.5 lc rgb 'dark-magenta' notitle",
         core::gnuplot_quote(out / "backbones_all_subharmonic4.csv"), two, w.size());
   }
+  // The families attached to modes 1 to 3 that the main job follows, each a vertical segment
+  // (constant period) labelled with its period in L/c at its top.
   int attached = 0;
-  const fs::path resonances = out / "mode1_resonances";
-  if (fs::exists(resonances))
+  std::string labels;
+  const double tau = s.material.length / s.material.wave_speed();
+  for (const char* folder : {"mode1_resonances", "mode1_resonance_twelve", "mode2_resonances",
+                             "mode2_resonances_14_11", "mode3_resonances"}) {
+    const fs::path resonances = out / folder;
+    if (!fs::exists(resonances)) continue;
+    std::vector<fs::path> followed;
     for (const auto& entry : fs::directory_iterator(resonances))
       if (entry.path().filename().string().rfind("branch_point_", 0) == 0 &&
-          has_branch(entry.path())) {
-        curves += fmt::format(
-            ", {} using 'frequency':'energy' with linespoints pt 1 ps 0.4 lw 2 lc rgb 'orange' "
-            "{}",
-            core::gnuplot_quote(entry.path() / "branch.csv"),
-            attached == 0 ? "title 'families attached to mode 1'" : "notitle");
-        ++attached;
-      }
+          has_branch(entry.path()))
+        followed.push_back(entry.path());
+    std::sort(followed.begin(), followed.end());
+    for (const fs::path& dir : followed) {
+      curves += fmt::format(
+          ", {} using 'frequency':'energy' with linespoints pt 1 ps 0.4 lw 2 lc rgb 'orange' {}",
+          core::gnuplot_quote(dir / "branch.csv"),
+          attached == 0 ? "title 'families attached to modes 1 to 3 (period in L/c)'"
+                        : "notitle");
+      const Table b = Table::read_csv(dir / "branch.csv");
+      const auto w = b.column("frequency"), e = b.column("energy"), t = b.column("period");
+      if (!w.empty())
+        labels += fmt::format("set label {} 'T = {:.5g}' at {:.9g},{:.9g} right offset -0.5,0 "
+                              "font ',9' tc rgb 'dark-orange'\n",
+                              attached + 1, t.back() / tau, w.back(),
+                              *std::max_element(e.begin(), e.end()));
+      ++attached;
+    }
+  }
   const double w1 = ContactFamily(s.material, g0, 1).linear_frequency();
   const double w_top = ContactFamily(s.material, g0, modes).asymptotic_frequency();
   const std::string plot = fmt::format(
       "set title 'Backbones of modes 1 to {} (g_0 = {} m, c = {} m/s, L = {} m)'\n"
       "set xlabel 'frequency {{/Symbol w}} [rad/s]'\nset ylabel 'energy E [J]'\n"
       "set logscale y\nset format y '10^{{%L}}'\nset grid\nset key below maxrows 5\n"
-      "set xrange [{}:{}]\n{}\n",
-      modes, g0, s.material.wave_speed(), s.material.length, 0.8 * w1, 1.05 * w_top, curves);
+      "set xrange [{}:{}]\n{}{}\n",
+      modes, g0, s.material.wave_speed(), s.material.length, 0.8 * w1, 1.05 * w_top, labels,
+      curves);
   const fs::path png = out / "backbones_all.png";
   report(core::render_png(png, plot, {1400, 900}), png);
   return 0;
