@@ -371,15 +371,14 @@ int draw_all_backbones(const fs::path& out, const FigureInputs& inputs) {
       curves += fmt::format(
           ", {} using 'frequency':'energy' with linespoints pt 1 ps 0.4 lw 2 lc rgb 'orange' {}",
           core::gnuplot_quote(dir / "branch.csv"),
-          attached == 0 ? "title 'families attached to modes 1 to 3 (period in L/c)'"
-                        : "notitle");
+          attached == 0 ? "title 'families attached to modes 1 to 3 (period in L/c)'" : "notitle");
       const Table b = Table::read_csv(dir / "branch.csv");
       const auto w = b.column("frequency"), e = b.column("energy"), t = b.column("period");
       if (!w.empty())
-        labels += fmt::format("set label {} 'T = {:.5g}' at {:.9g},{:.9g} right offset -0.5,0 "
-                              "font ',9' tc rgb 'dark-orange'\n",
-                              attached + 1, t.back() / tau, w.back(),
-                              *std::max_element(e.begin(), e.end()));
+        labels += fmt::format(
+            "set label {} 'T = {:.5g}' at {:.9g},{:.9g} right offset -0.5,0 "
+            "font ',9' tc rgb 'dark-orange'\n",
+            attached + 1, t.back() / tau, w.back(), *std::max_element(e.begin(), e.end()));
       ++attached;
     }
   }
