@@ -88,12 +88,13 @@ void register_plugin(cli::PluginRegistry& registry) {
         "3e-5", "--follow", "all", "--follow_max_points", "100", "--out",
         "{out}/mode1_resonances"}},
       // The law of the attached periods against detection on fine steps (mode1_law.csv by the
-      // figures step): every family the 40-interval grid holds up to 1e-3 J.
+      // figures step): every family the 40-interval grid holds up to 1e-3 J. Steps of 0.1 % of
+      // the amplitude: the test function's dips next to grazing are narrower than 0.005 g0.
       {"mode1_law",
        "trace",
        {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40",
-        "--detect_branch_points", "true", "--amplitude_units", "false", "--ds", "0.005", "--ds_max",
-        "0.005", "--max_points", "8000", "--energy_max", "1e-3", "--out", "{out}/mode1_law"}},
+        "--detect_branch_points", "true", "--ds", "0.001", "--ds_max", "0.001", "--max_points",
+        "8000", "--energy_max", "1e-3", "--out", "{out}/mode1_law"}},
       // The family of resonance order 12 attached at T = 24/7 L/c (the paper's "about 12
       // times", figures/README.md): 70 intervals resolve it (7 divides 140), and steps of 0.05
       // sample the test function finely enough to locate it (the third candidate).
