@@ -45,6 +45,17 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
     args.push_back("{out}/stability/" + branch + "_" + run);
     steps.push_back({"stability_" + branch + "_" + run, "trace", std::move(args)});
   }
+  // The subharmonic backbone and its continuum at 1e-3 J (mode 2 over two periods), at the
+  // branches' own 20 intervals.
+  steps.push_back({"stability_subharmonic_N20",
+                   "trace",
+                   {scenes + "paper.ini", "--branch", "subharmonic", "--stability", "true",
+                    "--threads", "2", "--out", "{out}/stability/subharmonic_N20"}});
+  steps.push_back({"stability_subharmonic_continuum_N20",
+                   "trace",
+                   {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1e-3",
+                    "--stability", "true", "--threads", "2", "--out",
+                    "{out}/stability/subharmonic_continuum_N20"}});
   // The family attached to mode 1 at T = 3.2 L/c, followed with its multipliers.
   steps.push_back({"stability_mode1_resonances_N40",
                    "trace",
