@@ -31,8 +31,7 @@ namespace backbone::continuation {
 // Where the solution set ends: an observable that falls to 0 at its boundary (a nonsmooth edge,
 // beyond which no solution exists or F cannot be evaluated). A branch that ends with step_floor
 // or evaluation_failed at a point where the observable is at most `within` has reached that
-// boundary: it ends with
-// StopReason::boundary_reached, a planned end. Empty observable: none.
+// boundary: it ends with StopReason::boundary_reached, a planned end. Empty observable: none.
 struct Boundary {
   std::string observable;
   double within = 0;

@@ -141,20 +141,20 @@ std::vector<FollowedBranch> follow_branch_points(
         g.attempts = attempt + 1;
         return g;
       };
+      const auto cancelled = [&] { return hooks.cancel_requested && hooks.cancel_requested(); };
       int at_boundary = -1, attempts = 0;
       for (int attempt = 0; attempt < std::max(1, run.start_attempts); ++attempt) {
         if (attempt > 0 && !attached_start(problem, report, run.observable, attempt)) break;
         f = attempt_from(attempt);
         attempts = attempt + 1;
-        if (hooks.cancel_requested && hooks.cancel_requested()) break;
+        if (cancelled()) break;
         if (f.branch.reason == StopReason::boundary_reached) {
           if (at_boundary < 0) at_boundary = attempt;
           continue;
         }
         if (!f.branch.ended_early()) break;
       }
-      if (f.branch.ended_early() && at_boundary >= 0 &&
-          !(hooks.cancel_requested && hooks.cancel_requested())) {
+      if (f.branch.ended_early() && at_boundary >= 0 && !cancelled()) {
         f = attempt_from(at_boundary);
         f.attempts = attempts;
       }

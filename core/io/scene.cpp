@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -332,6 +333,34 @@ std::string scene_problem_name(const std::string& ini_path) {
     rethrow_as_input_error(e, ini_path);
   }
   return vm["problem"].as<std::string>();
+}
+
+std::vector<int> parse_increasing_integers(const std::string& text, const std::string& key,
+                                           long min_value, long max_value,
+                                           const std::string& what) {
+  std::string spaced = text;
+  std::replace(spaced.begin(), spaced.end(), ',', ' ');
+  std::istringstream words(spaced);
+  std::vector<int> list;
+  std::string word;
+  while (words >> word) {
+    std::size_t used = 0;
+    long value = 0;
+    try {
+      value = std::stol(word, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != word.size() || value < min_value || value > max_value)
+      throw InputError(key, fmt::format("'{}' is not {} in {}..{} (in '{}')", word, what, min_value,
+                                        max_value, text));
+    if (!list.empty() && value <= list.back())
+      throw InputError(
+          key, fmt::format("must increase ({} after {} in '{}')", value, list.back(), text));
+    list.push_back(static_cast<int>(value));
+  }
+  if (list.empty()) throw InputError(key, fmt::format("no {} in '{}'", what, text));
+  return list;
 }
 
 }  // namespace backbone::core

@@ -68,6 +68,12 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
 po::variables_map parse_options(const po::options_description& keys,
                                 const std::vector<std::string>& arguments);
 
+// "20,40,80" or "20 40 80": whole numbers in [min_value, max_value], strictly increasing, at
+// least one; InputError(key) naming the word and `what` each must be ("a node", "a grid of
+// intervals") otherwise.
+std::vector<int> parse_increasing_integers(const std::string& text, const std::string& key,
+                                           long min_value, long max_value, const std::string& what);
+
 // The value of the `problem` key of an INI file (empty when absent), read before the
 // problem's keys are known. Throws InputError when the file cannot be read.
 std::string scene_problem_name(const std::string& ini_path);

@@ -164,30 +164,7 @@ double time_per_point_exponent(const std::vector<Mode1BranchCost>& runs, int min
 }
 
 std::vector<int> parse_element_list(const std::string& text, const std::string& name) {
-  std::string spaced = text;
-  std::replace(spaced.begin(), spaced.end(), ',', ' ');
-  std::istringstream words(spaced);
-  std::vector<int> list;
-  std::string word;
-  while (words >> word) {
-    std::size_t used = 0;
-    long value = 0;
-    try {
-      value = std::stol(word, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != word.size() || value < 2 || value > 100000)
-      throw core::InputError(
-          name, fmt::format("'{}' is not a grid of 2 to 100000 intervals (in '{}')", word, text));
-    if (!list.empty() && value <= list.back())
-      throw core::InputError(
-          name, fmt::format("grids must increase ({} after {} in '{}')", value, list.back(), text));
-    list.push_back(static_cast<int>(value));
-  }
-  if (list.empty())
-    throw core::InputError(name, fmt::format("no grid in '{}' (e.g. 20,40,80)", text));
-  return list;
+  return core::parse_increasing_integers(text, name, 2, 100000, "a grid of intervals");
 }
 
 JacobianThreadsTiming time_jacobian_threads(int elements, int repetitions) {

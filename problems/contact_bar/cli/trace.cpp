@@ -26,6 +26,7 @@
 #include <memory>
 
 #include "core/errors.hpp"
+#include "core/io/scene.hpp"
 #include "core/io/table.hpp"
 #include "core/jacobians/finite_difference.hpp"
 #include "problems/contact_bar/cli/simulate.hpp"
@@ -410,27 +411,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
     }
   }
   if (const std::string nodes = scene.text("knot_nodes"); !nodes.empty()) {
-    options.knot_nodes.clear();
-    std::string token;
-    for (const char ch : nodes + " ") {
-      if (ch == ' ' || ch == ',') {
-        if (token.empty()) continue;
-        std::size_t used = 0;
-        long value = 0;
-        try {
-          value = std::stol(token, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used != token.size() || value < 1 || value >= options.elements)
-          throw core::InputError(
-              "knot_nodes", fmt::format("'{}' is no node in 1..{}", token, options.elements - 1));
-        options.knot_nodes.push_back(static_cast<int>(value));
-        token.clear();
-      } else {
-        token += ch;
-      }
-    }
+    options.knot_nodes =
+        core::parse_increasing_integers(nodes, "knot_nodes", 1, options.elements - 1, "a node");
     if (static_cast<int>(options.knot_nodes.size()) != options.free_knots)
       throw core::InputError(
           "knot_nodes", fmt::format("needs one node per free knot ({}; got {})", options.free_knots,
@@ -477,9 +459,9 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
 //  - ds = ds_max = 1/40 of the closed-form path length in the scaled step norm, so every
 //    energy has about 40 members (the path grows like sqrt(E) / g0 in that norm), unless the
 //    scene gives ds or ds_max;
-//  - a window on the shape from shape_end = 1e-6 L / (D L) (D L = (1 - 3b) L for mode 2) to 1 (to 1
-//  - shape_end when
-//    the branch goes up from a first member below 1/2): the shape-0 limit has
+//  - a window on the shape from shape_end = 1e-6 L / (D L) (D L: the members' kink range,
+//    (1 - 3b) L for mode 2) to 1 (to 1 - shape_end when the branch goes up from a first member
+//    below 1/2): the shape-0 limit has
 //    its second kink at x = L, where the two-knot chart degenerates (the forward-difference
 //    step of the last knot, 1.5e-8 L, crosses L once L - k2 is smaller), so the branch lands
 //    on the member with L - k2 = 1e-6 L, whose contact phase at t = 0 lasts 2e-6 L / c, and
@@ -489,12 +471,11 @@ std::function<void(continuation::ContinuationOptions&, core::NewtonOptions&)> co
     double toward) {
   const bar::Material& material = problem.setup_template().material;
   const double g0 = problem.displacement_scale();
-  const double s = std::sqrt(2 * energy / (material.axial_stiffness() * material.length));
-  const double b = 0.25 * (1 + g0 / (s * material.length));
-  // 1e-6 L of kink travel over D L, the members' kink range (J = 2: D = 1 - 3b).
-  const double j = problem.options().subharmonic_mode, gamma = g0 / (s * material.length);
-  const double contact = j == 2 ? 1 - 3 * b : (1 - (2 * j - 1) * gamma) / (j * j);
-  const double shape_end = 1e-6 / contact;
+  // 1e-6 L of kink travel over D L: the two contact phases of a member last 2 D L / c together.
+  const SubharmonicMember middle =
+      subharmonic_member(material, g0, energy, 0.5, problem.options().subharmonic_mode);
+  const double shape_end = 1e-6 * 2 * material.length /
+                           ((middle.first_contact + middle.second_contact) * material.wave_speed());
   // The closed-form path length from `shape` to the end, in the loop's scaled unknowns: 40
   // steps to twice shape_end, so that no planned member falls on the bound itself (a member on
   // it leaves no landing ahead of it).

@@ -359,15 +359,7 @@ int draw_all_backbones(const fs::path& out, const FigureInputs& inputs) {
   const double tau = s.material.length / s.material.wave_speed();
   for (const char* folder : {"mode1_resonances", "mode1_resonance_twelve", "mode2_resonances",
                              "mode2_resonances_14_11", "mode3_resonances"}) {
-    const fs::path resonances = out / folder;
-    if (!fs::exists(resonances)) continue;
-    std::vector<fs::path> followed;
-    for (const auto& entry : fs::directory_iterator(resonances))
-      if (entry.path().filename().string().rfind("branch_point_", 0) == 0 &&
-          has_branch(entry.path()))
-        followed.push_back(entry.path());
-    std::sort(followed.begin(), followed.end());
-    for (const fs::path& dir : followed) {
+    for (const fs::path& dir : followed_branches(out / folder)) {
       curves += fmt::format(
           ", {} using 'frequency':'energy' with linespoints pt 1 ps 0.4 lw 2 lc rgb 'orange' {}",
           core::gnuplot_quote(dir / "branch.csv"),
@@ -558,6 +550,16 @@ std::vector<cli::ProblemJob> figure_jobs(const FigureInputs& inputs) {
       {"closed_form_summary", "closed_form_summary.csv: acceptance numbers of every branch",
        write_closed_form_summary},
   };
+}
+
+std::vector<fs::path> followed_branches(const fs::path& dir) {
+  std::vector<fs::path> followed;
+  if (!fs::exists(dir)) return followed;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().filename().string().rfind("branch_point_", 0) == 0 && has_branch(entry.path()))
+      followed.push_back(entry.path());
+  std::sort(followed.begin(), followed.end());
+  return followed;
 }
 
 }  // namespace backbone::contact_bar

@@ -77,4 +77,8 @@ std::optional<TracedOrbit> load_traced_orbit(const std::filesystem::path& branch
 std::optional<TracedOrbit> load_traced_orbit_point(const std::filesystem::path& branch_dir,
                                                    int point, double target_energy, double length);
 
+// The followed families a trace wrote into dir (--follow): its branch_point_K/ folders that hold
+// a branch.csv, sorted; empty when dir does not exist.
+std::vector<std::filesystem::path> followed_branches(const std::filesystem::path& dir);
+
 }  // namespace backbone::contact_bar

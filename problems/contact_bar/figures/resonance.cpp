@@ -35,17 +35,6 @@ constexpr double twelve_order = 12;
 // candidates against the law (mode1_law.csv).
 constexpr const char* law_folder = "mode1_law";
 
-std::vector<fs::path> followed_branches(const fs::path& mode1) {
-  std::vector<fs::path> attached;
-  if (!fs::exists(mode1)) return attached;
-  for (const auto& entry : fs::directory_iterator(mode1))
-    if (entry.path().filename().string().rfind("branch_point_", 0) == 0 &&
-        fs::exists(entry.path() / "branch.csv"))
-      attached.push_back(entry.path());
-  std::sort(attached.begin(), attached.end());
-  return attached;
-}
-
 // The followed branches of the q = 12 family in OUT/mode1_resonance_twelve (the rows of its
 // branch_points.csv with resonance_order 12 to 1e-3), else those of OUT/mode1_resonances.
 std::vector<fs::path> figure_branches(const fs::path& out) {

@@ -11,6 +11,7 @@
 #include "core/io/plot.hpp"
 #include "core/io/scene.hpp"
 #include "core/io/table.hpp"
+#include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/orbits/monodromy.hpp"
 #include "problems/contact_bar/solver/scene.hpp"
@@ -62,12 +63,10 @@ int write_stability_summary(const fs::path& out) {
     for (const auto& entry : fs::directory_iterator(folder)) {
       if (fs::exists(entry.path() / "branch.csv") && fs::exists(entry.path() / "multipliers.csv"))
         runs.push_back(entry.path());
-      // The families a run followed (--follow): branch_point_K/ with their own multipliers.
+      // The families a run followed (--follow), with their own multipliers.
       if (entry.is_directory())
-        for (const auto& sub : fs::directory_iterator(entry.path()))
-          if (sub.path().filename().string().rfind("branch_point_", 0) == 0 &&
-              fs::exists(sub.path() / "multipliers.csv"))
-            runs.push_back(sub.path());
+        for (const fs::path& followed : followed_branches(entry.path()))
+          if (fs::exists(followed / "multipliers.csv")) runs.push_back(followed);
     }
   if (runs.empty()) {
     fmt::print("[figures] stability_summary skipped: no trace with --stability true in {}\n",

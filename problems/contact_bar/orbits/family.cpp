@@ -116,11 +116,10 @@ double node_of(const bar::PiecewiseLinear& u0) {
 }
 
 // Derivation (c = L = 1, u = F(t + x) - F(t - x), H(t) = F'(t - 1) the wave arriving at x = 1,
-// README.md sections 'Mode 2' and 'Subharmonic continuum'): v0 = 0 makes H symmetric about 1 on
-// [0, 2] and u0'(x) = 2 H(1 + x). Take H = +h on a pulse of width 2b centred at c in [0, 1]
-// (mirrored about 1), -h elsewhere: u0(1) = s (4b - 1) = g0 whatever c, so the end starts on the
-// wall. Marching the free / closed reflections over T = 2 (1 + b) returns the state for every c
-// in [b, 1 - 2b]: contact phases of 2 (c - b) around t = 0 and 2 (1 - 2b - c) around T / 2.
+// README.md sections 'Subharmonic continuum' and 'Subharmonic continuum of mode J'): over
+// 2 T_J, two pulses of width B and two stretches A_a + A_b = 2A; for even J each pulse is its
+// own echo under the shift by 2, so every split with A_a, A_b >= B holds, and the wall condition
+// is mode J's. J = 2: B = 2b, b = (1 + g0/s)/4, kinks at (1 - c -+ b) L with c = b + shape D.
 SubharmonicMember subharmonic_member(const bar::Material& material, double gap, double energy,
                                      double shape, int mode) {
   if (mode < 2 || mode % 2 != 0)
@@ -137,23 +136,6 @@ SubharmonicMember subharmonic_member(const bar::Material& material, double gap, 
   if (!(shape >= 0 && shape <= 1))
     throw core::InputError("shape", fmt::format("must be in [0, 1] (got {})", shape));
   const double tau = length / material.wave_speed();
-  if (mode == 2) {
-    const double b = 0.25 * (1 + gap / (s * length));
-    const double c = b + shape * (1 - 3 * b);
-    const double x1 = (1 - c - b) * length, x2 = (1 - c + b) * length;
-    std::vector<double> knots{0.0, x1}, values{0.0, -s * x1};
-    if (x2 < length) {
-      knots.push_back(x2);
-      values.push_back(values.back() + s * (x2 - x1));
-    }
-    values.push_back(gap);  // s (4b - 1) L = g0 exactly (the sum of the slopes rounds)
-    knots.push_back(length);
-    return {bar::PiecewiseLinear(std::move(knots), std::move(values)),
-            2 * (1 + b) * tau,
-            2 * (c - b) * tau,
-            2 * (1 - 2 * b - c) * tau,
-            {x1, x2}};
-  }
   // Mode J even (README.md, 'Subharmonic continuum of mode J'), lengths in L: gamma = g0 / (sL),
   // B = (1 + gamma) / J, A = (J + 1 - (J - 1) gamma) / J^2, T_J = A + B, D = A - B. Kinks at
   // L - x = o_k + k T_J and o_k + k T_J + B for k = 0 .. J/2 - 1, o_k = shape D (k even) or

@@ -167,17 +167,22 @@ void ContactBarOrbitProblem::initial_state_samples(const Vector& x, Vector& coor
       Eigen::Map<const Vector>(u0.values().data(), static_cast<Eigen::Index>(u0.values().size()));
 }
 
-bar::PiecewiseLinear ContactBarOrbitProblem::initial_displacement(const Vector& x) const {
+void ContactBarOrbitProblem::u0_at_nodes(const Vector& x, std::vector<double>& knots,
+                                         std::vector<double>& values) const {
   const int n = options_.elements;
   const Vector y = node_positions(x);
-  std::vector<double> knots(n + 1), values(n + 1);
-  knots[0] = 0;
-  values[0] = 0;
+  knots.assign(static_cast<std::size_t>(n) + 1, 0.0);
+  values.assign(static_cast<std::size_t>(n) + 1, 0.0);
   for (int i = 1; i <= n; ++i) {
-    knots[i] = y[i - 1];
-    values[i] = node_value(x, i);
+    knots[static_cast<std::size_t>(i)] = y[i - 1];
+    values[static_cast<std::size_t>(i)] = node_value(x, i);
   }
-  knots[n] = setup_.material.length;  // exactly L, whatever the rounding of the map
+  knots.back() = setup_.material.length;  // exactly L, whatever the rounding of the map
+}
+
+bar::PiecewiseLinear ContactBarOrbitProblem::initial_displacement(const Vector& x) const {
+  std::vector<double> knots, values;
+  u0_at_nodes(x, knots, values);
   return bar::PiecewiseLinear(std::move(knots), std::move(values));
 }
 
@@ -228,19 +233,12 @@ double ContactBarOrbitProblem::subharmonic_shape(const Vector& x) const {
 
 double ContactBarOrbitProblem::min_slope(const Vector& x) const {
   // Any x a continuation evaluates, knots out of order (no u0) included: NaN there.
-  const int n = options_.elements;
-  const Vector y = node_positions(x);
-  Vector coordinates(n + 1), values(n + 1);
-  coordinates[0] = values[0] = 0;
-  for (int i = 1; i <= n; ++i) {
-    coordinates[i] = y[i - 1];
-    values[i] = node_value(x, i);
-  }
+  std::vector<double> coordinates, values;
+  u0_at_nodes(x, coordinates, values);
   const double length = setup_.material.length;
-  coordinates[n] = length;
   const double s = std::sqrt(2 * energy(x) / (setup_.material.axial_stiffness() * length));
   double smallest = std::numeric_limits<double>::infinity();
-  for (Eigen::Index i = 1; i < coordinates.size(); ++i) {
+  for (std::size_t i = 1; i < coordinates.size(); ++i) {
     const double dx = coordinates[i] - coordinates[i - 1];
     if (!(dx >= 0)) return std::nan("");
     if (dx > 0) smallest = std::min(smallest, std::abs((values[i] - values[i - 1]) / dx));

@@ -178,6 +178,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
 
   // The initial displacement at x, as the solver sees it (knots at the node positions).
   bar::PiecewiseLinear initial_displacement(const core::Vector& x) const;
+  // Its knots (x = 0, then the mapped nodes, the last exactly L) and values, unchecked.
+  void u0_at_nodes(const core::Vector& x, std::vector<double>& knots,
+                   std::vector<double>& values) const;
   // The full setup the residual simulates at x (template + u0, v0 = 0).
   bar::BarSetup setup_at(const core::Vector& x) const;
   // Time step used at period T.

@@ -16,15 +16,21 @@ namespace {
 
 using backbone::core::Table;
 
+// `backbone trace` on the paper scene with these arguments, into out.
+cli::Run trace_paper(const std::string& arguments, const std::filesystem::path& out) {
+  return cli::run(
+      "trace",
+      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini " + arguments,
+      out);
+}
+
 // Tolerances: the frequency is the closed form's to the Newton tolerance (1e-10 relative to the
 // amplitude; measured at most 2.5e-13), 1e-10 leaves a margin; the exact-oracle return is the
 // trace's own return_tolerance 1e-6 (measured at most 1.7e-9).
 TEST(ModesCli, ModesThreeAndEightReachTheEnergyBoundAlongTheirClosedForms) {
-  const std::string scene =
-      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
   for (int mode : {3, 8}) {
     const auto out = cli::scratch("modes", "mode" + std::to_string(mode));
-    const cli::Run r = cli::run("trace", scene + " --branch mode" + std::to_string(mode), out);
+    const cli::Run r = trace_paper("--branch mode" + std::to_string(mode), out);
     ASSERT_EQ(r.code, 0) << r.err;
     const Table b = Table::read_csv(out / "branch.csv");
     const Table c = Table::read_csv(out / "closed_form_check.csv");
@@ -42,14 +48,12 @@ TEST(ModesCli, ModesThreeAndEightReachTheEnergyBoundAlongTheirClosedForms) {
 }
 
 TEST(ModesCli, AModeNeedsTwoIntervalsPerKinkAndNamesLikeModeJ) {
-  const std::string scene =
-      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
   const auto out = cli::scratch("modes", "refused");
-  cli::Run r = cli::run("trace", scene + " --branch mode11", out);
+  cli::Run r = trace_paper("--branch mode11", out);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("shooting_elements"), std::string::npos) << r.err;
   for (const char* bad : {"mode0", "mode03", "modex", "mode-1"}) {
-    r = cli::run("trace", scene + " --branch " + bad, out);
+    r = trace_paper(std::string("--branch ") + bad, out);
     EXPECT_EQ(r.code, 2) << bad;
     EXPECT_NE(r.err.find("modeJ for every J >= 1"), std::string::npos) << r.err;
   }
@@ -68,14 +72,11 @@ namespace {
 // period (the location's tolerance is 1e-8 of T; measured about 4e-9), and verified exactly
 // when p divides 80.
 TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
-  const std::string scene =
-      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
   const auto out = cli::scratch("modes", "law");
-  const cli::Run r = cli::run("trace",
-                              scene +
-                                  " --branch mode1 --shooting_elements 40 --energy_max 3e-5 "
-                                  "--detect_branch_points true",
-                              out);
+  const cli::Run r = trace_paper(
+      "--branch mode1 --shooting_elements 40 --energy_max 3e-5 "
+      "--detect_branch_points true",
+      out);
   ASSERT_EQ(r.code, 0) << r.err;
   const Table b = Table::read_csv(out / "branch_points.csv");
   const auto period = b.column("period"), energy = b.column("energy"),
@@ -121,14 +122,11 @@ TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
 // 2.5e-5 J, with min_slope 0 there. The path's last point stops within the boundary's 1e-3 of
 // it, so its energy is 2 E_pq to 1e-3 (measured: 2e-8), at a period held to 1e-9.
 TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
-  const std::string scene =
-      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
   const auto out = cli::scratch("modes_cli", "family_boundary");
-  const cli::Run r = cli::run("trace",
-                              scene +
-                                  " --branch mode1 --shooting_elements 10 "
-                                  "--detect_branch_points true --follow all --energy_max 3e-5",
-                              out);
+  const cli::Run r = trace_paper(
+      "--branch mode1 --shooting_elements 10 "
+      "--detect_branch_points true --follow all --energy_max 3e-5",
+      out);
   ASSERT_EQ(r.code, 0) << r.err;
   const Table points = Table::read_csv(out / "branch_points.csv");
   const auto period = points.column("period"), verified = points.column("verified");
@@ -159,8 +157,6 @@ TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
 // mode 3 at T = 18/23 (p = 23, q = 9: s = 23 g0, kinks at 5/23 and 13/23) on 46, nodes 10
 // and 26. Located to the location's 1e-8 of T (1e-7 here), energy EA L s^2 / 2 to 1e-6.
 TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
-  const std::string scene =
-      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
   struct Case {
     const char* branch;
     int elements;
@@ -171,14 +167,13 @@ TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
   for (const Case& c :
        {Case{"mode2", 35, "10", "4e-5", 2, 14, 9}, Case{"mode3", 46, "10,26", "4e-4", 3, 23, 9}}) {
     const auto out = cli::scratch("modes_cli", std::string("law_") + c.branch);
-    const cli::Run r =
-        cli::run("trace",
-                 scene + " --branch " + c.branch + " --shooting_elements " +
-                     std::to_string(c.elements) + " --knot_nodes " + c.knots +
-                     " --detect_branch_points true --amplitude_units false --ds 0.05 --ds_max 0.05 "
-                     "--energy_max " +
-                     c.energy_max + " --follow all",
-                 out);
+    const cli::Run r = trace_paper(
+        std::string("--branch ") + c.branch + " --shooting_elements " + std::to_string(c.elements) +
+            " --knot_nodes " + c.knots +
+            " --detect_branch_points true --amplitude_units false --ds 0.05 --ds_max 0.05 "
+            "--energy_max " +
+            c.energy_max + " --follow all",
+        out);
     ASSERT_EQ(r.code, 0) << r.err;
     const Table points = Table::read_csv(out / "branch_points.csv");
     const auto period = points.column("period"), energy = points.column("energy");
@@ -206,17 +201,14 @@ TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
 // law: the default 24 probes give a lower bound the row says is one (probed < candidates), 60
 // probes give the law's number.
 TEST(ModesCli, TheAttachedDimensionReachesTheLawWithEnoughProbes) {
-  const std::string scene =
-      std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
   for (const int probes : {24, 60}) {
     const auto out = cli::scratch("modes_cli", "probes_" + std::to_string(probes));
-    const cli::Run r = cli::run("trace",
-                                scene +
-                                    " --branch mode1 --shooting_elements 200 "
-                                    "--detect_branch_points true --energy_max 2.5e-6 "
-                                    "--max_probes " +
-                                    std::to_string(probes),
-                                out);
+    const cli::Run r = trace_paper(
+        "--branch mode1 --shooting_elements 200 "
+        "--detect_branch_points true --energy_max 2.5e-6 "
+        "--max_probes " +
+            std::to_string(probes),
+        out);
     ASSERT_EQ(r.code, 0) << r.err;
     const Table points = Table::read_csv(out / "branch_points.csv");
     const auto period = points.column("period"), dimension = points.column("dimension");
