@@ -19,6 +19,8 @@ const char* to_string(EndType e) {
       return "free";
     case EndType::contact:
       return "contact";
+    case EndType::clearance:
+      return "clearance";
   }
   return "?";
 }
@@ -27,7 +29,9 @@ EndType parse_end_type(const std::string& key, const std::string& value) {
   if (value == "fixed") return EndType::fixed;
   if (value == "free") return EndType::free;
   if (value == "contact") return EndType::contact;
-  throw InputError(key, fmt::format("must be one of fixed, free, contact (got '{}')", value));
+  if (value == "clearance") return EndType::clearance;
+  throw InputError(key,
+                   fmt::format("must be one of fixed, free, contact, clearance (got '{}')", value));
 }
 
 double Material::wave_speed() const {
@@ -129,6 +133,11 @@ void BarSetup::validate() const {
   for (const auto& [key, end] : {std::pair{"gap", left}, std::pair{"gap", right}}) {
     if (!std::isfinite(end.gap) || end.gap < 0)
       throw InputError(key, fmt::format("must be >= 0 (got {})", end.gap));
+    if (!std::isfinite(end.gap_back) || end.gap_back < 0)
+      throw InputError("gap_back", fmt::format("must be >= 0 (got {})", end.gap_back));
+    if (end.has_back_wall() && !(end.gap + end.gap_back > 0))
+      throw InputError("gap_back", "gap + gap_back must be > 0 for a clearance end (the two "
+                                   "walls may not coincide)");
   }
   if (!std::isfinite(body_force))
     throw InputError("body_force", fmt::format("must be finite (got {})", body_force));
@@ -138,17 +147,23 @@ void BarSetup::validate() const {
       throw InputError(key, fmt::format("knots must lie in [0, length] = [0, {}] (got [{}, {}])", L,
                                         f->knots().front(), f->knots().back()));
   }
-  // A contact end must start on the admissible side of its wall.
-  if (right.type == EndType::contact && u0(L) > right.gap * (1 + 1e-12) + 1e-300)
+  // A contact end must start on the admissible side of its walls.
+  if (right.has_wall() && u0(L) > right.gap * (1 + 1e-12) + 1e-300)
     throw InputError("u0",
                      fmt::format("u0(L) = {} penetrates the wall at gap {}", u0(L), right.gap));
-  if (left.type == EndType::contact && -u0(0.0) > left.gap * (1 + 1e-12) + 1e-300)
+  if (left.has_wall() && -u0(0.0) > left.gap * (1 + 1e-12) + 1e-300)
     throw InputError("u0",
                      fmt::format("u0(0) = {} penetrates the wall at gap {}", u0(0.0), left.gap));
+  if (right.has_back_wall() && -u0(L) > right.gap_back * (1 + 1e-12) + 1e-300)
+    throw InputError("u0", fmt::format("u0(L) = {} penetrates the back wall at gap_back {}",
+                                       u0(L), right.gap_back));
+  if (left.has_back_wall() && u0(0.0) > left.gap_back * (1 + 1e-12) + 1e-300)
+    throw InputError("u0", fmt::format("u0(0) = {} penetrates the back wall at gap_back {}",
+                                       u0(0.0), left.gap_back));
 }
 
 bool BarSetup::observed_end_is_right() const {
-  return right.type == EndType::contact || left.type != EndType::contact;
+  return right.has_wall() || !left.has_wall();
 }
 
 void SimulationOptions::validate() const {

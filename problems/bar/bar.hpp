@@ -6,7 +6,10 @@
 // (u = 0), free (u_x = 0) or in unilateral contact with a rigid wall at outward gap g:
 //     g(t) = gap - n u(end, t) >= 0,  lambda = -EA u_x >= 0,  g * lambda = 0   (Signorini)
 // so at x = L the wall sits at u = +gap, at x = 0 at u = -gap. lambda is the compressive
-// contact force [N] (compression, u_x < 0, at either end). body_force is a constant force per unit
+// contact force [N] (compression, u_x < 0, at either end). A clearance end moves between two
+// walls: the front one as above and a back one at outward distance gap_back behind it,
+//     gap_back + n u(end, t) >= 0,  -lambda >= 0,  (gap_back + n u) lambda = 0   (Signorini),
+// where the contact force is tensile (lambda < 0: the back wall pulls the end outwards). body_force is a constant force per unit
 // volume along +x [N/m^3]; its potential enters the energy: E = 1/2 int (rho A v^2 + EA u_x^2) dx -
 // int body_force A u dx. Initial displacement and velocity are piecewise linear (knots may be
 // anywhere in [0, L]).
@@ -27,13 +30,16 @@
 
 namespace backbone::bar {
 
-enum class EndType { fixed, free, contact };
+enum class EndType { fixed, free, contact, clearance };
 const char* to_string(EndType e);
 EndType parse_end_type(const std::string& key, const std::string& value);  // InputError
 
 struct End {
   EndType type = EndType::fixed;
-  double gap = 0;  // contact only: outward distance to the wall at rest [m]
+  double gap = 0;       // contact, clearance: outward distance to the (front) wall at rest [m]
+  double gap_back = 0;  // clearance only: inward distance to the back wall at rest [m]
+  bool has_wall() const { return type == EndType::contact || type == EndType::clearance; }
+  bool has_back_wall() const { return type == EndType::clearance; }
 };
 
 struct Material {

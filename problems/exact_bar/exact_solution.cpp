@@ -129,8 +129,8 @@ void ExactBarSolution::march() {
         {0, t0, t1, v0(xb) - c_ * u0.slope(xm, 1) + b_ * t0, -c_ * v0.slope(xm, 1) + b_});
   }
 
-  EndState left_state{false, u0(0.0)};
-  EndState right_state{false, u0(L)};
+  EndState left_state{false, 1, u0(0.0)};
+  EndState right_state{false, 1, u0(L)};
   // Signals must cover [0, t_end + tau] (a profile at t reads them up to t + tau) and the end
   // tracks [0, t_end]; one more window keeps every query strictly inside.
   const long last_window = static_cast<long>(std::ceil(t_end_ / tau_)) + 1;
@@ -177,18 +177,19 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
       continue;
     }
     // Contact end: walk the segment through its events. The incoming invariant is the
-    // end velocity when free (v = in) and the outward incoming velocity is q = n * in.
+    // end velocity when free (v = in); toward a wall whose outward normal is m (the end's n for
+    // the front wall, -n for a clearance end's back wall) the incoming velocity is q = m * in.
     double rc = s.r0;
     double yc = s.y0;
     for (int events = 0; rc < s.r1; ++events) {
       const double len = s.r1 - rc;
-      const double q = n * yc, qm = n * s.slope;
       if (events > 16) {  // cannot happen with exact roots; safety against a float cycle
         emit(side, k, rc, s.r1, yc, s.slope, state.closed, state.closed, state);
         break;
       }
       if (state.closed) {
-        const double sr = release_time(q, qm);
+        const double m = state.side * n;
+        const double sr = release_time(m * yc, m * s.slope);
         if (sr <= tol) {
           state.closed = false;
           continue;
@@ -202,11 +203,21 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
         yc = 0.0;  // the force vanishes exactly at release
         state.closed = false;
       } else {
-        const double gap_left = std::max(0.0, model.gap - n * state.u);
-        const double sc = closure_time(gap_left, q, qm, tol);
+        const double q = n * yc, qm = n * s.slope;
+        double sc = closure_time(std::max(0.0, model.gap - n * state.u), q, qm, tol);
+        int wall = 1;
+        if (model.has_back_wall()) {
+          const double sb = closure_time(std::max(0.0, model.gap_back + n * state.u), -q, -qm, tol);
+          if (sb < sc) {
+            sc = sb;
+            wall = -1;
+          }
+        }
+        const double wall_u = wall > 0 ? n * model.gap : -n * model.gap_back;
         if (sc <= tol) {
           state.closed = true;
-          state.u = n * model.gap;
+          state.side = wall;
+          state.u = wall_u;
           state.u_compensation = 0;
           continue;
         }
@@ -218,7 +229,8 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
         yc += s.slope * sc;
         rc += sc;
         state.closed = true;
-        state.u = n * model.gap;  // the wall position, exactly
+        state.side = wall;
+        state.u = wall_u;  // the wall position, exactly
         state.u_compensation = 0;
       }
     }
@@ -235,7 +247,8 @@ void ExactBarSolution::emit(Side side, long k, double r0, double r1, double in0,
   const double out0 = sign * in0, out_slope = sign * in_slope;
   auto& track = side == Side::right ? right_ : left_;
   auto& other = side == Side::right ? b_sig_ : a_;
-  track.segments.push_back({k, r0, r1, in0, in_slope, out0, out_slope, state.u, closed});
+  track.segments.push_back(
+      {k, r0, r1, in0, in_slope, out0, out_slope, state.u, closed, closed && state.side < 0});
   if (!reflect_negative) {  // free: the end moves with v = incoming
     const double len = r1 - r0;
     // Compensated sum: a free end adds one increment per segment for the whole run.
@@ -465,10 +478,10 @@ std::vector<ContactInterval> ExactBarSolution::contact_intervals(Side side) cons
     if (!(t_close < t_end_)) break;
     if (!track[i].closed) continue;
     std::size_t j = i;
-    while (j + 1 < track.size() && track[j + 1].closed) ++j;
+    while (j + 1 < track.size() && track[j + 1].closed && track[j + 1].back == track[i].back) ++j;
     double release = j + 1 < track.size() ? global_time(track[j + 1].k, track[j + 1].r0) : infinity;
     if (release > t_end_) release = infinity;
-    out.push_back({t_close, release});
+    out.push_back({t_close, release, track[i].back});
     i = j;
   }
   return out;

@@ -34,6 +34,7 @@ enum class Side { left, right };
 struct ContactInterval {
   double t_close = 0;
   double t_release = 0;  // +infinity if the end is still closed at the solution's t_end
+  bool back_wall = false;  // on the wall behind a clearance end
 };
 
 class ExactBarSolution {
@@ -93,6 +94,7 @@ class ExactBarSolution {
     double in0, in_slope, out0, out_slope;
     double u0;
     bool closed;
+    bool back;  // closed on the back wall of a clearance end
   };
   // Segments in time order with the index of the first segment of each window.
   template <class Seg>
@@ -107,6 +109,7 @@ class ExactBarSolution {
   };
   struct EndState {
     bool closed = false;
+    int side = 1;               // the wall of a closed end: +1 front, -1 back (clearance)
     double u = 0;               // displacement of the end
     double u_compensation = 0;  // Kahan: low-order part lost when adding to u
   };

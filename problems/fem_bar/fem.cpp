@@ -116,11 +116,18 @@ class CentralDifference {
       u_next_[node] = 0;
       return 0;
     }
-    if (end.type != bar::EndType::contact) return 0;
+    if (!end.has_wall()) return 0;
     const double penetration = normal * u_next_[node] - end.gap;
-    if (!(penetration > 0)) return 0;  // the multiplier would be tensile (or zero): no contact
-    u_next_[node] = normal * end.gap;
-    return mass_[node] * penetration / (dt_ * dt_);
+    if (penetration > 0) {
+      u_next_[node] = normal * end.gap;
+      return mass_[node] * penetration / (dt_ * dt_);
+    }
+    // The back wall of a clearance end: the same projection from the other side; the
+    // multiplier is tensile (negative compressive force).
+    const double behind = -normal * u_next_[node] - end.gap_back;
+    if (!end.has_back_wall() || !(behind > 0)) return 0;
+    u_next_[node] = -normal * end.gap_back;
+    return -mass_[node] * behind / (dt_ * dt_);
   }
 
   const bar::BarSetup& setup_;
@@ -137,7 +144,8 @@ void check_setup(const bar::BarSetup& setup) {
   const double L = setup.material.length;
   double scale = 0;
   for (double y : setup.u0.values()) scale = std::max(scale, std::abs(y));
-  scale = std::max({scale, setup.left.gap, setup.right.gap, 1e-300});
+  scale = std::max({scale, setup.left.gap, setup.right.gap, setup.left.gap_back,
+                    setup.right.gap_back, 1e-300});
   auto check_fixed = [&](const bar::End& end, double x, const char* which) {
     if (end.type == bar::EndType::fixed && std::abs(setup.u0(x)) > 1e-12 * scale)
       throw InputError("u0", fmt::format("u0 = {} at the fixed {} end (x = {}) must be 0",

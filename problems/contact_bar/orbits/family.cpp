@@ -106,6 +106,109 @@ bar::PiecewiseLinear ContactFamily::u0(double energy) const {
   return bar::PiecewiseLinear(std::move(x), std::move(y));
 }
 
+ClearanceMode::ClearanceMode(const bar::Material& material, double gap, double gap_back, int mode)
+    : material_(material), gap_(gap), gap_back_(gap_back), mode_(mode) {
+  if (mode < 1) throw core::InputError("mode", fmt::format("must be >= 1 (got {})", mode));
+  if (!(gap > 0) || !std::isfinite(gap))
+    throw core::InputError("gap", fmt::format("the clearance modes need a gap > 0 (got {})", gap));
+  if (!(gap_back >= gap) || !std::isfinite(gap_back))
+    throw core::InputError("gap_back",
+                           fmt::format("the clearance modes start on the nearer wall, the front "
+                                       "one: gap_back >= gap = {} (got {}); mirror the scene",
+                                       gap, gap_back));
+}
+
+double ClearanceMode::slope(double energy) const {
+  return std::sqrt(2 * energy / (material_.axial_stiffness() * material_.length));
+}
+
+double ClearanceMode::grazing_energy() const {
+  const double g = (2 * mode_ - 1) * gap_;
+  return material_.axial_stiffness() * g * g / (2 * material_.length);
+}
+
+double ClearanceMode::back_grazing_energy() const {
+  const double g = mode_ * gap_back_ + (mode_ - 1) * gap_;
+  return material_.axial_stiffness() * g * g / (2 * material_.length);
+}
+
+// Derivation (README.md, 'Modes in a clearance'; c = L = 1, H as in 'Mode J'): H T-periodic,
+// -h for A and +h for B. With 2 = J T - delta the shift by 2 is -delta modulo T: where
+// H(t - delta) = H(t) the end is closed (front while H = -h, back while H = +h), elsewhere free,
+// so each wall holds for A - delta resp. B - delta and the flights last delta. The walls:
+// w = int_t^{t+2} H at the start of each phase gives J h (B - A) + h delta = g and
+// J h (B - A) - h delta = -g_back, so delta = gamma + gamma_b, A = (1 + gamma_b) / J,
+// B = (1 + gamma) / J. The back phase exists while B > delta; at B = delta, A equals mode J's
+// one-sided A, so the two regimes join continuously.
+double ClearanceMode::period(double energy) const {
+  const double s = slope(energy), length = material_.length, c = material_.wave_speed();
+  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s)) return std::nan("");
+  const double j = mode_, gamma = gap_ / (s * length), gamma_b = gap_back_ / (s * length);
+  if (energy <= back_grazing_energy()) return ContactFamily(material_, gap_, mode_).period(energy);
+  return (2 + gamma + gamma_b) * length / (j * c);
+}
+
+double ClearanceMode::frequency(double energy) const {
+  return 2 * std::numbers::pi / period(energy);
+}
+
+double ClearanceMode::front_contact(double energy) const {
+  const double s = slope(energy), length = material_.length, c = material_.wave_speed();
+  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s)) return std::nan("");
+  const double j = mode_, gamma = gap_ / (s * length), gamma_b = gap_back_ / (s * length);
+  const double b = (1 + gamma) / j;
+  if (energy <= back_grazing_energy())
+    return ((j + 1 - (j - 1) * gamma) / (j * j) - b) * length / c;  // one-sided: A - B
+  return ((1 + gamma_b) / j - gamma - gamma_b) * length / c;
+}
+
+double ClearanceMode::back_contact(double energy) const {
+  const double s = slope(energy), length = material_.length, c = material_.wave_speed();
+  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s)) return std::nan("");
+  if (energy <= back_grazing_energy()) return 0;
+  const double j = mode_, gamma = gap_ / (s * length), gamma_b = gap_back_ / (s * length);
+  return ((1 + gamma) / j - gamma - gamma_b) * length / c;
+}
+
+std::vector<double> ClearanceMode::kinks(double energy) const {
+  const double length = material_.length, c = material_.wave_speed();
+  const double front = front_contact(energy), t = period(energy);
+  std::vector<double> at;
+  if (!std::isfinite(front)) return at;
+  const double gamma = gap_ / (slope(energy) * length);
+  // In units of L: C/2 + k T and C/2 + B + k T from the end, the first J of them.
+  const double half = 0.5 * front * c / length, p = t * c / length, b = (1 + gamma) / mode_;
+  for (int k = 0; static_cast<int>(at.size()) < mode_; ++k) {
+    at.push_back(length * (1 - (half + k * p)));
+    if (static_cast<int>(at.size()) < mode_) at.push_back(length * (1 - (half + b + k * p)));
+  }
+  std::reverse(at.begin(), at.end());
+  return at;
+}
+
+bar::PiecewiseLinear ClearanceMode::u0(double energy) const {
+  const double length = material_.length, s = slope(energy);
+  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s))
+    throw core::InputError("energy",
+                           fmt::format("clearance mode {} exists from its grazing energy {} (got "
+                                       "{})",
+                                       mode_, grazing_energy(), energy));
+  const std::vector<double> at = kinks(energy);
+  // From the end, on the front wall: slope -s back to the first kink, +s to the next...
+  std::vector<double> x{length}, y{gap_};
+  double sign = -1;
+  for (auto k = at.rbegin(); k != at.rend(); ++k) {
+    y.push_back(y.back() - sign * s * (x.back() - *k));
+    x.push_back(*k);
+    sign = -sign;
+  }
+  x.push_back(0.0);
+  y.push_back(0.0);  // u0(0) = 0 exactly (the sum of the segments rounds)
+  std::reverse(x.begin(), x.end());
+  std::reverse(y.begin(), y.end());
+  return bar::PiecewiseLinear(std::move(x), std::move(y));
+}
+
 double node_of(const bar::PiecewiseLinear& u0) {
   const auto& xs = u0.knots();
   const auto& ys = u0.values();

@@ -61,6 +61,49 @@ class ContactFamily {
   int mode_;
 };
 
+// Mode J of a bar whose end moves in a clearance: a front wall at gap g, a back wall at
+// gap_back >= g behind the rest position (README.md, section 'Modes in a clearance'). The orbit
+// starts at rest at the centre of a front contact phase, u0(L) = g, with J kinks; slopes +-s,
+// E = EA L s^2 / 2. With gamma = g / (s L), gamma_b = g_back / (s L), lengths in L, times in L/c:
+//   front grazing at s L = (2J - 1) g (the linear mode J, T = 4 / (2J - 1));
+//   back grazing at s L = J g_back + (J - 1) g; below it the orbit is mode J of the one-sided
+//   bar (ContactFamily), T = ((2J + 1) + gamma) / J^2; above it
+//   T = (2 + gamma + gamma_b) / J, a front phase of (1 + gamma_b) / J - gamma - gamma_b and a
+//   back phase of (1 + gamma) / J - gamma - gamma_b per period, free flights of
+//   gamma + gamma_b between them;
+//   kinks at L - x = C/2 + k T and C/2 + B + k T (k >= 0), C the front phase, B = (1 + gamma) / J.
+// The symmetric clearance (g_back = g) touches both walls from grazing on.
+//
+//   ClearanceMode m(material, 1e-3, 3e-3, 1);
+//   m.period(5e-5);  m.u0(5e-5);  m.back_grazing_energy();
+class ClearanceMode {
+ public:
+  // mode >= 1 (InputError "mode"); gap > 0 ("gap"); gap_back >= gap ("gap_back": the orbit
+  // starts on the nearer wall, the front one).
+  ClearanceMode(const bar::Material& material, double gap, double gap_back, int mode);
+
+  int mode() const { return mode_; }
+  double slope(double energy) const;  // s = sqrt(2E / (EA L))
+  double grazing_energy() const;      // the front wall: EA ((2J - 1) g)^2 / (2L)
+  double back_grazing_energy() const;
+  // Closed-form period and frequency; NaN below grazing.
+  double period(double energy) const;
+  double frequency(double energy) const;
+  // Contact phase durations per period on each wall [s] (0 for the back wall below its
+  // grazing energy); NaN below grazing.
+  double front_contact(double energy) const;
+  double back_contact(double energy) const;
+  // The J kinks of u0, increasing in x, and u0 itself (u0(0) = 0, u0(L) = g); InputError
+  // "energy" below grazing.
+  std::vector<double> kinks(double energy) const;
+  bar::PiecewiseLinear u0(double energy) const;
+
+ private:
+  bar::Material material_;
+  double gap_, gap_back_;
+  int mode_;
+};
+
 // Where a piecewise-linear u0 first changes sign from + to - (or - to +) inside (0, L),
 // linearly interpolated; NaN when it does not. The numerical counterpart of
 // ContactFamily::node.

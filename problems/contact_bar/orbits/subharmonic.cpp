@@ -17,31 +17,38 @@
 namespace backbone::contact_bar {
 
 ContactStructure contact_structure(const bar::BarSetup& setup, double period) {
-  if (setup.right.type != bar::EndType::contact || !(setup.right.gap > 0))
-    throw core::InputError("right", "the contact structure needs right = contact and gap > 0");
+  if (!setup.right.has_wall() || !(setup.right.gap > 0))
+    throw core::InputError("right", "the contact structure needs right = contact or clearance "
+                                    "and gap > 0");
   ContactStructure result;
   const exact_bar::ExactBarSolution sol(setup, period);
   if (!sol.ok()) return result;
   result.ok = true;
   const double g0 = setup.right.gap, tol = 1e-9 * period;
   const auto intervals = sol.contact_intervals(exact_bar::Side::right);
-  std::vector<std::pair<double, double>> phases;
-  for (const auto& c : intervals) {
-    const double release = std::min(c.t_release, period);
-    if (release - c.t_close > tol) phases.emplace_back(c.t_close, release);
-  }
-  // A phase through t = 0 = T appears as [0, a) and [T - a', T): one phase.
-  if (phases.size() >= 2 && phases.front().first <= tol && phases.back().second >= period - tol) {
-    result.first_contact = phases.front().second + (period - phases.back().first);
-    phases.pop_back();
-  } else if (!phases.empty() && phases.front().first <= tol) {
-    result.first_contact = phases.front().second;
-  }
-  result.contact_phases = static_cast<int>(phases.size());
+  // The phases on one wall; a phase through t = 0 = T appears as [0, a) and [T - a', T): one
+  // phase. Returns the count and the duration of the phase that contains t = 0.
+  auto phases_on = [&](bool back, double& first_contact) {
+    std::vector<std::pair<double, double>> phases;
+    for (const auto& c : intervals) {
+      const double release = std::min(c.t_release, period);
+      if (c.back_wall == back && release - c.t_close > tol) phases.emplace_back(c.t_close, release);
+    }
+    if (phases.size() >= 2 && phases.front().first <= tol && phases.back().second >= period - tol) {
+      first_contact = phases.front().second + (period - phases.back().first);
+      phases.pop_back();
+    } else if (!phases.empty() && phases.front().first <= tol) {
+      first_contact = phases.front().second;
+    }
+    return static_cast<int>(phases.size());
+  };
+  result.contact_phases = phases_on(false, result.first_contact);
+  double unused = 0;
+  result.back_contact_phases = phases_on(true, unused);
   // Closed during a phase; a closed interval shorter than tol is a grazing instant.
   auto closed_at = [&](double t) {
     for (const auto& c : intervals)
-      if (std::min(c.t_release, period) - c.t_close > tol && t >= c.t_close - tol &&
+      if (!c.back_wall && std::min(c.t_release, period) - c.t_close > tol && t >= c.t_close - tol &&
           t <= std::min(c.t_release, period) + tol)
         return true;
     return false;
@@ -49,9 +56,12 @@ ContactStructure contact_structure(const bar::BarSetup& setup, double period) {
   const int samples = 4000;
   std::vector<double> u(samples + 1);
   result.min_gap = std::numeric_limits<double>::infinity();
+  const bool back_wall = setup.right.has_back_wall();
+  if (back_wall) result.min_back_gap = std::numeric_limits<double>::infinity();
   for (int i = 0; i <= samples; ++i) {
     u[i] = sol.u_end(exact_bar::Side::right, period * i / samples);
     result.min_gap = std::min(result.min_gap, g0 - u[i]);
+    if (back_wall) result.min_back_gap = std::min(result.min_back_gap, setup.right.gap_back + u[i]);
   }
   // Local maxima of the (periodic) end displacement, refined by ternary search.
   for (int i = 0; i < samples; ++i) {

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 
 #include "continuation/branch.hpp"
 #include "problems/bar/bar.hpp"
@@ -29,9 +30,14 @@ struct ContactStructure {
   int grazing_instants = 0;  // instants where the open end reaches the wall and leaves it
   double min_gap = 0;        // min over the period of g0 - u(L, t) [m]
   double first_contact = 0;  // duration of the phase that contains t = 0 (0 if none) [s]
+  // A clearance end: phases on the wall behind it, and min over the period of
+  // gap_back + u(L, t) on the 4000-sample scan [m] (NaN without a back wall).
+  int back_contact_phases = 0;
+  double min_back_gap = std::numeric_limits<double>::quiet_NaN();
 };
 
-// The observed (right) end must be a contact end with a gap > 0 (InputError "right" otherwise).
+// The observed (right) end must be a contact or clearance end with a gap > 0 (InputError "right"
+// otherwise); contact_phases and grazing_instants count the front wall.
 // Grazing: a local maximum of u(L, t) off the contact phases within 1e-9 g0 of the wall, located
 // by refining the local maxima of a 4000-sample scan (u(L, t) is piecewise linear).
 ContactStructure contact_structure(const bar::BarSetup& setup, double period);

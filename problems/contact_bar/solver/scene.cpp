@@ -43,11 +43,14 @@ po::options_description scene_keys() {
       "density", po::value<double>()->default_value(1.0), "density rho [kg/m^3] (> 0)")(
       "area", po::value<double>()->default_value(1.0), "cross-section area A [m^2] (> 0)")(
       "left_end", po::value<std::string>()->default_value("fixed"),
-      "end condition at x = 0: fixed | free | contact")(
+      "end condition at x = 0: fixed | free | contact | clearance")(
       "right_end", po::value<std::string>()->default_value("contact"),
-      "end condition at x = L: fixed | free | contact")(
+      "end condition at x = L: fixed | free | contact | clearance (between two walls)")(
       "gap", po::value<double>()->default_value(0.0),
-      "distance from a contact end to its wall at rest [m] (>= 0)")(
+      "distance from a contact or clearance end to its (front) wall at rest [m] (>= 0)")(
+      "gap_back", po::value<double>()->default_value(0.0),
+      "distance from a clearance end to the wall behind it at rest [m] (> 0 with a clearance "
+      "end, else 0)")(
       "body_force", po::value<double>()->default_value(0.0),
       "constant body force per unit volume along +x [N/m^3]")(
       "u0", po::value<std::string>()->default_value(""),
@@ -134,8 +137,16 @@ bar::BarSetup bar_from_scene(const core::Scene& scene) {
   s.material.density = within_double_range("density", scene.positive("density"));
   s.material.area = within_double_range("area", scene.positive("area"));
   const double gap = within_double_range("gap", scene.non_negative("gap"));
-  s.left = {bar::parse_end_type("left_end", scene.text("left_end")), gap};
-  s.right = {bar::parse_end_type("right_end", scene.text("right_end")), gap};
+  const double gap_back = within_double_range("gap_back", scene.non_negative("gap_back"));
+  s.left = {bar::parse_end_type("left_end", scene.text("left_end")), gap, gap_back};
+  s.right = {bar::parse_end_type("right_end", scene.text("right_end")), gap, gap_back};
+  const bool clearance = s.left.has_back_wall() || s.right.has_back_wall();
+  if (clearance && !(gap_back > 0))
+    throw InputError("gap_back", "must be > 0 with a clearance end (got 0)");
+  if (!clearance && gap_back != 0)
+    throw InputError("gap_back", fmt::format("is read only with left_end or right_end = "
+                                             "clearance (got {} with neither)",
+                                             gap_back));
   s.body_force = within_double_range("body_force", scene.number("body_force"));
   s.u0 = bar::PiecewiseLinear::zero(s.material.length);
   s.v0 = bar::PiecewiseLinear::zero(s.material.length);

@@ -133,13 +133,16 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
     for (double v : f->values())
       gauge_scale_ = std::max(gauge_scale_, std::abs(v) * (f == &setup_.u0 ? 1.0 : tau_));
   gauge_scale_ = std::max(
-      {gauge_scale_, setup_.left.gap, setup_.right.gap, std::abs(body_coef_) * c_ * tau_ * tau_});
+      {gauge_scale_, setup_.left.gap, setup_.right.gap, setup_.left.gap_back,
+       setup_.right.gap_back, std::abs(body_coef_) * c_ * tau_ * tau_});
   const bar::End* end_of[2] = {&setup_.left, &setup_.right};
   for (int e = 0; e < 2; ++e) {
     EndState& E = ends_[e];
     E.end = *end_of[e];
     E.normal = e == 0 ? -1.0 : 1.0;
-    E.wall = E.end.type == bar::EndType::contact ? E.normal * E.end.gap : 0.0;
+    E.wall = E.end.has_wall() ? E.normal * E.end.gap : 0.0;
+    E.has_back = E.end.has_back_wall();
+    E.wall_back = E.has_back ? -E.normal * E.end.gap_back : 0.0;
     const double u = setup_.u0(e == 0 ? 0.0 : L_);
     if (E.end.type == bar::EndType::fixed && u != 0)
       throw InputError("u0", fmt::format("u0 must vanish at the fixed end x = {} (got {})",
@@ -148,14 +151,19 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
     E.knots.reserve(static_cast<std::size_t>(2 * tau_grid_.step) + setup_.u0.knots().size() +
                     setup_.v0.knots().size() + 64);
     E.knots.push_back({GridTime{}, u, 0.0, 0.5 * u, 0.0, false});
-    E.closed = E.end.type == bar::EndType::contact && E.normal * (u - E.wall) >= 0;
-    if (E.closed) {
-      // A state that starts on the wall (a subharmonic member at the centre of a contact
-      // phase): the force at t = 0 is the initial compressive strain, -EA n u0_x at the end.
-      const double inward_slope = e == 0 ? setup_.u0.slope(0.0, +1) : setup_.u0.slope(L_, -1);
-      E.force = std::max(0.0, -ea_ * E.normal * inward_slope);
+    E.closed = E.end.has_wall() && E.normal * (u - E.wall) >= 0;
+    if (!E.closed && E.has_back && -E.normal * (u - E.wall_back) >= 0) {
+      E.closed = true;
+      E.side = -1;
     }
-    E.contact_u = E.wall;
+    if (E.closed) {
+      // A state that starts on a wall (a subharmonic member at the centre of a contact
+      // phase): the force at t = 0 is the initial strain, -EA n u0_x at the end, compressive on
+      // the front wall and tensile on the back one.
+      const double inward_slope = e == 0 ? setup_.u0.slope(0.0, +1) : setup_.u0.slope(L_, -1);
+      E.force = E.side * std::max(0.0, -E.side * ea_ * E.normal * inward_slope);
+    }
+    E.contact_u = E.wall_at(E.side);
     if (method_ == ContactMethod::event) {
       // Kinks of R_e inside (0, tau]: data knots reaching the end, and the end of the IC term.
       // Each function's arrival times increase along its knots (from x = 0 for end 0, from
@@ -302,18 +310,25 @@ void TdbemMarch::step_end(int e, GridTime ta, GridTime tb) {
         E.force = 0;
         push_knot(e, tb, 2 * r + c_ * a.s, a.s, false);
         break;
-      case bar::EndType::contact: {
+      case bar::EndType::contact:
+      case bar::EndType::clearance: {
         const double u_free = 2 * r + c_ * a.s;
-        const double penetration = E.normal * (u_free - E.wall);
-        // On the wall counts as closed, as at t = 0 (the grid reproduces mode 1's onset 1.1
+        // On a wall counts as closed, as at t = 0 (the grid reproduces mode 1's onset 1.1
         // exactly: u_free(1.1) is the wall to the last bit).
-        const bool closed = penetration >= 0;
-        if (closed && !E.closed) events_.push_back({seconds(tb), e == 1, true});
-        if (!closed && E.closed) events_.push_back({seconds(ta), e == 1, false});
+        int side = E.normal * (u_free - E.wall) >= 0 ? 1 : 0;
+        if (side == 0 && E.has_back && -E.normal * (u_free - E.wall_back) >= 0) side = -1;
+        const bool closed = side != 0;
+        if (E.closed && (!closed || side != E.side))
+          events_.push_back({seconds(ta), e == 1, false, E.side < 0});
+        if (closed && (!E.closed || side != E.side))
+          events_.push_back({seconds(tb), e == 1, true, side < 0});
         E.closed = closed;
         if (closed) {
-          E.force = ea_ * penetration / (c_ * h);
-          push_knot(e, tb, E.wall, (E.wall - 2 * r) / c_, false);
+          E.side = side;
+          const double wall = E.wall_at(side);
+          // Signed: compressive on the front wall, tensile on the back one.
+          E.force = ea_ * E.normal * (u_free - wall) / (c_ * h);
+          push_knot(e, tb, wall, (wall - 2 * r) / c_, false);
         } else {
           E.force = 0;
           push_knot(e, tb, u_free, a.s, false);
@@ -366,6 +381,7 @@ void TdbemMarch::substep_event(int e, GridTime ta, GridTime tb, bool kink_at_end
       push_knot(e, tb, 2 * r_end(e, tb) + c_ * a.s, a.s, kink_at_end);
       return;
     case bar::EndType::contact:
+    case bar::EndType::clearance:
       if (E.closed) {
         solve_closed_to(e, ta, tb, kink_at_end);
       } else {
@@ -376,22 +392,33 @@ void TdbemMarch::substep_event(int e, GridTime ta, GridTime tb, bool kink_at_end
 }
 
 // Open end over [ta, tb] (no kink of R inside): free motion unless the free displacement
-// crosses the wall, in which case the step is split at the crossing. Local times in steps.
+// crosses a wall, in which case the step is split at the crossing. Local times in steps.
+// A clearance end's two walls are gap + gap_back apart, so one sub-step of free motion (linear
+// in t, quadratic with a body force) ends beyond at most one of them: the one it crossed.
 void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   EndState& E = ends_[e];
   const Knot a = E.knots.back();
   const double h = steps_between(tb, ta);
-  const double n = E.normal;
-  auto gap_violation = [&](GridTime t) { return n * (2 * r_end(e, t) + c_ * a.s - E.wall); };
   const double r_b = r_end(e, tb);  // R_e(tb), used below (a pure function of the history)
-  const double pb = n * (2 * r_b + c_ * a.s - E.wall);
+  const double u_b = 2 * r_b + c_ * a.s;
+  // n: the outward normal of the wall in question (the end's for the front wall, its opposite
+  // for the back one), so that a violation n (u - wall) > 0 is a penetration of either.
+  double n = E.normal, wall = E.wall;
+  if (E.has_back && !(n * (u_b - wall) > 0) && -n * (u_b - E.wall_back) > 0) {
+    n = -n;
+    wall = E.wall_back;
+  }
+  auto gap_violation = [&](GridTime t) { return n * (2 * r_end(e, t) + c_ * a.s - wall); };
+  const double pb = n * (u_b - wall);
   if (!(pb > 0)) {
     E.force = 0;
-    push_knot(e, tb, 2 * r_b + c_ * a.s, a.s, kink_at_end);
+    push_knot(e, tb, u_b, a.s, kink_at_end);
     return;
   }
+  E.side = n == E.normal ? 1 : -1;
+  const bool back = E.side < 0;
   // Crossing: the free displacement is linear in t (quadratic with a body force).
-  const double pa = std::min(n * (a.u - E.wall), 0.0);
+  const double pa = std::min(n * (a.u - wall), 0.0);
   const double pm = gap_violation(later(ta, 0.5 * h));
   const double alpha = (4 * pm - 3 * pa - pb) / h;
   const double beta = 2 * (pa - 2 * pm + pb) / (h * h);
@@ -416,23 +443,23 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   if (root <= root_snap_steps) {  // closed from ta
     E.contact_u = a.u;
     mark_kink(e);
-    events_.push_back({seconds(ta), e == 1, true});
+    events_.push_back({seconds(ta), e == 1, true, back});
     const double s = (E.contact_u - 2 * r_b) / c_;
-    E.force = -ea_ * n * (s - a.s) / seconds_between(tb, ta);
+    E.force = -ea_ * E.normal * (s - a.s) / seconds_between(tb, ta);
     push_knot(e, tb, E.contact_u, s, kink_at_end);
     return;
   }
   if (h - root <= root_snap_steps) {  // open up to tb, closed from tb
-    E.contact_u = 2 * r_b + c_ * a.s;
+    E.contact_u = u_b;
     E.force = 0;
-    events_.push_back({seconds(tb), e == 1, true});
+    events_.push_back({seconds(tb), e == 1, true, back});
     push_knot(e, tb, E.contact_u, a.s, true);
     return;
   }
   const GridTime t_close = later(ta, root);
-  E.contact_u = E.wall;
-  push_knot(e, t_close, E.wall, a.s, true);
-  events_.push_back({seconds(t_close), e == 1, true});
+  E.contact_u = wall;
+  push_knot(e, t_close, wall, a.s, true);
+  events_.push_back({seconds(t_close), e == 1, true, back});
   solve_closed_to(e, t_close, tb, kink_at_end);
 }
 
@@ -443,7 +470,8 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
   EndState& E = ends_[e];
   const Knot a = E.knots.back();
   const double h = steps_between(tb, ta);
-  const double n = E.normal;
+  const double n = E.side * E.normal;  // the wall's outward normal (solve_open)
+  const bool back = E.side < 0;
   auto gap_violation = [&](GridTime t) { return n * (2 * r_end(e, t) + c_ * a.s - E.contact_u); };
   // gap_violation(ta) = 0 on the wall; the force over [ta, t] is EA * violation(t) / (c (t-ta)).
   const double pm = gap_violation(later(ta, 0.5 * h));
@@ -453,11 +481,11 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
   const double beta = 2 * (pb - 2 * pm) / (h * h);
   auto closed_step = [&](GridTime t_end, bool kink) {
     const double s = (E.contact_u - 2 * (t_end == tb ? r_b : r_end(e, t_end))) / c_;
-    E.force = -ea_ * n * (s - a.s) / seconds_between(t_end, ta);
+    E.force = -ea_ * E.normal * (s - a.s) / seconds_between(t_end, ta);
     push_knot(e, t_end, E.contact_u, s, kink);
   };
   if (alpha < 0 && pb < 0) {
-    events_.push_back({seconds(ta), e == 1, false});
+    events_.push_back({seconds(ta), e == 1, false, back});
     E.closed = false;
     mark_kink(e);
     solve_open(e, ta, tb, kink_at_end);
@@ -469,14 +497,14 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
     if (release > root_snap_steps && h - release > root_snap_steps) {
       const GridTime t_release = later(ta, release);
       closed_step(t_release, true);
-      events_.push_back({seconds(t_release), e == 1, false});
+      events_.push_back({seconds(t_release), e == 1, false, back});
       E.closed = false;
       solve_open(e, t_release, tb, kink_at_end);
       return;
     }
   }
   if (pb < 0) {  // tensile over the whole sub-step: release at ta
-    events_.push_back({seconds(ta), e == 1, false});
+    events_.push_back({seconds(ta), e == 1, false, back});
     E.closed = false;
     mark_kink(e);
     solve_open(e, ta, tb, kink_at_end);

@@ -51,7 +51,8 @@ ContactMethod parse_contact_method(const std::string& key, const std::string& va
 struct ContactEvent {
   double t = 0;
   bool right_end = true;
-  bool closing = true;  // false: release
+  bool closing = true;     // false: release
+  bool back_wall = false;  // the wall behind a clearance end
 };
 
 // The boundary march with its history window; the field at the current time on demand.
@@ -188,7 +189,11 @@ class TdbemMarch {
     bar::End end;
     double normal = 1;     // outward normal
     double wall = 0;       // wall position n * gap
+    double wall_back = 0;  // a clearance end's back wall, -n * gap_back
+    bool has_back = false;
+    int side = 1;          // the wall of a closed end: +1 the front one, -1 the back one
     double contact_u = 0;  // U held while closed: the wall, or a round-off off it (solve_open)
+    double wall_at(int s) const { return s > 0 ? wall : wall_back; }
     Fifo<Knot> knots;
     Fifo<GridTime> pending;  // times of kinks of R_e still ahead (event method)
     double force = 0;

@@ -11,6 +11,7 @@
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
+#include "problems/exact_bar/exact_solution.hpp"
 
 namespace {
 
@@ -155,3 +156,98 @@ TEST(ContactFamily, ModeJGrazesAtTheLinearPeriodAndHardensToItsLimit) {
 }
 
 }  // namespace
+
+// The clearance modes (README.md, 'Modes in a clearance') against the exact characteristics
+// solver, which knows nothing of the derivation: after the closed-form period u0 is back and
+// v = 0; each wall holds for its closed-form duration once per period; the energy is
+// EA L s^2 / 2. Symmetric (gap_back = gap) and asymmetric (3 gap) clearances, below and above
+// the back wall's grazing energy, on the paper's bar and on one with L = 2, c = 2.
+TEST(ClearanceMode, ReturnsAfterItsPeriodWithOnePhaseOnEachWall) {
+  for (double gap : {1e-3, 5e-3}) {
+    bar::BarSetup setup;
+    setup.left = {bar::EndType::fixed, 0};
+    if (gap == 5e-3) {
+      setup.material.length = 2;
+      setup.material.youngs_modulus = 4;
+    }
+    const double length = setup.material.length, c = setup.material.wave_speed();
+    for (double back_factor : {1.0, 3.0}) {
+      setup.right = {bar::EndType::clearance, gap, back_factor * gap};
+      for (int mode : {1, 2, 3, 5}) {
+        const contact_bar::ClearanceMode family(setup.material, gap, back_factor * gap, mode);
+        // Symmetric: both walls from grazing on. Asymmetric: one-sided up to the back grazing.
+        EXPECT_NEAR(family.back_grazing_energy() / family.grazing_energy(),
+                    back_factor == 1 ? 1.0 : std::pow((4.0 * mode - 1) / (2 * mode - 1), 2), 1e-12);
+        for (double factor : {1.21, 1.9, 100.0}) {
+          const double energy = factor * family.grazing_energy();
+          const bool two_walls = energy > family.back_grazing_energy();
+          const bar::PiecewiseLinear u0 = family.u0(energy);
+          ASSERT_EQ(u0.knots().size(), static_cast<std::size_t>(mode + 2)) << mode;
+          const double s = family.slope(energy);
+          for (std::size_t k = 1; k < u0.knots().size(); ++k) {
+            const double slope =
+                (u0.values()[k] - u0.values()[k - 1]) / (u0.knots()[k] - u0.knots()[k - 1]);
+            // Each slope from two knot values a few L apart: round-off of s (the first
+            // segment ends on u0(0) = 0 set exactly, so it checks that the kinks add up).
+            EXPECT_NEAR(std::abs(slope) / s, 1, 1e-10) << "mode " << mode << " segment " << k;
+          }
+          EXPECT_EQ(u0(length), gap);
+          setup.u0 = u0;
+          const double period = family.period(energy);
+          const exact_bar::ExactBarSolution sol(setup, period);
+          ASSERT_TRUE(sol.ok()) << sol.message();
+          double worst_u = 0, worst_v = 0, scale = 0;
+          for (int i = 0; i <= 200; ++i) {
+            const double x = length * i / 200;
+            worst_u = std::max(worst_u, std::abs(sol.u(x, period) - u0(x)));
+            worst_v = std::max(worst_v, std::abs(sol.v(x, period)) * length / c);
+            scale = std::max(scale, std::abs(u0(x)));
+          }
+          // Piecewise-linear data, exact solver: round-off of some 1e2 characteristic crossings.
+          EXPECT_LT(worst_u / scale, 1e-11) << mode << " " << back_factor << " " << factor;
+          EXPECT_LT(worst_v / scale, 1e-11) << mode << " " << back_factor << " " << factor;
+          EXPECT_NEAR(sol.energy(0) / (0.5 * setup.material.axial_stiffness() * length * s * s), 1,
+                      1e-12);
+          // One phase per wall per period: the one through t = 0 = T (front) appears as
+          // [0, a) and [T - a', T]; the back one lies inside.
+          double front = 0, back = 0;
+          int back_phases = 0;
+          for (const auto& ci : sol.contact_intervals(exact_bar::Side::right)) {
+            const double d = std::min(ci.t_release, period) - ci.t_close;
+            if (ci.back_wall) {
+              back += d;
+              ++back_phases;
+            } else {
+              front += d;
+            }
+          }
+          EXPECT_EQ(back_phases, two_walls ? 1 : 0) << mode << " " << factor;
+          // Durations: instants of exact roots, a few ulps of the period.
+          EXPECT_NEAR(front, family.front_contact(energy), 1e-12 * period);
+          EXPECT_NEAR(back, family.back_contact(energy), 1e-12 * period);
+          if (!two_walls) {  // the one-sided mode J, whatever the clearance behind
+            EXPECT_NEAR(period, ContactFamily(setup.material, gap, mode).period(energy),
+                        1e-14 * period);
+          }
+        }
+      }
+    }
+  }
+}
+
+// At the linear grazing the symmetric clearance's mode J is the linear mode J (period
+// 4L / ((2J - 1) c)); far above it every mode tends to the fixed-fixed bar, T -> 2L / (J c).
+TEST(ClearanceMode, GrazesAtTheLinearPeriodAndTendsToTheFixedFixedBar) {
+  const bar::Material paper;  // c = L = 1
+  for (int mode : {1, 2, 3}) {
+    const contact_bar::ClearanceMode m(paper, 1e-3, 1e-3, mode);
+    EXPECT_NEAR(m.period(m.grazing_energy() * (1 + 1e-14)), 4.0 / (2 * mode - 1), 1e-12);
+    EXPECT_NEAR(m.period(1e24 * m.grazing_energy()), 2.0 / mode, 1e-10);  // gamma ~ 1e-12
+    // The asymmetric one is continuous where the back wall joins.
+    const contact_bar::ClearanceMode a(paper, 1e-3, 3e-3, mode);
+    const double e = a.back_grazing_energy();
+    EXPECT_NEAR(a.period(e * (1 + 1e-13)), a.period(e), 1e-12);
+    EXPECT_NEAR(a.back_contact(e * (1 + 1e-13)), 0, 1e-12);
+  }
+  EXPECT_THROW(contact_bar::ClearanceMode(paper, 3e-3, 1e-3, 1), core::InputError);
+}
