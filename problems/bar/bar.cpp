@@ -136,8 +136,9 @@ void BarSetup::validate() const {
     if (!std::isfinite(end.gap_back) || end.gap_back < 0)
       throw InputError("gap_back", fmt::format("must be >= 0 (got {})", end.gap_back));
     if (end.has_back_wall() && !(end.gap + end.gap_back > 0))
-      throw InputError("gap_back", "gap + gap_back must be > 0 for a clearance end (the two "
-                                   "walls may not coincide)");
+      throw InputError("gap_back",
+                       "gap + gap_back must be > 0 for a clearance end (the two "
+                       "walls may not coincide)");
   }
   if (!std::isfinite(body_force))
     throw InputError("body_force", fmt::format("must be finite (got {})", body_force));
@@ -155,8 +156,8 @@ void BarSetup::validate() const {
     throw InputError("u0",
                      fmt::format("u0(0) = {} penetrates the wall at gap {}", u0(0.0), left.gap));
   if (right.has_back_wall() && -u0(L) > right.gap_back * (1 + 1e-12) + 1e-300)
-    throw InputError("u0", fmt::format("u0(L) = {} penetrates the back wall at gap_back {}",
-                                       u0(L), right.gap_back));
+    throw InputError("u0", fmt::format("u0(L) = {} penetrates the back wall at gap_back {}", u0(L),
+                                       right.gap_back));
   if (left.has_back_wall() && u0(0.0) > left.gap_back * (1 + 1e-12) + 1e-300)
     throw InputError("u0", fmt::format("u0(0) = {} penetrates the back wall at gap_back {}",
                                        u0(0.0), left.gap_back));

@@ -9,10 +9,10 @@
 // contact force [N] (compression, u_x < 0, at either end). A clearance end moves between two
 // walls: the front one as above and a back one at outward distance gap_back behind it,
 //     gap_back + n u(end, t) >= 0,  -lambda >= 0,  (gap_back + n u) lambda = 0   (Signorini),
-// where the contact force is tensile (lambda < 0: the back wall pulls the end outwards). body_force is a constant force per unit
-// volume along +x [N/m^3]; its potential enters the energy: E = 1/2 int (rho A v^2 + EA u_x^2) dx -
-// int body_force A u dx. Initial displacement and velocity are piecewise linear (knots may be
-// anywhere in [0, L]).
+// where the contact force is tensile (lambda < 0: the back wall pulls the end outwards). body_force
+// is a constant force per unit volume along +x [N/m^3]; its potential enters the energy: E = 1/2
+// int (rho A v^2 + EA u_x^2) dx - int body_force A u dx. Initial displacement and velocity are
+// piecewise linear (knots may be anywhere in [0, L]).
 //
 //   bar::BarSetup s;
 //   s.material = {1.0, 1.0, 1.0, 1.0};                     // L, E, rho, A  (c = 1)

@@ -33,7 +33,7 @@ enum class Side { left, right };
 // One closed-contact episode of an end: closed on [t_close, t_release).
 struct ContactInterval {
   double t_close = 0;
-  double t_release = 0;  // +infinity if the end is still closed at the solution's t_end
+  double t_release = 0;    // +infinity if the end is still closed at the solution's t_end
   bool back_wall = false;  // on the wall behind a clearance end
 };
 

@@ -144,8 +144,8 @@ void check_setup(const bar::BarSetup& setup) {
   const double L = setup.material.length;
   double scale = 0;
   for (double y : setup.u0.values()) scale = std::max(scale, std::abs(y));
-  scale = std::max({scale, setup.left.gap, setup.right.gap, setup.left.gap_back,
-                    setup.right.gap_back, 1e-300});
+  scale = std::max(
+      {scale, setup.left.gap, setup.right.gap, setup.left.gap_back, setup.right.gap_back, 1e-300});
   auto check_fixed = [&](const bar::End& end, double x, const char* which) {
     if (end.type == bar::EndType::fixed && std::abs(setup.u0(x)) > 1e-12 * scale)
       throw InputError("u0", fmt::format("u0 = {} at the fixed {} end (x = {}) must be 0",

@@ -18,8 +18,9 @@ namespace backbone::contact_bar {
 
 ContactStructure contact_structure(const bar::BarSetup& setup, double period) {
   if (!setup.right.has_wall() || !(setup.right.gap > 0))
-    throw core::InputError("right", "the contact structure needs right = contact or clearance "
-                                    "and gap > 0");
+    throw core::InputError("right",
+                           "the contact structure needs right = contact or clearance "
+                           "and gap > 0");
   ContactStructure result;
   const exact_bar::ExactBarSolution sol(setup, period);
   if (!sol.ok()) return result;

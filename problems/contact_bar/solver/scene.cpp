@@ -50,9 +50,8 @@ po::options_description scene_keys() {
       "distance from a contact or clearance end to its (front) wall at rest [m] (>= 0)")(
       "gap_back", po::value<double>()->default_value(0.0),
       "distance from a clearance end to the wall behind it at rest [m] (> 0 with a clearance "
-      "end, else 0)")(
-      "body_force", po::value<double>()->default_value(0.0),
-      "constant body force per unit volume along +x [N/m^3]")(
+      "end, else 0)")("body_force", po::value<double>()->default_value(0.0),
+                      "constant body force per unit volume along +x [N/m^3]")(
       "u0", po::value<std::string>()->default_value(""),
       "initial displacement, knots \"x:u x:u ...\" (x in [0, L] [m], u [m]; empty = 0)")(
       "v0", po::value<std::string>()->default_value(""),

@@ -132,9 +132,8 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
   for (const auto* f : {&setup_.u0, &setup_.v0})
     for (double v : f->values())
       gauge_scale_ = std::max(gauge_scale_, std::abs(v) * (f == &setup_.u0 ? 1.0 : tau_));
-  gauge_scale_ = std::max(
-      {gauge_scale_, setup_.left.gap, setup_.right.gap, setup_.left.gap_back,
-       setup_.right.gap_back, std::abs(body_coef_) * c_ * tau_ * tau_});
+  gauge_scale_ = std::max({gauge_scale_, setup_.left.gap, setup_.right.gap, setup_.left.gap_back,
+                           setup_.right.gap_back, std::abs(body_coef_) * c_ * tau_ * tau_});
   const bar::End* end_of[2] = {&setup_.left, &setup_.right};
   for (int e = 0; e < 2; ++e) {
     EndState& E = ends_[e];

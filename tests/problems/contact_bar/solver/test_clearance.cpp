@@ -92,7 +92,8 @@ TEST(Clearance, TdbemProjectionAndFemConvergeToTheExactSolver) {
   auto end_error = [&](const bar::History& h) {
     double worst = 0;
     for (std::size_t i = 0; i < h.t.size(); ++i)
-      worst = std::max(worst, std::abs(h.u_contact[i] - exact.u_end(exact_bar::Side::right, h.t[i])));
+      worst =
+          std::max(worst, std::abs(h.u_contact[i] - exact.u_end(exact_bar::Side::right, h.t[i])));
     return worst;
   };
   double previous_tdbem = 1, previous_fem = 1;
