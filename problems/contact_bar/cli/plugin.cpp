@@ -11,6 +11,7 @@
 #include "problems/contact_bar/bench/cases.hpp"
 #include "problems/contact_bar/bench/peers.hpp"
 #include "problems/contact_bar/cli/trace.hpp"
+#include "problems/contact_bar/figures/clearance.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/figures/resonance.hpp"
 #include "problems/contact_bar/figures/stability.hpp"
@@ -96,6 +97,25 @@ cli::ReproduceStep law_step(const std::string& name, const std::string& branch,
            "{out}/" + name}};
 }
 
+// Mode J of the clearance scene with the back wall at gap_back.
+cli::ReproduceStep clearance_step(const std::string& name, const std::string& branch,
+                                  const std::string& gap_back) {
+  return {name,
+          "trace",
+          {"problems/contact_bar/scenes/clearance.ini", "--branch", branch, "--gap_back", gap_back,
+           "--out", "{out}/" + name}};
+}
+
+// 10^4 periods of a clearance orbit (strain 0.01, orbits/README.md 'Modes in a clearance') by
+// TD-BEM with dt = 0.0073, no multiple of L/c: every contact instant is a fresh root.
+cli::ReproduceStep drift_step(const std::string& name, const std::string& gap_back,
+                              const std::string& u0, const std::string& period) {
+  return {name,
+          "simulate",
+          {"problems/contact_bar/scenes/clearance.ini", "--gap_back", gap_back, "--u0", u0,
+           "--period", period, "--periods", "10000", "--dt", "0.0073", "--out", "{out}/" + name}};
+}
+
 }  // namespace
 
 void register_plugin(cli::PluginRegistry& registry) {
@@ -105,6 +125,7 @@ void register_plugin(cli::PluginRegistry& registry) {
   p.figures = figure_jobs();
   for (cli::ProblemJob& job : resonance_figure_jobs()) p.figures.push_back(std::move(job));
   for (cli::ProblemJob& job : stability_figure_jobs()) p.figures.push_back(std::move(job));
+  for (cli::ProblemJob& job : clearance_figure_jobs()) p.figures.push_back(std::move(job));
   const std::string scenes = "problems/contact_bar/scenes/";
   p.reproduce = {
       {"bouncing_bar",
@@ -175,6 +196,20 @@ void register_plugin(cli::PluginRegistry& registry) {
        "trace",
        {scenes + "paper.ini", "--branch", "subharmonic_continuum4", "--out",
         "{out}/subharmonic_continuum4"}},
+      // The end in a clearance (problems/contact_bar/orbits/README.md, 'Modes in a
+      // clearance'): modes 1 and 2 with the back wall as far as the front one, and three times
+      // as far; then 10^4 periods of one orbit of each by TD-BEM, off the L/c lattice
+      // (dt = 0.0073), for the energy drift (figures: clearance_energy_drift.csv).
+      clearance_step("clearance_mode1", "mode1", "1e-3"),
+      clearance_step("clearance_mode2", "mode2", "1e-3"),
+      clearance_step("clearance_asym_mode1", "mode1", "3e-3"),
+      clearance_step("clearance_asym_mode2", "mode2", "3e-3"),
+      drift_step("clearance_drift_mode1", "1e-3", "0:0 0.55:0.0055 1:0.001", "2.2"),
+      drift_step("clearance_drift_mode2", "1e-3", "0:0 0.275:-0.00275 0.825:0.00275 1:0.001",
+                 "1.1"),
+      drift_step("clearance_drift_asym_mode1", "3e-3", "0:0 0.55:0.0055 1:0.001", "2.4"),
+      drift_step("clearance_drift_asym_mode2", "3e-3", "0:0 0.325:-0.00325 0.875:0.00225 1:0.001",
+                 "1.2"),
       // Other scenes, the bar changed (and u0, period and dt with it, so that each scene.ini
       // simulates too): the closed forms must hold there as well.
       {"mode1_short_bar",

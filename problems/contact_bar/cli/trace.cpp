@@ -40,6 +40,7 @@
 #include "problems/contact_bar/solver/scene.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
+#include "problems/exact_bar/exact_solution.hpp"
 
 namespace backbone::contact_bar {
 
@@ -220,13 +221,16 @@ void check_residual_work(const core::Scene& scene, const OrbitOptions& options) 
 }
 
 // The ends a contact-bar orbit needs, named by their scene keys: left_end fixed, right_end
-// contact with gap > 0.
-void check_orbit_ends(const bar::BarSetup& setup, const std::string& what) {
+// contact (or clearance, where allowed) with gap > 0.
+void check_orbit_ends(const bar::BarSetup& setup, const std::string& what,
+                      bool clearance_too = false) {
   if (setup.left.type != bar::EndType::fixed)
     throw core::InputError("left_end", fmt::format("{} need a fixed left end (got {})", what,
                                                    bar::to_string(setup.left.type)));
-  if (setup.right.type != bar::EndType::contact)
-    throw core::InputError("right_end", fmt::format("{} need right_end = contact (got {})", what,
+  if (setup.right.type != bar::EndType::contact &&
+      !(clearance_too && setup.right.type == bar::EndType::clearance))
+    throw core::InputError("right_end", fmt::format("{} need right_end = contact{} (got {})", what,
+                                                    clearance_too ? " or clearance" : "",
                                                     bar::to_string(setup.right.type)));
   if (!(setup.right.gap > 0))
     throw core::InputError("gap",
@@ -374,6 +378,116 @@ void describe_mode(cli::TraceSetup& s, const ContactBarOrbitProblem* p,
   };
 }
 
+// Mode J of a clearance end (problems/contact_bar/orbits/README.md, 'Modes in a clearance'):
+// started on the front wall at the centre of a contact phase (start_on_wall), its J kinks on J
+// free knots: the first J - 1 on the nodes nearest them at the start, the last (nearest the
+// end, at L - C/2 with C the front phase) on node N - 1, since C vanishes at grazing. The first
+// orbit has strain (1 + start_offset) times the grazing strain (2J - 1) g / L.
+cli::TraceSetup setup_clearance_mode(const core::Scene& scene, const bar::BarSetup& setup,
+                                     int mode) {
+  const ClearanceMode family(setup.material, setup.right.gap, setup.right.gap_back, mode);
+  if (scene.text("follow") != "none")
+    throw core::InputError("follow",
+                           "the clearance modes are traced without attached families "
+                           "(follow = none)");
+  OrbitOptions options = shooting_grid(scene);
+  options.start_on_wall = true;
+  const long knots = scene.integer("free_knots", -1);
+  if (knots >= 0 && knots != mode)
+    throw core::InputError("free_knots", fmt::format("clearance mode {} has {} kinks, one per "
+                                                     "knot: {} or -1 (got {})",
+                                                     mode, mode, mode, knots));
+  options.free_knots = mode;
+  if (options.elements < 2 * mode + 1)
+    throw core::InputError("shooting_elements",
+                           fmt::format("clearance mode {} needs at least {} intervals (got {})",
+                                       mode, 2 * mode + 1, options.elements));
+  const double length = setup.material.length;
+  const double strain =
+      (1 + scene.positive("start_offset")) * (2 * mode - 1) * setup.right.gap / length;
+  const double energy = 0.5 * setup.material.axial_stiffness() * length * strain * strain;
+  std::vector<double> kinks = family.kinks(energy);
+  kinks.back() = length;  // its node: N - 1; the others below it, strictly increasing
+  options.knot_nodes = nearest_knot_nodes(options.elements, length, kinks);
+  for (int j = mode - 1; j >= 0; --j)
+    options.knot_nodes[j] =
+        std::min(options.knot_nodes[j],
+                 j == mode - 1 ? options.elements - 1 : options.knot_nodes[j + 1] - 1);
+  if (const std::string nodes = scene.text("knot_nodes"); !nodes.empty()) {
+    options.knot_nodes =
+        core::parse_increasing_integers(nodes, "knot_nodes", 1, options.elements - 1, "a node");
+    if (static_cast<int>(options.knot_nodes.size()) != mode)
+      throw core::InputError("knot_nodes", fmt::format("needs one node per free knot ({}; got {})",
+                                                       mode, options.knot_nodes.size()));
+  }
+  const long test_elements = scene.integer("test_elements", -1);
+  options.test_elements =
+      static_cast<int>(test_elements < 0 ? 2 * options.state_size() : test_elements);
+  check_memory(scene, options);
+  options.amplitude_units = scene.flag("amplitude_units");
+
+  auto problem = std::make_unique<ContactBarOrbitProblem>(setup, shooting_solver(scene), options);
+  problem->set_monodromy_options(monodromy_options(scene));
+  cli::TraceSetup s;
+  // Where the back wall joins (gap_back > gap) the branch has a corner: u0(E) stays the same
+  // family of tents while T(E) changes slope, so every step across it turns by the corner's
+  // angle (35 degrees for mode 1 at 20 intervals). The turn check is raised to 60 degrees
+  // unless the scene gives it; each point is still checked by the exact oracle.
+  const bool turn_given = !scene.values()["max_turn_degrees"].defaulted();
+  const auto units = options.amplitude_units ? amplitude_unit_options(scene) : nullptr;
+  s.branch_options = [units, turn_given](continuation::ContinuationOptions& o,
+                                         core::NewtonOptions& newton) {
+    if (units) units(o, newton);
+    if (!turn_given) o.branch_points.max_turn_degrees = 60;
+  };
+  s.guess = problem->clearance_guess(mode, energy);
+  check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
+  s.direction = problem->clearance_guess(mode, energy * 1.02) - s.guess;
+  s.reject_point = return_check(scene, problem.get(), 4 * problem->state_size());
+  s.describe_point = [family](const continuation::BranchPoint& point) {
+    const double exact = family.frequency(point.observable("energy"));
+    return fmt::format("closed-form rel err {:.2e}",
+                       std::abs(point.observable("frequency") / exact - 1));
+  };
+  const ContactBarOrbitProblem* p = problem.get();
+  s.write_extra_outputs = [p, family](const std::filesystem::path& out,
+                                      const continuation::Branch& b) {
+    // Per point: the closed form at the point's own energy, the exact-oracle return error and
+    // the contact phases on each wall with their durations, from an exact simulation.
+    const exact_bar::ExactBarSolver oracle;
+    core::Table check({"point", "energy", "frequency", "closed_form_frequency", "relative_error",
+                       "return_error_u", "return_error_v", "front_phases", "back_phases",
+                       "front_contact", "closed_form_front_contact", "back_contact",
+                       "closed_form_back_contact", "min_back_gap", "one_sided_relative_error"});
+    // Mode J of the one-sided bar (the back wall removed): where no orbit reaches the back
+    // wall the two must agree.
+    const ContactFamily one_sided(p->setup_template().material, p->setup_template().right.gap,
+                                  family.mode());
+    for (const auto& point : b.points) {
+      const double energy = point.observable("energy");
+      const double w = point.observable("frequency");
+      const double exact = family.frequency(energy);
+      const ReturnError re = return_error(*p, point.x, oracle);
+      const double period = point.x[p->period_index()];
+      const bar::BarSetup at = p->setup_at(point.x);
+      const ContactStructure cs = contact_structure(at, period);
+      double front = 0, back = 0;
+      for (const auto& ci : exact_bar::ExactBarSolution(at, period).contact_intervals()) {
+        const double d = std::min(ci.t_release, period) - ci.t_close;
+        (ci.back_wall ? back : front) += d;
+      }
+      check.add_row({static_cast<double>(point.index), energy, w, exact, std::abs(w / exact - 1),
+                     re.displacement, re.velocity, static_cast<double>(cs.contact_phases),
+                     static_cast<double>(cs.back_contact_phases), front,
+                     family.front_contact(energy), back, family.back_contact(energy),
+                     cs.min_back_gap, std::abs(w / one_sided.frequency(energy) - 1)});
+    }
+    check.write_csv(out / "closed_form_check.csv");
+  };
+  s.problem = std::move(problem);
+  return s;
+}
+
 cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch) {
   if (!subharmonic_branch(branch).kind.empty()) return setup_subharmonic(scene, branch);
   // A subharmonic key given to a mode would be ignored in silence.
@@ -387,8 +501,9 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   }
   const int mode = mode_number(branch);
   bar::BarSetup setup = bar_from_scene(scene);  // u0, v0: the orbit's own
-  check_orbit_ends(setup, "the contact-bar modes");
+  check_orbit_ends(setup, "the contact-bar modes", true);
   check_simulation_keys(scene);
+  if (setup.right.type == bar::EndType::clearance) return setup_clearance_mode(scene, setup, mode);
   const ContactFamily family(setup.material, setup.right.gap, mode);
   const std::shared_ptr<const bar::BarSolver> solver = shooting_solver(scene);
 

@@ -85,8 +85,8 @@ ContactBarOrbitProblem::ContactBarOrbitProblem(bar::BarSetup setup, const bar::B
     throw InputError("body_force", fmt::format("the orbit problem is conservative without body "
                                                "force (got {})",
                                                setup_.body_force));
-  if (options_.start_on_wall && !(setup_.right.type == bar::EndType::contact && gap() > 0))
-    throw InputError("start_on_wall", "needs right = contact with a gap > 0");
+  if (options_.start_on_wall && !(setup_.right.has_wall() && gap() > 0))
+    throw InputError("start_on_wall", "needs right = contact or clearance with a gap > 0");
 }
 
 ContactBarOrbitProblem::ContactBarOrbitProblem(bar::BarSetup setup,
@@ -117,7 +117,7 @@ double ContactBarOrbitProblem::node_value(const Vector& x, int i) const {
 }
 
 double ContactBarOrbitProblem::gap() const {
-  return setup_.right.type == bar::EndType::contact ? setup_.right.gap : 0.0;
+  return setup_.right.has_wall() ? setup_.right.gap : 0.0;
 }
 
 double ContactBarOrbitProblem::displacement_scale() const {
@@ -248,7 +248,7 @@ double ContactBarOrbitProblem::min_slope(const Vector& x) const {
 
 core::Observables ContactBarOrbitProblem::observables(const Vector& x) const {
   core::Observables o = PeriodicOrbitProblem::observables(x);
-  if (options_.free_knots >= 2 && options_.start_on_wall)
+  if (options_.free_knots >= 2 && options_.start_on_wall && !setup_.right.has_back_wall())
     o.emplace_back("shape", subharmonic_shape(x));
   o.emplace_back("end_amplitude", std::abs(node_value(x, options_.elements)));
   o.emplace_back("min_slope", min_slope(x));
@@ -493,8 +493,9 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
   if (options_.free_knots > 0 && !(previous < length)) return EvalStatus::failed;
   for (int i = 0; i < options_.nodal_unknowns(); ++i)
     if (!std::isfinite(x[i])) return EvalStatus::non_finite;
-  // A u0 through the wall is outside the admissible set: no orbit starts there.
-  if (setup_.right.type == bar::EndType::contact && node_value(x, n) > setup_.right.gap)
+  // A u0 through a wall is outside the admissible set: no orbit starts there.
+  if (setup_.right.has_wall() && node_value(x, n) > setup_.right.gap) return EvalStatus::failed;
+  if (setup_.right.has_back_wall() && node_value(x, n) < -setup_.right.gap_back)
     return EvalStatus::failed;
 
   const bar::BarSetup s = setup_at(x);
@@ -660,6 +661,26 @@ Vector ContactBarOrbitProblem::subharmonic_guess(double energy, double shape) co
   const Vector y = node_positions(x);
   for (int i = 1; i <= options_.nodal_unknowns(); ++i) x[i - 1] = member.u0(y[i - 1]);
   x[period_index()] = member.period;
+  return x;
+}
+
+Vector ContactBarOrbitProblem::clearance_guess(int mode, double energy) const {
+  const bar::End& end = setup_.right;
+  if (!end.has_back_wall())
+    throw InputError("right_end", "the clearance modes need right_end = clearance");
+  const ClearanceMode family(setup_.material, end.gap, end.gap_back, mode);
+  if (!options_.start_on_wall || options_.free_knots != mode)
+    throw InputError("free_knots", fmt::format("clearance mode {} starts on the front wall "
+                                               "(start_on_wall) with {} kinks on {} free knots "
+                                               "(got {})",
+                                               mode, mode, mode, options_.free_knots));
+  const std::vector<double> kinks = family.kinks(energy);  // InputError below grazing
+  Vector x(num_unknowns());
+  for (int j = 0; j < mode; ++j) x[knot_index(j)] = kinks[static_cast<std::size_t>(j)];
+  const bar::PiecewiseLinear u0 = family.u0(energy);
+  const Vector y = node_positions(x);
+  for (int i = 1; i <= options_.nodal_unknowns(); ++i) x[i - 1] = u0(y[i - 1]);
+  x[period_index()] = family.period(energy);
   return x;
 }
 

@@ -199,6 +199,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // (J = options.subharmonic_mode); needs start_on_wall and K >= J free knots (its J kinks are
   // the first J knots). InputError.
   core::Vector subharmonic_guess(double energy, double shape) const;
+  // Mode J of a clearance end at energy E (family.hpp, ClearanceMode): on the front wall
+  // (start_on_wall), its J kinks on the J free knots, T of the closed form. InputError.
+  core::Vector clearance_guess(int mode, double energy) const;
   // u0 at node i = 1..N (the wall position g0 at node N with start_on_wall).
   double node_value(const core::Vector& x, int i) const;
   // Index of knot j (0-based) in x.
