@@ -41,6 +41,7 @@ import time
 S = "problems/contact_bar/scenes/paper.ini"
 D = "problems/duffing/scenes/duffing.ini"
 I = "problems/impact_oscillator/scenes/impact.ini"
+C = "problems/contact_bar/scenes/clearance.ini"
 SMALL = ["--branch", "mode1", "--shooting_elements", "20", "--energy_max", "2e-5"]
 MEMORY_CAP_KB = 4000000  # ulimit -v
 SLOW_SECONDS = 10.0      # a bad input answered later than this was not refused before work
@@ -52,7 +53,7 @@ FX = ""       # SCRATCH/_fixtures
 
 # --------------------------------------------------------------------------------------------
 # The table.  c(id, subcommand, arguments, key, kind, **options)
-#   arguments: list; "{S}" "{D}" "{I}" "{FX}" "{OUT}" are replaced; --out OUT is appended unless the
+#   arguments: list; "{S}" "{D}" "{I}" "{C}" "{FX}" "{OUT}" are replaced; --out OUT is appended unless the
 #              case says out=False or names {OUT} itself.
 #   options:   out=False (the subcommand takes no --out / the case must not add it),
 #              prep=fn(out) prepares the folder (then it must stay unchanged for `bad`),
@@ -160,6 +161,22 @@ c("trace_branch_empty", "trace", ["{S}", "--branch", "", "--energy_max", "2e-5"]
 c("trace_branch_unknown", "trace", ["{S}", "--branch", "mode3x"], "branch")
 c("trace_branch_of_other_problem", "trace", ["{D}", "--branch", "mode1"], "branch")
 c("trace_contact_key_on_duffing", "trace", ["{D}", "--gap", "1e-3"], "gap")
+# The clearance end (problems/contact_bar/scenes/clearance.ini).
+c("clearance_gap_back_without_clearance", "trace", ["{S}", "--gap_back", "1e-3"] + SMALL,
+  "gap_back")
+c("clearance_gap_back_zero", "trace", ["{C}", "--gap_back", "0"] + SMALL, "gap_back")
+c("clearance_gap_back_negative", "simulate", ["{C}", "--gap_back", "-1e-3"], "gap_back")
+c("clearance_gap_back_nan", "simulate", ["{C}", "--gap_back", "nan"], "gap_back")
+c("clearance_back_wall_nearer", "trace", ["{C}", "--branch", "mode1", "--gap_back", "5e-4"],
+  "gap_back")
+c("clearance_u0_through_back_wall", "simulate", ["{C}", "--u0", "0:0 1:-0.002"], "u0")
+c("clearance_follow", "trace", ["{C}", "--branch", "mode1", "--follow", "all"], "follow")
+c("clearance_subharmonic", "trace", ["{C}", "--branch", "subharmonic"], "right_end")
+c("clearance_free_knots", "trace", ["{C}", "--branch", "mode2", "--free_knots", "1"],
+  "free_knots")
+c("clearance_end_type_typo", "simulate", ["{C}", "--right_end", "clearence"], "right_end")
+c("clearance_left_end_on_trace", "trace", ["{C}", "--branch", "mode1", "--left_end",
+                                           "clearance", "--right_end", "fixed"], "left_end")
 # The forced impact oscillator and the stability keys.
 c("impact_frequency_zero", "trace", ["{I}", "--frequency", "0"], "frequency")
 c("impact_frequency_negative", "trace", ["{I}", "--frequency", "-2.8"], "frequency")
@@ -873,7 +890,7 @@ def cwd_snapshot():
 
 
 def substitute(arg, out):
-    return (arg.replace("{S}", S).replace("{D}", D).replace("{I}", I).replace("{FX}", FX)
+    return (arg.replace("{S}", S).replace("{D}", D).replace("{I}", I).replace("{C}", C).replace("{FX}", FX)
             .replace("{OUT}", out))
 
 
