@@ -324,6 +324,28 @@ std::function<std::string(const core::Vector&)> return_check(const core::Scene& 
   };
 }
 
+// The reject_point hook of a mode: a point whose orbit never reaches the wall is refused before
+// the return check. Below or near grazing the bar's non-contact orbits (every state is
+// 4L/c-periodic) form a manifold of dimension N beside the mode, and on fine grids a corrector
+// can land there (energy above grazing, end amplitude below the gap, period 4L/c): such an orbit
+// is periodic, so the return check alone passes it. The exact oracle says whether the end closes
+// on a wall at least once over the period.
+std::function<std::string(const core::Vector&)> mode_check(const core::Scene& scene,
+                                                           const ContactBarOrbitProblem* p,
+                                                           int check_elements) {
+  auto returns = return_check(scene, p, check_elements);
+  return [p, returns](const core::Vector& x) {
+    const double period = x[p->period_index()];
+    const exact_bar::ExactBarSolution sol(p->setup_at(x), period);
+    if (sol.ok() && sol.contact_intervals(exact_bar::Side::right).empty())
+      return fmt::format(
+          "the orbit never reaches the wall (period {:.6g} s): a non-contact "
+          "orbit beside the mode, not a member of it",
+          period);
+    return returns ? returns(x) : std::string();
+  };
+}
+
 // mode1 and mode2 in units of the amplitude: a step ds is a relative change of the orbit and
 // F's round-off is relative too (problems/contact_bar/orbits/README.md, section 'Amplitude units'),
 // so the defaults become 10 % steps, which give a branch enough points for the figures, and a
@@ -443,7 +465,7 @@ cli::TraceSetup setup_clearance_mode(const core::Scene& scene, const bar::BarSet
   s.guess = problem->clearance_guess(mode, energy);
   check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
   s.direction = problem->clearance_guess(mode, energy * 1.02) - s.guess;
-  s.reject_point = return_check(scene, problem.get(), 4 * problem->state_size());
+  s.reject_point = mode_check(scene, problem.get(), 4 * problem->state_size());
   s.describe_point = [family](const continuation::BranchPoint& point) {
     const double exact = family.frequency(point.observable("energy"));
     return fmt::format("closed-form rel err {:.2e}",
@@ -562,7 +584,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
                 problem->contact_family_guess(mode, ratio);
   // Exact oracle sampled on 4x as many intervals as unknowns (finer than the default test
   // grid): a spurious root of the projected equations is not a root of these.
-  s.reject_point = return_check(scene, problem.get(), 4 * problem->state_size());
+  s.reject_point = mode_check(scene, problem.get(), 4 * problem->state_size());
   describe_mode(s, problem.get(), family);
   s.problem = std::move(problem);
   return s;

@@ -82,11 +82,11 @@ int draw_clearance(const fs::path& out) {
       w_min = std::min(w_min, w[i]);
       w_max = std::max(w_max, w[i]);
     }
-    summary.add_row(b.folder, {double(b.mode), s.right.gap, s.right.gap_back, double(energy.size()),
-                               energy.front(), energy.back(), worst(check.column("relative_error")),
-                               worst(returns), double(one_front), double(one_back), double(no_back),
-                               no_back > 0 ? worst_one_sided : std::nan(""),
-                               family.back_grazing_energy()});
+    summary.add_row(b.folder,
+                    {double(b.mode), s.right.gap, s.right.gap_back, double(energy.size()),
+                     energy.front(), energy.back(), worst(check.column("relative_error")),
+                     worst(returns), double(one_front), double(one_back), double(no_back),
+                     no_back > 0 ? worst_one_sided : std::nan(""), family.back_grazing_energy()});
     // The closed form from grazing to the last point, every traced point on it.
     Table closed({"energy", "frequency"});
     const double e_graze = family.grazing_energy();

@@ -29,9 +29,8 @@ cli::Run trace_clearance(const std::string& arguments, const std::filesystem::pa
 TEST(ClearanceCli, ModesOneAndTwoHoldOneWallThenBoth) {
   for (const char* mode : {"mode1", "mode2"}) {
     const auto out = cli::scratch("clearance", mode);
-    const cli::Run r =
-        trace_clearance(std::string("--branch ") + mode + " --gap_back 3e-3 --energy_max 1e-3",
-                        out);
+    const cli::Run r = trace_clearance(
+        std::string("--branch ") + mode + " --gap_back 3e-3 --energy_max 1e-3", out);
     ASSERT_EQ(r.code, 0) << r.err;
     const Table b = Table::read_csv(out / "branch.csv");
     const Table c = Table::read_csv(out / "closed_form_check.csv");
