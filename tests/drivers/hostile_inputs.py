@@ -359,8 +359,8 @@ c("trace_shooting_elements_large", "trace", ["{S}", "--branch", "mode1",
   "shooting_elements", note="20000 x 40 = 8e5 element-steps; dense Jacobian 40000 x 20000")
 c("trace_shooting_elements_slow", "trace", ["{S}", "--branch", "mode1", "--shooting_elements",
                                            "3000", "--max_points", "2"], "shooting_elements",
-  timeout=8, note="3000 x 40 passes max_residual_work; measured by hand: one point and its "
-  "rank check run 19 min 50 s at 1.6 GB peak RSS (SIGTERM waits for the point)")
+  timeout=8, note="3000 x 40 passes max_residual_work and max_memory; its dense SVD "
+  "(6000 x 3001^2 = 5.4e10 operations) exceeds max_dense_work 2e10")
 c("trace_test_elements_bogus", "trace", ["{S}", "--test_elements", "-2"] + SMALL,
   "test_elements")
 c("trace_steps_per_period_odd", "trace", ["{S}", "--steps_per_period", "41"] + SMALL,

@@ -170,6 +170,10 @@ po::options_description trace_keys() {
       ("max_memory", po::value<double>()->default_value(0),
        "refuse a trace whose dense Jacobian and its factorizations would need more than this "
        "many GB (>= 0; 0: half of this machine's memory)")  //
+      ("max_dense_work", po::value<double>()->default_value(2e10),
+       "refuse a trace whose dense factorizations (the rank report's SVD of the m x n "
+       "Jacobian, m n^2 operations) cost more than this (> 0; 2e10: about 2000 intervals, "
+       "seconds per factorization on this machine class): raise it to run larger traces")  //
       ("stability", po::value<bool>()->default_value(false),
        "Floquet multipliers of every point (branch.csv's stability columns, multipliers.csv): "
        "the monodromy of the full state (u, v) on a grid of stability_elements, by "
@@ -273,6 +277,17 @@ void check_memory(const core::Scene& scene, const OrbitOptions& options) {
   const double equations = options.test_elements > 0 ? options.test_elements : options.state_size();
   const double unknowns = options.state_size() + 1.0;
   const double need_gb = 9 * equations * unknowns * sizeof(double) / 1e9;
+  // Time, before any work: one dense SVD of the Jacobian per rank report (3000 intervals:
+  // 5.4e10 operations, measured 6.4 s at the first point alone).
+  const double dense_limit = scene.positive("max_dense_work");
+  const double dense_work = equations * unknowns * unknowns;
+  if (dense_work > dense_limit)
+    throw core::InputError(
+        "shooting_elements",
+        fmt::format("{} intervals make a {:.0f} x {:.0f} Jacobian, whose dense factorizations "
+                    "cost {:.3g} operations each, above max_dense_work {:.3g}: lower "
+                    "shooting_elements, or raise max_dense_work",
+                    options.elements, equations, unknowns, dense_work, dense_limit));
   if (need_gb <= limit_gb) return;
   throw core::InputError(
       "shooting_elements",
