@@ -442,8 +442,8 @@ cli::TraceSetup setup_clearance_mode(const core::Scene& scene, const bar::BarSet
   const double length = setup.material.length;
   const double strain =
       (1 + scene.positive("start_offset")) * (2 * mode - 1) * setup.right.gap / length;
-  const double energy = 0.5 * setup.material.axial_stiffness() * length * strain * strain;
-  std::vector<double> kinks = family.kinks(energy);
+  const double start_energy = 0.5 * setup.material.axial_stiffness() * length * strain * strain;
+  std::vector<double> kinks = family.kinks(start_energy);
   kinks.back() = length;  // its node: N - 1; the others below it, strictly increasing
   options.knot_nodes = nearest_knot_nodes(options.elements, length, kinks);
   for (int j = mode - 1; j >= 0; --j)
@@ -477,9 +477,9 @@ cli::TraceSetup setup_clearance_mode(const core::Scene& scene, const bar::BarSet
     if (units) units(o, newton);
     if (!turn_given) o.branch_points.max_turn_degrees = 60;
   };
-  s.guess = problem->clearance_guess(mode, energy);
+  s.guess = problem->clearance_guess(mode, start_energy);
   check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
-  s.direction = problem->clearance_guess(mode, energy * 1.02) - s.guess;
+  s.direction = problem->clearance_guess(mode, start_energy * 1.02) - s.guess;
   s.reject_point = mode_check(scene, problem.get(), 4 * problem->state_size());
   s.describe_point = [family](const continuation::BranchPoint& point) {
     const double exact = family.frequency(point.observable("energy"));

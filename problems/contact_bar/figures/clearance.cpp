@@ -9,6 +9,7 @@
 #include "core/io/plot.hpp"
 #include "core/io/scene.hpp"
 #include "core/io/table.hpp"
+#include "problems/contact_bar/figures/modes.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/solver/scene.hpp"
 
@@ -162,11 +163,7 @@ int draw_clearance(const fs::path& out) {
       "set xrange [{}:{}]\n{}{}\n",
       gap, material.wave_speed(), material.length, 0.9 * w_min, 1.05 * w_max, labels, curves);
   const fs::path png = out / "clearance_backbones.png";
-  const core::PlotResult r = core::render_png(png, plot, {1400, 900});
-  if (r.ok)
-    fmt::print("[figures] wrote {}\n", png.string());
-  else
-    fmt::print(stderr, "[figures] {}\n", r.message);
+  render_figure(png, plot, 1400, 900);
   return 0;
 }
 

@@ -38,13 +38,6 @@ FigureScene read_figure_scene(const FigureInputs& inputs) {
           static_cast<int>(scene.integer("elements", 1))};
 }
 
-void report(const core::PlotResult& r, const fs::path& png) {
-  if (r.ok)
-    fmt::print("[figures] wrote {}\n", png.string());
-  else
-    fmt::print(stderr, "[figures] {}\n", r.message);
-}
-
 bool has_branch(const fs::path& dir) {
   return fs::exists(dir / "branch.csv");
 }
@@ -112,7 +105,7 @@ void spacetime_figure(const fs::path& out, int mode, const FigureScene& scene,
       fmt::format("Mode {}", mode), orbit.energy, orbit.period, title_extra,
       core::gnuplot_quote(out / (name + "_spacetime.csv")), marker);
   const fs::path png = out / (name + "_spacetime.png");
-  report(core::render_png(png, plot, {1100, 800}), png);
+  render_figure(png, plot, 1100, 800);
 }
 
 }  // namespace
@@ -241,7 +234,7 @@ int draw_backbones(const fs::path& out, const FigureInputs& inputs) {
         core::gnuplot_quote(out / "backbone_subharmonic.csv"));
   }
   const fs::path png = out / "backbones.png";
-  report(core::render_png(png, plot + "\n", {1200, 850}), png);
+  render_figure(png, plot + "\n", 1200, 850);
   return 0;
 }
 
@@ -280,7 +273,7 @@ int draw_mode1_contact(const fs::path& out, const FigureInputs& inputs) {
       orbit->energy, orbit->period, s.right.gap, s.right.gap, exact_csv, tdbem_csv, exact_csv,
       tdbem_csv);
   const fs::path png = out / "mode1_contact.png";
-  report(core::render_png(png, plot, {1000, 800}), png);
+  render_figure(png, plot, 1000, 800);
   return 0;
 }
 
@@ -384,7 +377,7 @@ int draw_all_backbones(const fs::path& out, const FigureInputs& inputs) {
       modes, g0, s.material.wave_speed(), s.material.length, 0.8 * w1, 1.05 * w_top, labels,
       curves);
   const fs::path png = out / "backbones_all.png";
-  report(core::render_png(png, plot, {1400, 900}), png);
+  render_figure(png, plot, 1400, 900);
   return 0;
 }
 
@@ -499,7 +492,7 @@ int draw_subharmonic_continuum(const fs::path& out, const FigureInputs& inputs) 
       core::gnuplot_quote(out / "subharmonic_continuum_limits.csv"),
       core::gnuplot_quote(out / "subharmonic_continuum_limits.csv"), g0, g0);
   const fs::path png = out / "subharmonic_continuum.png";
-  report(core::render_png(png, plot, {1300, 700}), png);
+  render_figure(png, plot, 1300, 700);
   return 0;
 }
 
@@ -525,7 +518,7 @@ int draw_subharmonic_spacetime(const fs::path& out, const FigureInputs& inputs) 
       orbit->energy, orbit->period, scene.setup.right.gap,
       core::gnuplot_quote(out / "subharmonic_spacetime.csv"));
   const fs::path png = out / "subharmonic_spacetime.png";
-  report(core::render_png(png, plot, {1100, 800}), png);
+  render_figure(png, plot, 1100, 800);
   return 0;
 }
 
@@ -550,6 +543,14 @@ std::vector<cli::ProblemJob> figure_jobs(const FigureInputs& inputs) {
       {"closed_form_summary", "closed_form_summary.csv: acceptance numbers of every branch",
        write_closed_form_summary},
   };
+}
+
+void render_figure(const fs::path& png, const std::string& plot, int width, int height) {
+  const core::PlotResult r = core::render_png(png, plot, {width, height});
+  if (r.ok)
+    fmt::print("[figures] wrote {}\n", png.string());
+  else
+    fmt::print(stderr, "[figures] {}\n", r.message);
 }
 
 std::vector<fs::path> followed_branches(const fs::path& dir) {

@@ -33,6 +33,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "continuation/cli/plugin.hpp"
@@ -80,5 +81,10 @@ std::optional<TracedOrbit> load_traced_orbit_point(const std::filesystem::path& 
 // The followed families a trace wrote into dir (--follow): its branch_point_K/ folders that hold
 // a branch.csv, sorted; empty when dir does not exist.
 std::vector<std::filesystem::path> followed_branches(const std::filesystem::path& dir);
+
+// Renders plot (gnuplot text) into png at size and says so on stdout, or the renderer's
+// message on stderr (a missing gnuplot leaves the CSV files as the result).
+void render_figure(const std::filesystem::path& png, const std::string& plot, int width,
+                   int height);
 
 }  // namespace backbone::contact_bar

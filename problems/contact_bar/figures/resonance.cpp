@@ -136,11 +136,7 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
   plot += "set title 'Contacting-end displacement over one period, exact oracle (Fig. 11)'\n" +
           curves + "\n";
   const fs::path png = out / "resonant_end.png";
-  const core::PlotResult r = core::render_png(png, plot, {1200, 700});
-  if (r.ok)
-    fmt::print("[figures] wrote {}\n", png.string());
-  else
-    fmt::print(stderr, "[figures] {}\n", r.message);
+  render_figure(png, plot, 1200, 700);
   if (spectra.empty()) return 0;
   const fs::path spectrum_png = out / "resonant_end_spectrum.png";
   const core::PlotResult rs = core::render_png(
@@ -204,11 +200,7 @@ int draw_resonant_spacetime(const fs::path& out, const fs::path& scene_path) {
       attached.front().filename().string().substr(13), orbit->energy, orbit->period,
       core::gnuplot_quote(csv));
   const fs::path png = out / "resonant_spacetime.png";
-  const core::PlotResult r = core::render_png(png, plot, {1100, 800});
-  if (r.ok)
-    fmt::print("[figures] wrote {}\n", png.string());
-  else
-    fmt::print(stderr, "[figures] {}\n", r.message);
+  render_figure(png, plot, 1100, 800);
   return 0;
 }
 
@@ -245,11 +237,7 @@ int draw_attached_branches(const fs::path& out) {
         core::gnuplot_quote(dir / "branch.csv"),
         dir.filename().string().substr(13));  // "branch_point_K" -> K
   const fs::path png = out / "attached_branches.png";
-  const core::PlotResult r = core::render_png(png, plot + "\n", {1200, 700});
-  if (r.ok)
-    fmt::print("[figures] wrote {}\n", png.string());
-  else
-    fmt::print(stderr, "[figures] {}\n", r.message);
+  render_figure(png, plot + "\n", 1200, 700);
   return 0;
 }
 

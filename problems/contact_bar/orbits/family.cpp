@@ -11,6 +11,28 @@
 
 namespace backbone::contact_bar {
 
+namespace {
+
+// u0 of slopes +-s on [0, L] from its end value u0(L): slope -s back to the last kink, +s to
+// the one before, ...; u0(0) = 0 exactly (the sum of the segments rounds).
+bar::PiecewiseLinear zigzag_from_end(double length, double end, double s,
+                                     const std::vector<double>& kinks) {
+  std::vector<double> x{length}, y{end};
+  double sign = -1;  // u0' on the segment ending at the current knot
+  for (auto k = kinks.rbegin(); k != kinks.rend(); ++k) {
+    y.push_back(y.back() - sign * s * (x.back() - *k));
+    x.push_back(*k);
+    sign = -sign;
+  }
+  x.push_back(0.0);
+  y.push_back(0.0);
+  std::reverse(x.begin(), x.end());
+  std::reverse(y.begin(), y.end());
+  return bar::PiecewiseLinear(std::move(x), std::move(y));
+}
+
+}  // namespace
+
 ContactFamily::ContactFamily(const bar::Material& material, double gap, int mode)
     : material_(material), gap_(gap), mode_(mode) {
   if (mode < 1) throw core::InputError("mode", fmt::format("must be >= 1 (got {})", mode));
@@ -89,21 +111,7 @@ bar::PiecewiseLinear ContactFamily::u0(double energy) const {
     throw core::InputError("energy",
                            fmt::format("mode {} exists from its grazing energy {} (got {})", mode_,
                                        grazing_energy(), energy));
-  const std::vector<double> at = kinks(energy);
-  // From the end: u0(L), then slope -s back to the first kink (from the end), +s to the next...
-  const double end = -(s * length - (mode_ - 1) * gap_) / mode_;
-  std::vector<double> x{length}, y{end};
-  double sign = -1;  // u0' on the segment ending at the current knot
-  for (auto k = at.rbegin(); k != at.rend(); ++k) {
-    y.push_back(y.back() - sign * s * (x.back() - *k));
-    x.push_back(*k);
-    sign = -sign;
-  }
-  x.push_back(0.0);
-  y.push_back(0.0);  // u0(0) = 0 exactly (the sum of the segments rounds)
-  std::reverse(x.begin(), x.end());
-  std::reverse(y.begin(), y.end());
-  return bar::PiecewiseLinear(std::move(x), std::move(y));
+  return zigzag_from_end(length, -(s * length - (mode_ - 1) * gap_) / mode_, s, kinks(energy));
 }
 
 ClearanceMode::ClearanceMode(const bar::Material& material, double gap, double gap_back, int mode)
@@ -193,20 +201,7 @@ bar::PiecewiseLinear ClearanceMode::u0(double energy) const {
                            fmt::format("clearance mode {} exists from its grazing energy {} (got "
                                        "{})",
                                        mode_, grazing_energy(), energy));
-  const std::vector<double> at = kinks(energy);
-  // From the end, on the front wall: slope -s back to the first kink, +s to the next...
-  std::vector<double> x{length}, y{gap_};
-  double sign = -1;
-  for (auto k = at.rbegin(); k != at.rend(); ++k) {
-    y.push_back(y.back() - sign * s * (x.back() - *k));
-    x.push_back(*k);
-    sign = -sign;
-  }
-  x.push_back(0.0);
-  y.push_back(0.0);  // u0(0) = 0 exactly (the sum of the segments rounds)
-  std::reverse(x.begin(), x.end());
-  std::reverse(y.begin(), y.end());
-  return bar::PiecewiseLinear(std::move(x), std::move(y));
+  return zigzag_from_end(length, gap_, s, kinks(energy));  // on the front wall
 }
 
 double node_of(const bar::PiecewiseLinear& u0) {
