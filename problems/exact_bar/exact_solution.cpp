@@ -70,6 +70,28 @@ ExactBarSolution::ExactBarSolution(const bar::BarSetup& setup, double t_end)
   march();
 }
 
+ExactBarSolution::ExactBarSolution(const bar::BarSetup& setup, double t_end, InitialTangent tangent)
+    : setup_(setup), t_end_(t_end), seed_(std::move(tangent)) {
+  setup_.validate();
+  if (!std::isfinite(t_end) || t_end < 0)
+    throw InputError("t_end", fmt::format("must be finite and >= 0 (got {})", t_end));
+  for (double v : setup_.v0.values())
+    if (v != 0) throw InputError("v0", "the tangent of the exact solution needs v0 = 0");
+  if (setup_.body_force != 0)
+    throw InputError("body_force", "the tangent of the exact solution needs no body force");
+  const std::size_t knots = setup_.u0.knots().size();
+  if (seed_.d_knot.size() != knots || seed_.d_value.size() != knots || knots == 0)
+    throw InputError("tangent", fmt::format("needs one derivative per knot of u0 ({})", knots));
+  tangent_size_ = static_cast<int>(seed_.d_knot.front().size());
+  for (std::size_t i = 0; i < knots; ++i)
+    if (seed_.d_knot[i].size() != tangent_size_ || seed_.d_value[i].size() != tangent_size_)
+      throw InputError("tangent", "every derivative must have the same size");
+  c_ = setup_.material.wave_speed();
+  tau_ = setup_.material.length / c_;
+  b_ = 0;
+  march();
+}
+
 template <class Seg>
 const Seg& ExactBarSolution::Chunked<Seg>::locate(long k, double r) const {
   k = std::clamp<long>(k, 0, static_cast<long>(first.size()) - 1);
@@ -129,8 +151,13 @@ void ExactBarSolution::march() {
         {0, t0, t1, v0(xb) - c_ * u0.slope(xm, 1) + b_ * t0, -c_ * v0.slope(xm, 1) + b_});
   }
 
-  EndState left_state{false, 1, u0(0.0)};
-  EndState right_state{false, 1, u0(L)};
+  EndState left_state{false, 1, u0(0.0), 0.0, {}};
+  EndState right_state{false, 1, u0(L), 0.0, {}};
+  if (tangent_size_ > 0) {
+    seed_initial_signals(xs);
+    left_state.du = seed_.d_value.front();
+    right_state.du = seed_.d_value.back();
+  }
   // Signals must cover [0, t_end + tau] (a profile at t reads them up to t + tau) and the end
   // tracks [0, t_end]; one more window keeps every query strictly inside.
   const long last_window = static_cast<long>(std::ceil(t_end_ / tau_)) + 1;
@@ -164,16 +191,19 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
   const double n = right ? 1.0 : -1.0;  // outward normal
   const double tol = snap_tolerance(tau_);
   const auto& incoming = right ? a_ : b_sig_;
+  const auto& incoming_tangent = right ? a_tan_ : b_tan_;
+  const bool tangent = tangent_size_ > 0;
   const std::size_t begin = incoming.first[static_cast<std::size_t>(k)];
   const std::size_t end = incoming.end_of(k);
   for (std::size_t i = begin; i < end; ++i) {
     const Segment s = incoming.segments[i];
+    const SegmentTangent* ts = tangent ? &incoming_tangent[i] : nullptr;
     if (model.type == bar::EndType::fixed) {
-      emit(side, k, s.r0, s.r1, s.y0, s.slope, true, false, state);
+      emit(side, k, s.r0, s.r1, s.y0, s.slope, true, false, state, ts);
       continue;
     }
     if (model.type == bar::EndType::free) {
-      emit(side, k, s.r0, s.r1, s.y0, s.slope, false, false, state);
+      emit(side, k, s.r0, s.r1, s.y0, s.slope, false, false, state, ts);
       continue;
     }
     // Contact end: walk the segment through its events. The incoming invariant is the
@@ -181,10 +211,25 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
     // the front wall, -n for a clearance end's back wall) the incoming velocity is q = m * in.
     double rc = s.r0;
     double yc = s.y0;
+    // Tangent: the derivatives of rc and of the value yc there (README.md, 'Tangent').
+    SegmentTangent piece;
+    if (tangent) piece = {ts->dr0, ts->dr1, ts->dy0};
+    auto emit_to = [&](double r1, const Eigen::VectorXd* dr1, bool negative, bool closed) {
+      if (!tangent) return emit(side, k, rc, r1, yc, s.slope, negative, closed, state);
+      piece.dr1 = dr1 ? *dr1 : ts->dr1;
+      emit(side, k, rc, r1, yc, s.slope, negative, closed, state, &piece);
+    };
+    // Moves rc to the event at rc + ds (with d(ds) when tangent) and yc with it (segments
+    // are constant with a tangent: yc's derivative stays).
+    auto advance = [&](double ds, const Eigen::VectorXd& d_ds) {
+      if (tangent) piece.dr0 += d_ds;
+      yc += s.slope * ds;
+      rc += ds;
+    };
     for (int events = 0; rc < s.r1; ++events) {
       const double len = s.r1 - rc;
       if (events > 16) {  // cannot happen with exact roots; safety against a float cycle
-        emit(side, k, rc, s.r1, yc, s.slope, state.closed, state.closed, state);
+        emit_to(s.r1, nullptr, state.closed, state.closed);
         break;
       }
       if (state.closed) {
@@ -195,12 +240,18 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
           continue;
         }
         if (sr >= len - tol) {
-          emit(side, k, rc, s.r1, yc, s.slope, true, true, state);
+          emit_to(s.r1, nullptr, true, true);
           break;
         }
-        emit(side, k, rc, rc + sr, yc, s.slope, true, true, state);
-        rc += sr;
+        Eigen::VectorXd d_sr, d_release;
+        if (tangent) {  // q + qm sr = 0 (qm != 0 here: a constant segment releases at its start)
+          d_sr = -piece.dy0 / s.slope;
+          d_release = piece.dr0 + d_sr;
+        }
+        emit_to(rc + sr, tangent ? &d_release : nullptr, true, true);
+        advance(sr, d_sr);
         yc = 0.0;  // the force vanishes exactly at release
+        if (tangent) piece.dy0.setZero();
         state.closed = false;
       } else {
         const double q = n * yc, qm = n * s.slope;
@@ -219,19 +270,27 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
           state.side = wall;
           state.u = wall_u;
           state.u_compensation = 0;
+          if (tangent) state.du.setZero();
           continue;
         }
         if (sc >= len - tol) {
-          emit(side, k, rc, s.r1, yc, s.slope, false, false, state);
+          emit_to(s.r1, nullptr, false, false);
           break;
         }
-        emit(side, k, rc, rc + sc, yc, s.slope, false, false, state);
-        yc += s.slope * sc;
-        rc += sc;
+        Eigen::VectorXd d_sc, d_close;
+        if (tangent) {
+          // w(rc + sc) = wall: w(rc) + yc sc = wall_u (a constant segment), so
+          // yc d_sc = -(dw + sc dyc).
+          d_sc = -(state.du + sc * piece.dy0) / yc;
+          d_close = piece.dr0 + d_sc;
+        }
+        emit_to(rc + sc, tangent ? &d_close : nullptr, false, false);
+        advance(sc, d_sc);
         state.closed = true;
         state.side = wall;
         state.u = wall_u;  // the wall position, exactly
         state.u_compensation = 0;
+        if (tangent) state.du.setZero();
       }
     }
   }
@@ -241,8 +300,16 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
 // in0 + in_slope (r - r0); the outgoing one is -incoming (fixed end, closed contact) or
 // +incoming (free end). It reaches the other end in window k + 1, increased by b tau.
 void ExactBarSolution::emit(Side side, long k, double r0, double r1, double in0, double in_slope,
-                            bool reflect_negative, bool closed, EndState& state) {
+                            bool reflect_negative, bool closed, EndState& state,
+                            const SegmentTangent* tangent) {
   if (!(r1 > r0)) return;
+  if (tangent) {
+    const double sign = reflect_negative ? -1.0 : 1.0;
+    auto& other_tangent = side == Side::right ? b_tan_ : a_tan_;
+    other_tangent.push_back({tangent->dr0, tangent->dr1, sign * tangent->dy0});
+    if (!reflect_negative)  // the free end's displacement gains int in = in0 (r1 - r0)
+      state.du.noalias() += (r1 - r0) * tangent->dy0 + in0 * (tangent->dr1 - tangent->dr0);
+  }
   const double sign = reflect_negative ? -1.0 : 1.0;
   const double out0 = sign * in0, out_slope = sign * in_slope;
   auto& track = side == Side::right ? right_ : left_;
@@ -260,7 +327,8 @@ void ExactBarSolution::emit(Side side, long k, double r0, double r1, double in0,
   const Segment next{k + 1, r0, r1, out0 + b_ * tau_, out_slope};
   // A breakpoint across which the signal is continuous with the same slope (a front that has
   // been cancelled by a reflection) is dropped, or fronts would pile up window after window.
-  if (other.segments.size() > other.first.back()) {
+  // (Not with a tangent: the perturbed signal need not be continuous there.)
+  if (tangent_size_ == 0 && other.segments.size() > other.first.back()) {
     Segment& last = other.segments.back();
     const double left_value = last.at(r0);
     if (last.r1 == r0 &&

@@ -20,6 +20,7 @@
 //   sol.energy(2.0);                  // EA L eps^2 / 2
 #pragma once
 
+#include <Eigen/Dense>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -29,6 +30,20 @@
 namespace backbone::exact_bar {
 
 enum class Side { left, right };
+
+// Forward sensitivities of a solution with respect to n parameters p on which its initial
+// displacement depends (v0 = 0, no body force): per knot i of setup.u0, the derivatives of its
+// position and of its value, each a vector of size n (README.md, 'Tangent').
+struct InitialTangent {
+  std::vector<Eigen::VectorXd> d_knot, d_value;
+};
+
+// The derivatives of the hat projections int v(x, t) psi_i dx on a uniform grid: d_p, one row
+// per node i = 0..elements and one column per parameter, at fixed t; and d_t, their rate in t.
+struct ProjectedVelocityTangent {
+  Eigen::MatrixXd d_p;  // (elements + 1) x n
+  Eigen::VectorXd d_t;
+};
 
 // One closed-contact episode of an end: closed on [t_close, t_release).
 struct ContactInterval {
@@ -41,6 +56,9 @@ class ExactBarSolution {
  public:
   // Solves on [0, t_end]. Throws core::InputError for a bad setup or t_end (key "t_end").
   ExactBarSolution(const bar::BarSetup& setup, double t_end);
+  // The same, carrying the forward sensitivities seeded by `tangent` (InputError "v0" or
+  // "body_force" when either is not zero, "tangent" when its sizes do not fit u0).
+  ExactBarSolution(const bar::BarSetup& setup, double t_end, InitialTangent tangent);
 
   // false if the event march failed (non-finite signal or runaway event count).
   bool ok() const { return ok_; }
@@ -74,6 +92,11 @@ class ExactBarSolution {
   // The field on the uniform grid of request.elements intervals at time t; every projection
   // int f psi_i dx is exact (Simpson on each polynomial piece). request.dt is ignored.
   bar::FieldSnapshot snapshot(double t, const bar::SnapshotRequest& request) const;
+
+  // With a tangent: the derivatives of snapshot(t, {elements, projected_v}).v_projected. At a
+  // kink of the solution map (an event exactly on a front, a grazing) one of the one-sided
+  // derivatives is taken: the one of the event's side as the march resolved it.
+  ProjectedVelocityTangent projected_velocity_tangent(double t, int elements) const;
 
   // Number of linear pieces stored (both signals and both end tracks): the cost measure.
   std::size_t segment_count() const;
@@ -112,6 +135,12 @@ class ExactBarSolution {
     int side = 1;               // the wall of a closed end: +1 front, -1 back (clearance)
     double u = 0;               // displacement of the end
     double u_compensation = 0;  // Kahan: low-order part lost when adding to u
+    Eigen::VectorXd du;         // its derivative (tangent only)
+  };
+  // The derivatives of a segment's data (tangent only): of its start and end times and of its
+  // value. With v0 = 0 and no body force every segment is constant (slope 0), and stays so.
+  struct SegmentTangent {
+    Eigen::VectorXd dr0, dr1, dy0;
   };
   struct Local {
     long k;
@@ -131,7 +160,9 @@ class ExactBarSolution {
   void march();
   void march_end(Side side, long k, EndState& state);
   void emit(Side side, long k, double r0, double r1, double in0, double in_slope,
-            bool reflect_negative, bool closed, EndState& state);
+            bool reflect_negative, bool closed, EndState& state,
+            const SegmentTangent* tangent = nullptr);
+  void seed_initial_signals(const std::vector<double>& xs);  // a_tan_, b_tan_ of window 0
   void check_time(double t) const;
   double front_tolerance(double t) const;  // fronts closer than this in x are one front
   Local to_local(double t) const;
@@ -148,6 +179,10 @@ class ExactBarSolution {
   Chunked<EndSegment> left_, right_;
   bool ok_ = true;
   std::string message_;
+  // Tangent: its seed, its size n (0: none), the segments' derivatives beside a_ and b_sig_.
+  InitialTangent seed_;
+  int tangent_size_ = 0;
+  std::vector<SegmentTangent> a_tan_, b_tan_;
 };
 
 // Convenience: ExactBarSolution(setup, t_end).

@@ -170,6 +170,11 @@ po::options_description trace_keys() {
       ("max_memory", po::value<double>()->default_value(0),
        "refuse a trace whose dense Jacobian and its factorizations would need more than this "
        "many GB (>= 0; 0: half of this machine's memory)")  //
+      ("jacobian", po::value<std::string>()->default_value("differences"),
+       "the shooting Jacobian: differences (finite differences, compressed by its pattern) or "
+       "exact (from the exact solution's tangent: problems/contact_bar/orbits/README.md, "
+       "section 'Exact Jacobian'; the regular formulation with the exact solver or the TD-BEM's "
+       "event march, without path rows; else differences)")  //
       ("max_dense_work", po::value<double>()->default_value(2e10),
        "refuse a trace whose dense factorizations (the rank report's SVD of the m x n "
        "Jacobian, m n^2 operations) cost more than this (> 0; 2e10: about 2000 intervals, "
@@ -310,6 +315,7 @@ OrbitOptions shooting_grid(const core::Scene& scene) {
   options.elements =
       static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
   options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
+  options.exact_jacobian = scene.choice("jacobian", {"differences", "exact"}) == "exact";
   check_residual_work(scene, options);
   return options;
 }

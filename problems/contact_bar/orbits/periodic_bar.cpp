@@ -10,6 +10,8 @@
 
 #include "core/errors.hpp"
 #include "problems/contact_bar/orbits/family.hpp"
+#include "problems/contact_bar/solver/tdbem.hpp"
+#include "problems/exact_bar/exact_solution.hpp"
 
 namespace backbone::contact_bar {
 
@@ -546,6 +548,58 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
     }
   }
   return EvalStatus::ok;
+}
+
+bool ContactBarOrbitProblem::exact_jacobian_applies() const {
+  if (!options_.exact_jacobian) return false;
+  if (formulation() != core::ShootingFormulation::half_period_velocity) return false;
+  if (path_rows_enabled_ && options_.path_rows() > 0) return false;
+  if (solver_.name() == "exact") return true;
+  const auto* tdbem = dynamic_cast<const TdbemSolver*>(&solver_);
+  return tdbem && tdbem->method() == ContactMethod::event;
+}
+
+// The regular residual r_i = (L/c) / u_s int v(x, T/2) psi_i dx / m_i differentiated through
+// the exact solution (exact_bar, 'Tangent'): the unknowns move u0's knots (the free knots map
+// the grid) and values, and T moves the instant T/2.
+EvalStatus ContactBarOrbitProblem::compute_jacobian(const Vector& x, core::Matrix& J) const {
+  if (!exact_jacobian_applies()) return PeriodicOrbitProblem::compute_jacobian(x, J);
+  const int n = options_.elements, k = options_.free_knots, unknowns = num_unknowns();
+  const int m = options_.test_elements > 0 ? options_.test_elements : state_size();
+  const double length = setup_.material.length, period = x[period_index()];
+  if (!std::isfinite(period) || !(period > 0)) return EvalStatus::failed;
+  Vector scratch;
+  if (compute_residual(x, scratch) != EvalStatus::ok) return EvalStatus::failed;
+  exact_bar::InitialTangent seed;
+  seed.d_knot.assign(static_cast<std::size_t>(n) + 1, Vector::Zero(unknowns));
+  seed.d_value.assign(static_cast<std::size_t>(n) + 1, Vector::Zero(unknowns));
+  for (int i = 1; i <= options_.nodal_unknowns(); ++i) seed.d_value[i][i - 1] = 1;
+  if (k > 0) {  // node i between the anchors i0 and i1 (node_positions)
+    const std::vector<int> anchors = reference_knot_nodes();
+    int segment = 0;
+    for (int i = 1; i < n; ++i) {
+      while (segment < k && i > anchors[segment]) ++segment;
+      const int i0 = segment == 0 ? 0 : anchors[segment - 1];
+      const int i1 = segment == k ? n : anchors[segment];
+      const double w = static_cast<double>(i - i0) / (i1 - i0);
+      if (segment > 0) seed.d_knot[i][knot_index(segment - 1)] = i == i1 ? 0.0 : 1 - w;
+      if (segment < k) seed.d_knot[i][knot_index(segment)] = i == i1 ? 1.0 : w;
+    }
+  }
+  exact_bar::ExactBarSolution solution(setup_at(x), 0.5 * period, std::move(seed));
+  if (!solution.ok()) return EvalStatus::failed;
+  const exact_bar::ProjectedVelocityTangent d =
+      solution.projected_velocity_tangent(0.5 * period, m);
+  const double dx = length / m;
+  const double scale = setup_.material.travel_time() / displacement_scale();
+  const int rows = path_rows_enabled_ ? options_.path_rows() : 0;
+  J.setZero(m + rows, unknowns);
+  for (int i = 1; i <= m; ++i) {
+    const double factor = scale / (i == m ? 0.5 * dx : dx);
+    J.row(i - 1) = factor * d.d_p.row(i);
+    J(i - 1, period_index()) = factor * 0.5 * d.d_t[i];
+  }
+  return J.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 
 Vector ContactBarOrbitProblem::linear_mode_guess(int mode, double amplitude_ratio) const {

@@ -81,6 +81,10 @@ struct OrbitOptions {
   // is relative and the rank report's column scaling does not degrade as the amplitude grows
   // (problems/contact_bar/orbits/README.md, section 'Amplitude units'). false: g0 throughout.
   bool amplitude_units = false;
+  // The Jacobian of the regular residual from the exact solution's tangent (README.md,
+  // 'Exact Jacobian') instead of finite differences: for the exact solver and the TD-BEM's
+  // event march (which reproduces the exact solution on these states), without path rows.
+  bool exact_jacobian = false;
   int path_rows() const { return (fixed_energy > 0 ? 1 : 0) + (fixed_shape >= 0 ? 1 : 0); }
   int nodal_unknowns() const { return elements - (start_on_wall ? 1 : 0); }
   int state_size() const { return nodal_unknowns() + free_knots; }
@@ -160,6 +164,10 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // each contact release (found by one simulation at x). None (every column differenced) for
   // other solvers and with path rows (they are dense rows).
   std::optional<core::JacobianPattern> jacobian_pattern(const core::Vector& x) const override;
+  // With options.exact_jacobian where it applies (exact_jacobian_applies), the Jacobian from
+  // the exact solution's tangent; else finite differences (core::Problem).
+  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
+  bool exact_jacobian_applies() const;
   // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
   double displacement_scale() const;
 

@@ -109,7 +109,9 @@ TEST(Clearance, TdbemProjectionAndFemConvergeToTheExactSolver) {
     // scheme), and end below 10 % of the distance between the walls.
     EXPECT_LT(e_tdbem, previous_tdbem / 1.5) << elements;
     EXPECT_LT(e_fem, previous_fem / 1.5) << elements;
-    if (elements == 400) EXPECT_LT(std::max(e_tdbem, e_fem), 0.1 * 3e-3);  // of gap + gap_back
+    if (elements == 400) {
+      EXPECT_LT(std::max(e_tdbem, e_fem), 0.1 * 3e-3);  // of gap + gap_back
+    }
     previous_tdbem = e_tdbem;
     previous_fem = e_fem;
   }
