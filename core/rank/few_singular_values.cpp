@@ -104,14 +104,42 @@ struct TriangularGram {
   }
 };
 
+// J sparse but for k <= SparseLeastSquares::max_dense_rows dense rows D (a front whose motion
+// depends on every unknown): the factor is of S^T S + mu I, S the other rows, and the dense rows
+// join by Woodbury, (M + D^T D)^-1 = M^-1 - Z (I + D Z)^-1 D M^-1 with Z = M^-1 D^T, so that
+// J^T J's fill (dense from one dense row) is never formed.
 struct SparseGram {
   Eigen::SparseMatrix<double> a;
   NormalFactor factor;
+  Matrix d, z;                     // D (k x n) and Z (n x k); empty without dense rows
+  Eigen::LLT<Matrix> capacitance;  // I + D Z
   Eigen::Index rows() const { return a.rows(); }
   Vector times(const Vector& v) const { return a * v; }
   Matrix times(const Matrix& x) const { return a * x; }
   Vector times_transpose(const Vector& u) const { return a.transpose() * u; }
-  Matrix inverse_gram(const Matrix& x) const { return factor.solve(x); }
+  Matrix inverse_gram(const Matrix& x) const {
+    Matrix y = factor.solve(x);
+    if (d.rows() > 0) y -= z * capacitance.solve(d * y);
+    return y;
+  }
+  // Factors a (all of J) with the rows marked dense set apart; false when that fails.
+  bool factor_with_dense_rows(const Matrix& J, const std::vector<char>& dense_row) {
+    Eigen::SparseMatrix<double> sparse_rows = a;
+    sparse_rows.prune([&](Eigen::Index i, Eigen::Index, double) {
+      return !dense_row[static_cast<std::size_t>(i)];
+    });
+    if (!factor_shifted_normal(sparse_rows, factor)) return false;
+    std::vector<Eigen::Index> dense;
+    for (std::size_t i = 0; i < dense_row.size(); ++i)
+      if (dense_row[i]) dense.push_back(static_cast<Eigen::Index>(i));
+    if (dense.empty()) return true;
+    d.resize(static_cast<Eigen::Index>(dense.size()), J.cols());
+    for (std::size_t r = 0; r < dense.size(); ++r)
+      d.row(static_cast<Eigen::Index>(r)) = J.row(dense[r]);
+    z = factor.solve(Matrix(d.transpose()));
+    capacitance.compute(Matrix::Identity(d.rows(), d.rows()) + d * z);
+    return capacitance.info() == Eigen::Success && z.allFinite();
+  }
 };
 
 // sigma_max of the Gram's operator A (A^T A = J^T J); 0 when the iteration breaks down at once.
@@ -231,20 +259,18 @@ bool smallest_singular_values(const Gram& gram, Eigen::Index n, double relative_
 // full SVD) when R is singular to working precision, the block would exceed n / 2, or 60 steps
 // do not converge. Measured on the contact bar's mode 1 at N = 160 (321 x 161): 4-7 steps,
 // sigma_zero and sigma_kept within 3.4e-6 of the full SVD's (sigma_max's Lanczos estimate),
-// the same branch and dimensions; core/README.md, 'Rank reports'. A sparse J without dense
-// rows skips the QR: the products are J's, the inverse iteration a sparse Cholesky solve
+// the same branch and dimensions; core/README.md, 'Rank reports'. A sparse J (a few dense rows
+// allowed) skips the QR: the products are J's, the inverse iteration a sparse Cholesky solve
 // (SparseGram); should that not converge, the QR is taken after all.
 bool smallest_singular_values(const Matrix& J, double relative_threshold, double absolute_threshold,
                               SmallestSingularValues& out) {
   const Eigen::Index n = J.cols();
   if (J.rows() < n || n < 4) return false;
   {
-    // Sparse without dense rows (those would make J^T J dense): no QR at all.
+    // Sparse, its few dense rows set apart (SparseGram): no QR at all.
     SparseGram sparse;
     std::vector<char> dense_row;
-    if (sparse_view(J, sparse.a, dense_row) &&
-        std::find(dense_row.begin(), dense_row.end(), 1) == dense_row.end() &&
-        factor_shifted_normal(sparse.a, sparse.factor) &&
+    if (sparse_view(J, sparse.a, dense_row) && sparse.factor_with_dense_rows(J, dense_row) &&
         smallest_singular_values(sparse, n, relative_threshold, absolute_threshold, out))
       return true;
   }

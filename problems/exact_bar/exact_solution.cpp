@@ -155,8 +155,8 @@ void ExactBarSolution::march() {
   EndState right_state{false, 1, u0(L), 0.0, {}};
   if (tangent_size_ > 0) {
     seed_initial_signals(xs);
-    left_state.du = seed_.d_value.front();
-    right_state.du = seed_.d_value.back();
+    left_state.du = Eigen::VectorXd(seed_.d_value.front());
+    right_state.du = Eigen::VectorXd(seed_.d_value.back());
   }
   // Signals must cover [0, t_end + tau] (a profile at t reads them up to t + tau) and the end
   // tracks [0, t_end]; one more window keeps every query strictly inside.
@@ -214,14 +214,14 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
     // Tangent: the derivatives of rc and of the value yc there (README.md, 'Tangent').
     SegmentTangent piece;
     if (tangent) piece = {ts->dr0, ts->dr1, ts->dy0};
-    auto emit_to = [&](double r1, const Eigen::VectorXd* dr1, bool negative, bool closed) {
+    auto emit_to = [&](double r1, const Sensitivity* dr1, bool negative, bool closed) {
       if (!tangent) return emit(side, k, rc, r1, yc, s.slope, negative, closed, state);
       piece.dr1 = dr1 ? *dr1 : ts->dr1;
       emit(side, k, rc, r1, yc, s.slope, negative, closed, state, &piece);
     };
     // Moves rc to the event at rc + ds (with d(ds) when tangent) and yc with it (segments
     // are constant with a tangent: yc's derivative stays).
-    auto advance = [&](double ds, const Eigen::VectorXd& d_ds) {
+    auto advance = [&](double ds, const Sensitivity& d_ds) {
       if (tangent) piece.dr0 += d_ds;
       yc += s.slope * ds;
       rc += ds;
@@ -243,7 +243,7 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
           emit_to(s.r1, nullptr, true, true);
           break;
         }
-        Eigen::VectorXd d_sr, d_release;
+        Sensitivity d_sr, d_release;
         if (tangent) {  // q + qm sr = 0 (qm != 0 here: a constant segment releases at its start)
           d_sr = -piece.dy0 / s.slope;
           d_release = piece.dr0 + d_sr;
@@ -277,11 +277,13 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
           emit_to(s.r1, nullptr, false, false);
           break;
         }
-        Eigen::VectorXd d_sc, d_close;
+        Sensitivity d_sc, d_close;
         if (tangent) {
           // w(rc + sc) = wall: w(rc) + yc sc = wall_u (a constant segment), so
           // yc d_sc = -(dw + sc dyc).
-          d_sc = -(state.du + sc * piece.dy0) / yc;
+          Eigen::VectorXd dense = state.du;
+          dense += sc * piece.dy0;
+          d_sc = (dense / -yc).sparseView(1.0, 0.0);
           d_close = piece.dr0 + d_sc;
         }
         emit_to(rc + sc, tangent ? &d_close : nullptr, false, false);
@@ -308,7 +310,7 @@ void ExactBarSolution::emit(Side side, long k, double r0, double r1, double in0,
     auto& other_tangent = side == Side::right ? b_tan_ : a_tan_;
     other_tangent.push_back({tangent->dr0, tangent->dr1, sign * tangent->dy0});
     if (!reflect_negative)  // the free end's displacement gains int in = in0 (r1 - r0)
-      state.du.noalias() += (r1 - r0) * tangent->dy0 + in0 * (tangent->dr1 - tangent->dr0);
+      state.du += (r1 - r0) * tangent->dy0 + in0 * (tangent->dr1 - tangent->dr0);
   }
   const double sign = reflect_negative ? -1.0 : 1.0;
   const double out0 = sign * in0, out_slope = sign * in_slope;

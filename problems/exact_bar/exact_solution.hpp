@@ -21,6 +21,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -34,14 +35,18 @@ enum class Side { left, right };
 // Forward sensitivities of a solution with respect to n parameters p on which its initial
 // displacement depends (v0 = 0, no body force): per knot i of setup.u0, the derivatives of its
 // position and of its value, each a vector of size n (README.md, 'Tangent').
+// Sparse: a segment depends on the few knots its characteristics come from, except where an
+// event (a closing, a release) has gathered the end's whole history.
+using Sensitivity = Eigen::SparseVector<double>;
 struct InitialTangent {
-  std::vector<Eigen::VectorXd> d_knot, d_value;
+  std::vector<Sensitivity> d_knot, d_value;
 };
 
-// The derivatives of the hat projections int v(x, t) psi_i dx on a uniform grid: d_p, one row
-// per node i = 0..elements and one column per parameter, at fixed t; and d_t, their rate in t.
+// The derivatives of the hat projections int v(x, t) psi_i dx on a uniform grid: d_p, one
+// column per node i = 0..elements (n x (elements + 1): the gradient of that projection in the
+// n parameters) at fixed t; and d_t, their rate in t.
 struct ProjectedVelocityTangent {
-  Eigen::MatrixXd d_p;  // (elements + 1) x n
+  Eigen::MatrixXd d_p;
   Eigen::VectorXd d_t;
 };
 
@@ -135,12 +140,12 @@ class ExactBarSolution {
     int side = 1;               // the wall of a closed end: +1 front, -1 back (clearance)
     double u = 0;               // displacement of the end
     double u_compensation = 0;  // Kahan: low-order part lost when adding to u
-    Eigen::VectorXd du;         // its derivative (tangent only)
+    Eigen::VectorXd du;         // its derivative (tangent only; dense: it sums the history)
   };
   // The derivatives of a segment's data (tangent only): of its start and end times and of its
   // value. With v0 = 0 and no body force every segment is constant (slope 0), and stays so.
   struct SegmentTangent {
-    Eigen::VectorXd dr0, dr1, dy0;
+    Sensitivity dr0, dr1, dy0;
   };
   struct Local {
     long k;

@@ -23,7 +23,7 @@ void ExactBarSolution::seed_initial_signals(const std::vector<double>& xs) {
   if (xs.size() != knots.size())
     throw InputError("tangent", "u0's knots must include 0 and L and hold every breakpoint");
   const std::size_t elements = xs.size() - 1;
-  std::vector<Eigen::VectorXd> d_slope(elements);
+  std::vector<Sensitivity> d_slope(elements);
   for (std::size_t j = 0; j < elements; ++j) {
     const double width = knots[j + 1] - knots[j];
     const double slope = (values[j + 1] - values[j]) / width;
@@ -31,15 +31,14 @@ void ExactBarSolution::seed_initial_signals(const std::vector<double>& xs) {
                   slope * (seed_.d_knot[j + 1] - seed_.d_knot[j])) /
                  width;
   }
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(tangent_size_);
+  const Sensitivity zero(tangent_size_);
   b_tan_.clear();
   a_tan_.clear();
   for (std::size_t j = 0; j < elements; ++j)  // B, in the order march() pushes it
     b_tan_.push_back({seed_.d_knot[j] / c_, j + 1 == elements ? zero : seed_.d_knot[j + 1] / c_,
                       c_ * d_slope[j]});
   for (std::size_t j = elements; j > 0; --j)  // A, from x = L down
-    a_tan_.push_back({-seed_.d_knot[j] / c_,
-                      j == 1 ? zero : Eigen::VectorXd(-seed_.d_knot[j - 1] / c_),
+    a_tan_.push_back({-seed_.d_knot[j] / c_, j == 1 ? zero : Sensitivity(-seed_.d_knot[j - 1] / c_),
                       -c_ * d_slope[j - 1]});
 }
 
@@ -47,15 +46,14 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
                                                                       int elements) const {
   if (tangent_size_ == 0)
     throw std::logic_error("projected_velocity_tangent: the solution carries no tangent");
-  if (elements < 1)
-    throw InputError("elements", fmt::format("must be >= 1 (got {})", elements));
+  if (elements < 1) throw InputError("elements", fmt::format("must be >= 1 (got {})", elements));
   check_time(t);
   const double L = setup_.material.length;
   const Local lt = to_local(t);
   const long k = lt.k;
   const double rt = lt.r, rest = tau_ - lt.r;
   const int n = tangent_size_;
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  const Sensitivity zero(n);
 
   // The fronts at t, as profile() finds them, with their derivatives in p and their speed.
   // Fronts of A and of B that coincide at t (as a mode's closing and release fronts do at T/2)
@@ -63,11 +61,12 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
   struct Front {
     double x;
     bool of_a;  // a front of A (runs towards x = 0 as t grows), else of B
-    Eigen::VectorXd dx;
+    Sensitivity dx;
   };
   struct Breakpoint {
     double x;
-    Eigen::VectorXd dx_a, dx_b;  // zero when no front of that signal sits here
+    Sensitivity dx_a, dx_b;  // zero when no front of that signal sits here
+    bool has_a = false, has_b = false;
   };
   std::vector<Front> fronts;
   auto add_fronts = [&](const Chunked<Segment>& sig, const std::vector<SegmentTangent>& tan,
@@ -99,15 +98,21 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
     if (!(L - f.x > tol)) continue;
     if (f.x - kept.back().x > tol) kept.push_back({f.x, zero, zero});
     if (kept.size() == 1) continue;  // at x = 0
-    Eigen::VectorXd& dx = f.of_a ? kept.back().dx_a : kept.back().dx_b;
-    if (dx.isZero(0.0)) dx = f.dx;
+    Breakpoint& at = kept.back();
+    if (f.of_a && !at.has_a) {
+      at.dx_a = f.dx;
+      at.has_a = true;
+    } else if (!f.of_a && !at.has_b) {
+      at.dx_b = f.dx;
+      at.has_b = true;
+    }
   }
   kept.push_back({L, zero, zero});
 
   // A signal's value at argument t + offset with its derivative at fixed argument and its
   // slope, from the segment that holds t + mid_offset (the piece's own side of a front).
   auto value = [&](const Chunked<Segment>& sig, const std::vector<SegmentTangent>& tan,
-                   double offset, double mid_offset, Eigen::VectorXd& d, double& slope) {
+                   double offset, double mid_offset, Sensitivity& d, double& slope) {
     const double rm = rt + mid_offset;
     const long kk = rm < tau_ ? k : k + 1;
     const double shift = kk == k ? 0.0 : tau_;
@@ -126,8 +131,7 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
     return seg.at(arg);
   };
 
-  // Accumulated transposed (one contiguous column per node), returned as rows.
-  Eigen::MatrixXd d_pt = Eigen::MatrixXd::Zero(n, elements + 1);
+  Eigen::MatrixXd d_pt = Eigen::MatrixXd::Zero(n, elements + 1);  // one column per node
   Eigen::VectorXd d_t = Eigen::VectorXd::Zero(elements + 1);
   const double h = L / elements;
   auto hat = [&](int i, double x) { return std::max(0.0, 1 - std::abs(x - i * h) / h); };
@@ -136,17 +140,17 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
   double a_left = 0, b_left = 0;  // A and B just left of the breakpoint (from the piece before)
   for (std::size_t j = 0; j + 1 < kept.size(); ++j) {
     const double xa = kept[j].x, xb = kept[j + 1].x, xm = 0.5 * (xa + xb);
-    Eigen::VectorXd dpa, dpb, dma, dmb;
+    Sensitivity dpa, dpb, dma, dmb;
     double slope_a, slope_b;
     const double plus_a = value(a_, a_tan_, (L - xa) / c_, (L - xm) / c_, dpa, slope_a);
     const double plus_b = value(a_, a_tan_, (L - xb) / c_, (L - xm) / c_, dpb, slope_a);
     const double minus_a = value(b_sig_, b_tan_, xa / c_, xm / c_, dma, slope_b);
     const double minus_b = value(b_sig_, b_tan_, xb / c_, xm / c_, dmb, slope_b);
-    const Eigen::VectorXd ga = 0.5 * (dpa + dma), gb = 0.5 * (dpb + dmb);
+    const Sensitivity ga = 0.5 * (dpa + dma), gb = 0.5 * (dpb + dmb);
     const double vt = 0.5 * (slope_a + slope_b);  // dv/dt at fixed x
-    if (j > 0) {  // the breakpoint at xa
+    if (j > 0) {                                  // the breakpoint at xa
       const double jump_a = 0.5 * (a_left - plus_a), jump_b = 0.5 * (b_left - minus_a);
-      const Eigen::VectorXd dx = jump_a * kept[j].dx_a + jump_b * kept[j].dx_b;
+      const Sensitivity dx = jump_a * kept[j].dx_a + jump_b * kept[j].dx_b;
       const double dx_dt = (jump_a - jump_b) * c_;
       const int cell = static_cast<int>(std::floor(xa / h));
       for (int i = std::max(0, cell); i <= std::min(elements, cell + 1); ++i) {
@@ -162,7 +166,7 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
     // int g psi_i and int vt psi_i over the piece: g linear, psi_i linear on each cell, so
     // Simpson's rule on every (piece x cell) intersection is exact; with g = ga + f (gb - ga),
     // f = (x - xa) / (xb - xa), each weight splits into a multiple of ga and one of gb - ga.
-    const Eigen::VectorXd diff = gb - ga;
+    const Sensitivity diff = gb - ga;
     const double width = xb - xa;
     const int first_cell = std::clamp(static_cast<int>(std::floor(xa / h)), 0, elements - 1);
     for (int cell = first_cell; cell < elements && cell * h < xb; ++cell) {
@@ -173,13 +177,13 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
       for (int i : {cell, cell + 1}) {
         const double ha = hat(i, a), hm = hat(i, m), hb = hat(i, b);
         const double whole = w * (ha + 4 * hm + hb), along = w * (ha * fa + 4 * hm * fm + hb * fb);
-        d_pt.col(i).noalias() += whole * ga + along * diff;
+        d_pt.col(i) += whole * ga;
+        d_pt.col(i) += along * diff;
         d_t[i] += whole * vt;
       }
     }
   }
-  ProjectedVelocityTangent out{d_pt.transpose(), d_t};
-  return out;
+  return {std::move(d_pt), std::move(d_t)};
 }
 
 }  // namespace backbone::exact_bar

@@ -571,9 +571,9 @@ EvalStatus ContactBarOrbitProblem::compute_jacobian(const Vector& x, core::Matri
   Vector scratch;
   if (compute_residual(x, scratch) != EvalStatus::ok) return EvalStatus::failed;
   exact_bar::InitialTangent seed;
-  seed.d_knot.assign(static_cast<std::size_t>(n) + 1, Vector::Zero(unknowns));
-  seed.d_value.assign(static_cast<std::size_t>(n) + 1, Vector::Zero(unknowns));
-  for (int i = 1; i <= options_.nodal_unknowns(); ++i) seed.d_value[i][i - 1] = 1;
+  seed.d_knot.assign(static_cast<std::size_t>(n) + 1, exact_bar::Sensitivity(unknowns));
+  seed.d_value.assign(static_cast<std::size_t>(n) + 1, exact_bar::Sensitivity(unknowns));
+  for (int i = 1; i <= options_.nodal_unknowns(); ++i) seed.d_value[i].insert(i - 1) = 1;
   if (k > 0) {  // node i between the anchors i0 and i1 (node_positions)
     const std::vector<int> anchors = reference_knot_nodes();
     int segment = 0;
@@ -582,8 +582,8 @@ EvalStatus ContactBarOrbitProblem::compute_jacobian(const Vector& x, core::Matri
       const int i0 = segment == 0 ? 0 : anchors[segment - 1];
       const int i1 = segment == k ? n : anchors[segment];
       const double w = static_cast<double>(i - i0) / (i1 - i0);
-      if (segment > 0) seed.d_knot[i][knot_index(segment - 1)] = i == i1 ? 0.0 : 1 - w;
-      if (segment < k) seed.d_knot[i][knot_index(segment)] = i == i1 ? 1.0 : w;
+      if (segment > 0 && i != i1) seed.d_knot[i].insert(knot_index(segment - 1)) = 1 - w;
+      if (segment < k) seed.d_knot[i].insert(knot_index(segment)) = i == i1 ? 1.0 : w;
     }
   }
   exact_bar::ExactBarSolution solution(setup_at(x), 0.5 * period, std::move(seed));
@@ -593,12 +593,12 @@ EvalStatus ContactBarOrbitProblem::compute_jacobian(const Vector& x, core::Matri
   const double dx = length / m;
   const double scale = setup_.material.travel_time() / displacement_scale();
   const int rows = path_rows_enabled_ ? options_.path_rows() : 0;
-  J.setZero(m + rows, unknowns);
-  for (int i = 1; i <= m; ++i) {
-    const double factor = scale / (i == m ? 0.5 * dx : dx);
-    J.row(i - 1) = factor * d.d_p.row(i);
-    J(i - 1, period_index()) = factor * 0.5 * d.d_t[i];
-  }
+  Vector factor = Vector::Constant(m, scale / dx);
+  factor[m - 1] *= 2;  // the last hat is half
+  J.resize(m + rows, unknowns);
+  J.topRows(m) = factor.asDiagonal() * d.d_p.middleCols(1, m).transpose();
+  J.col(period_index()).head(m) = 0.5 * factor.cwiseProduct(d.d_t.segment(1, m));
+  J.bottomRows(rows).setZero();
   return J.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 

@@ -133,6 +133,30 @@ TEST(SmallestSingularValues, TheBlockDoublesWhileTheValuesBelowFillIt) {
   EXPECT_NEAR(few.values[6], o.s[30], 1e-9 * o.s[30]);  // the smallest above the threshold
 }
 
+// The same sparse matrix with two dense rows appended (rows with an entry in every column, as
+// the contact bar's exact Jacobian has where a front's motion depends on every unknown): the
+// sparse path sets them apart (Woodbury) and must agree with the full SVD of that J.
+TEST(SmallestSingularValues, ASparseMatrixWithDenseRowsAgreesWithTheFullSvd) {
+  const Eigen::Index n = 64;
+  Vector tail(2);
+  tail << 1e-9, 1e-11;
+  const Vector s = spectrum(n, tail);
+  Matrix J = Matrix::Zero(2 * n + 2, n);
+  for (Eigen::Index j = 0; j < n; ++j) J(2 * j, j) = (j % 3 ? -1.0 : 1.0) * s[j];
+  for (Eigen::Index j = 0; j < n; ++j) {  // dense, but none along e_62, e_63
+    J(2 * n, j) = j < n - 2 ? std::sin(0.3 * j + 0.1) : 0.0;
+    J(2 * n + 1, j) = j < n - 2 ? std::cos(0.7 * j) : 0.0;
+  }
+  const Eigen::JacobiSVD<Matrix> full(J, Eigen::ComputeThinV);
+  SmallestSingularValues few;
+  ASSERT_TRUE(smallest_singular_values(J, 1e-8, 0.0, few));
+  EXPECT_NEAR(few.largest, full.singularValues()[0], 1e-10 * full.singularValues()[0]);
+  EXPECT_LT(span_distance(full.matrixV().rightCols(2), few.right.rightCols(2)), 1e-8);
+  // The smallest value above the threshold: the shift's 5e-6 relative as in the test below.
+  const Eigen::Index k = few.values.size();
+  EXPECT_NEAR(few.values[k - 3], full.singularValues()[n - 3], 1e-5 * full.singularValues()[n - 3]);
+}
+
 TEST(SmallestSingularValues, ASparseMatrixTakesTheSparsePathToTheSameAnswer) {
   // A signed permutation of rows times a diagonal (orthogonal factors that keep J sparse: one
   // entry per row, 128 x 64), so that the sparse Cholesky path answers. Its shift of 1e-10 of

@@ -49,9 +49,8 @@ std::vector<Case> cases() {
   oc.free_knots = 1;
   oc.knot_nodes = {11};
   oc.test_elements = 40;
-  out.push_back({"clearance mode 1", clearance, oc, [](const ContactBarOrbitProblem& p) {
-                   return p.clearance_guess(1, 2e-5);
-                 }});
+  out.push_back({"clearance mode 1", clearance, oc,
+                 [](const ContactBarOrbitProblem& p) { return p.clearance_guess(1, 2e-5); }});
   return out;
 }
 
@@ -69,8 +68,7 @@ TEST(ExactJacobian, MatchesCentralDifferencesAwayFromKinks) {
       ASSERT_TRUE(p.exact_jacobian_applies());
       core::Vector x = c.point(p);
       // Off the closed form (a rough u0, a period off the orbit's): a generic state.
-      for (int i = 0; i < p.options().nodal_unknowns(); ++i)
-        x[i] += 2e-5 * std::sin(1.7 * i + 0.3);
+      for (int i = 0; i < p.options().nodal_unknowns(); ++i) x[i] += 2e-5 * std::sin(1.7 * i + 0.3);
       x[p.period_index()] *= 1.003;
       core::Matrix exact, fd;
       ASSERT_EQ(p.jacobian(x, exact), core::EvalStatus::ok) << c.name;
