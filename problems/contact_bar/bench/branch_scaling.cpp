@@ -47,14 +47,26 @@ struct Mode1Scene {
 void read_mode1_scene(Mode1Scene& s, const Mode1BranchSettings& settings) {
   s.contact_bar = trace_plugin();
   s.plugin = &s.contact_bar;
-  s.scene = bench::read_paper_scene(
-      *s.plugin,
-      {"--start_offset", "0.25", "--energy_max", fmt::format("{:.17g}", settings.energy_max),
-       "--shooting_elements", std::to_string(settings.elements), "--steps_per_period",
-       std::to_string(settings.steps_per_period), "--formulation", settings.formulation, "--newton",
-       settings.newton, "--test_elements", std::to_string(settings.test_elements), "--threads",
-       std::to_string(settings.threads), "--rank_check_every",
-       std::to_string(settings.rank_check_every)});
+  s.scene = bench::read_paper_scene(*s.plugin, {"--start_offset",
+                                                fmt::format("{:.17g}", settings.start_offset),
+                                                "--energy_max",
+                                                fmt::format("{:.17g}", settings.energy_max),
+                                                "--shooting_elements",
+                                                std::to_string(settings.elements),
+                                                "--steps_per_period",
+                                                std::to_string(settings.steps_per_period),
+                                                "--formulation",
+                                                settings.formulation,
+                                                "--newton",
+                                                settings.newton,
+                                                "--test_elements",
+                                                std::to_string(settings.test_elements),
+                                                "--threads",
+                                                std::to_string(settings.threads),
+                                                "--rank_check_every",
+                                                std::to_string(settings.rank_check_every),
+                                                "--jacobian",
+                                                settings.jacobian});
 }
 
 // The 1-minute load average of the machine (Linux /proc/loadavg), "unknown" elsewhere: wall
@@ -78,6 +90,9 @@ std::string error_text(double value) {
 std::string Mode1BranchSettings::label() const {
   if (study == "grid") return fmt::format("N = {}", elements);
   if (study == "grid_unchecked") return fmt::format("N = {}, no rank checks", elements);
+  if (study == "grid_exact" || study == "grid_exact_differences")
+    return fmt::format("N = {}, {} Jacobian, start 1.3 g0", elements,
+                       jacobian == "exact" ? "exact" : "differences");
   std::string text = fmt::format("N = {}", elements);
   if (steps_per_period != 40) text += fmt::format(", steps_per_period = {}", steps_per_period);
   if (formulation != "regular") text += fmt::format(", {} formulation", formulation);
@@ -119,6 +134,8 @@ Mode1BranchCost trace_mode1_cost(const Mode1BranchSettings& settings) {
     c.jacobians += p.jacobian_evaluations;
     c.unknowns.push_back(p.x);
   }
+  for (double z : continuation::branch_table(branch).column("sigma_zero"))
+    if (std::isfinite(z)) c.sigma_zero = std::max(c.sigma_zero, z);
   c.median_error = bench::median(errors);
   c.worst_error = errors.empty() ? std::nan("") : *std::max_element(errors.begin(), errors.end());
   c.energy_reached =
@@ -139,13 +156,15 @@ core::Table branch_cost_table(const std::vector<Mode1BranchCost>& runs) {
   core::Table table({"study", "setting", "N", "steps_per_period", "formulation", "newton",
                      "test_elements", "threads", "points", "jacobians_per_point", "ms_per_point",
                      "total_seconds", "wall_seconds", "worst_closed_form_error",
-                     "median_closed_form_error", "energy_reached", "complete"});
+                     "median_closed_form_error", "energy_reached", "complete", "jacobian",
+                     "sigma_zero_max"});
   for (const Mode1BranchCost& c : runs)
     table.add_cells({c.settings.study, c.settings.label(), double(c.settings.elements),
                      double(c.settings.steps_per_period), c.settings.formulation, c.settings.newton,
                      double(c.settings.test_elements), double(c.settings.threads), double(c.points),
                      c.jacobians_per_point(), c.ms_per_point(), c.cpu_seconds, c.wall_seconds,
-                     c.worst_error, c.median_error, c.energy_reached, c.complete ? 1.0 : 0.0});
+                     c.worst_error, c.median_error, c.energy_reached, c.complete ? 1.0 : 0.0,
+                     c.settings.jacobian, c.sigma_zero});
   return table;
 }
 
@@ -219,7 +238,7 @@ constexpr int variant_n = 40, threads_n = 80, jacobian_n = 200;
 
 // Every run of the case: `all` in the table's order, the rest by study.
 struct ScalingRuns {
-  std::vector<Mode1BranchCost> all, grid, fine, unchecked;
+  std::vector<Mode1BranchCost> all, grid, fine, unchecked, exact;
   Mode1BranchCost base, spp80, paper, eigen_square, kinsol_square, threads_base, threads;
   bool threads_same = false;
   int status = 0;  // 1 when a grid run stops early or threads change the branch
@@ -277,6 +296,20 @@ void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
     s.steps_per_period = 2 * n;
     r.run_into(r.fine, s);
   }
+  // The exact Jacobian (orbits/README.md, 'Exact Jacobian') against the differences on the
+  // same grids, from end amplitude 1.3 g0 (T = 3.77): the grids' start at 1.25 g0, T = 3.8 =
+  // 19/5 L/c, is a branch point of mode 1, where the exact Jacobian's clean two-dimensional
+  // null space leaves the first tangent to the direction hint, 48 degrees off the branch.
+  for (int n : grids)
+    for (const char* jacobian : {"exact", "differences"}) {
+      Mode1BranchSettings s;
+      s.study =
+          std::string("grid_exact") + (jacobian == std::string("exact") ? "" : "_differences");
+      s.elements = n;
+      s.jacobian = jacobian;
+      s.start_offset = 0.3;
+      r.run_into(r.exact, s);
+    }
   // Without rank reports (--rank_check_every 0), up to N = 640: what the corrections cost
   // alone, without the verification of the many-dimensional start at T = 3.8, which dominates
   // the checked trace at large N (problems/contact_bar/bench/README.md, 'Cost').
@@ -409,10 +442,25 @@ std::string cost_row(const Mode1BranchCost& c) {
   const std::string stopped =
       c.complete ? std::string()
                  : fmt::format(" (stopped at E = {:.2g}: {})", c.energy_reached, c.stop_reason);
-  return fmt::format("| {}{} | {} | {} | {} | {} | {} | {} |\n", c.settings.label(), stopped,
+  return fmt::format("| {}{} | {} | {} | {} | {} | {} | {} | {} |\n", c.settings.label(), stopped,
                      c.points, significant(c.jacobians_per_point()), significant(c.ms_per_point()),
                      significant(c.cpu_seconds), error_text(c.worst_error),
-                     error_text(c.median_error));
+                     error_text(c.median_error), error_text(c.sigma_zero));
+}
+
+// The exact Jacobian against the differences, grid by grid: ms per point and sigma_zero.
+std::string exact_verdict(const ScalingRuns& r) {
+  std::string rows;
+  for (const Mode1BranchCost& e : r.exact)
+    for (const Mode1BranchCost& d : r.exact)
+      if (e.settings.jacobian == "exact" && d.settings.jacobian == "differences" &&
+          d.settings.elements == e.settings.elements)
+        rows += fmt::format(
+            "{}N = {}: {} against {} ms per point, sigma_zero at most {} against {}",
+            rows.empty() ? "" : "; ", e.settings.elements, significant(e.ms_per_point()),
+            significant(d.ms_per_point()), error_text(e.sigma_zero), error_text(d.sigma_zero));
+  return rows.empty() ? std::string()
+                      : " With the exact Jacobian (`--jacobian exact`): " + rows + ".";
 }
 
 std::string grid_verdict(const ScalingRuns& r, const GridFit& f) {
@@ -502,9 +550,9 @@ std::string scaling_section(const ScalingRuns& r, const JacobianThreadsTiming& j
                             const std::string& jacobian) {
   const std::string header =
       "| setting | points | Jacobians/point | ms/point (CPU) | total CPU s | worst error | "
-      "median error |\n|---|---|---|---|---|---|---|\n";
+      "median error | sigma_zero max |\n|---|---|---|---|---|---|---|---|\n";
   std::string grid_rows, variant_rows;
-  for (const std::vector<Mode1BranchCost>* study : {&r.grid, &r.fine, &r.unchecked})
+  for (const std::vector<Mode1BranchCost>* study : {&r.grid, &r.fine, &r.unchecked, &r.exact})
     for (const Mode1BranchCost& c : *study) grid_rows += cost_row(c);
   for (const Mode1BranchCost* c : {&r.base, &r.spp80, &r.paper, &r.eigen_square, &r.kinsol_square,
                                    &r.threads_base, &r.threads})
@@ -566,13 +614,15 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
 
   const std::string grid = grid_verdict(r, fit);
   const std::string unchecked = unchecked_verdict(r);
-  fmt::print("  {}\n", unchecked);
+  const std::string exact = exact_verdict(r);
+  fmt::print("  {}\n  {}\n", unchecked, exact);
   const std::string fine = fine_verdict(r);
   const std::string variants = variant_verdict(r);
   const std::string jacobian = jacobian_verdict(jt, load);
   fmt::print("  {}\n  {}\n  {}\n", grid, variants, jacobian);
-  cli::write_bench_section(out, "mode1_scaling",
-                           scaling_section(r, jt, grid + fine + unchecked, variants, jacobian));
+  cli::write_bench_section(
+      out, "mode1_scaling",
+      scaling_section(r, jt, grid + fine + unchecked + exact, variants, jacobian));
   return r.status;
 }
 

@@ -27,12 +27,14 @@ struct Mode1BranchSettings {
   std::string study = "grid";  // the row group of the table: grid, steps_per_period, ...
   int elements = 20;           // --shooting_elements
   int steps_per_period = 40;
-  std::string formulation = "regular";  // or paper (scene key formulation)
-  std::string newton = "eigen";         // or kinsol (square systems only: test_elements 0)
-  int test_elements = -1;               // -1: the trace's auto (2x the unknowns)
-  int threads = 1;                      // finite-difference Jacobian columns
-  int rank_check_every = 1;             // --rank_check_every (0: no rank reports)
-  double energy_max = 5e-3;             // [J]
+  std::string formulation = "regular";   // or paper (scene key formulation)
+  std::string newton = "eigen";          // or kinsol (square systems only: test_elements 0)
+  int test_elements = -1;                // -1: the trace's auto (2x the unknowns)
+  int threads = 1;                       // finite-difference Jacobian columns
+  int rank_check_every = 1;              // --rank_check_every (0: no rank reports)
+  double energy_max = 5e-3;              // [J]
+  std::string jacobian = "differences";  // or exact (--jacobian)
+  double start_offset = 0.25;            // --start_offset (0.25: T = 3.8, a branch point)
   // "N = 40", "steps_per_period = 80", "paper formulation", ...: the row's label.
   std::string label() const;
 };
@@ -49,6 +51,7 @@ struct Mode1BranchCost {
   double worst_error = 0;   // max |omega / omega_exact(E) - 1| over the points
   double median_error = 0;
   double energy_reached = 0;           // the last point's energy [J]
+  double sigma_zero = 0;               // the largest sigma_zero of the points' rank reports
   std::vector<core::Vector> unknowns;  // every point's x, to compare branches bit for bit
 
   double ms_per_point() const;  // CPU
