@@ -299,7 +299,7 @@ void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
   // The exact Jacobian (orbits/README.md, 'Exact Jacobian') against the differences on the
   // same grids, from end amplitude 1.3 g0 (T = 3.77): the grids' start at 1.25 g0, T = 3.8 =
   // 19/5 L/c, is a branch point of mode 1, where the exact Jacobian's clean two-dimensional
-  // null space leaves the first tangent to the direction hint, 48 degrees off the branch.
+  // null space leaves the first tangent to the direction hint, off the branch.
   for (int n : grids)
     for (const char* jacobian : {"exact", "differences"}) {
       Mode1BranchSettings s;
