@@ -360,27 +360,10 @@ std::vector<ExactBarSolution::Piece> ExactBarSolution::profile(double t) const {
   const double L = setup_.material.length;
   const Local lt = to_local(t);
   const long k = lt.k;
-  const double rt = lt.r, rest = tau_ - lt.r;  // the window of t ends rest after t
-  // Breakpoints: segment starts whose argument s lies in (t, t + tau). For A,
-  // x = L - c (s - t); for B, x = c (s - t).
+  const double rt = lt.r;
   std::vector<double> xs{0.0, L};
   auto add_breakpoints = [&](const Chunked<Segment>& sig, bool from_right) {
-    for (long kk : {k, k + 1}) {
-      if (kk >= static_cast<long>(sig.first.size())) continue;
-      for (std::size_t i = sig.first[kk]; i < sig.end_of(kk); ++i) {
-        const double r0 = sig.segments[i].r0;
-        double offset;  // s - t
-        if (kk == k) {
-          if (!(r0 > rt)) continue;
-          offset = r0 - rt;
-        } else {
-          if (!(r0 < rt)) break;
-          offset = rest + r0;
-        }
-        const double x = from_right ? L - c_ * offset : c_ * offset;
-        xs.push_back(std::clamp(x, 0.0, L));
-      }
-    }
+    for_each_front(sig, from_right, t, [&](std::size_t, double x) { xs.push_back(x); });
   };
   add_breakpoints(a_, true);
   add_breakpoints(b_sig_, false);

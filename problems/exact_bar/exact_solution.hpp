@@ -22,6 +22,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -173,6 +174,11 @@ class ExactBarSolution {
   Local to_local(double t) const;
   double global_time(long k, double r) const;
   std::vector<Piece> profile(double t) const;
+  // Calls f(i, x) for every segment i of `sig` (A when from_right, else B) whose start is a
+  // front in flight at t: its argument s in (t, t + tau), at x = L - c (s - t) for A, c (s - t)
+  // for B (clamped to [0, L]).
+  template <class F>
+  void for_each_front(const Chunked<Segment>& sig, bool from_right, double t, F&& f) const;
   const EndSegment& end_segment(Side side, double t, double& r) const;
   double end_strain(const EndSegment& seg, Side side, double r) const;
   Side observed() const;
@@ -189,6 +195,30 @@ class ExactBarSolution {
   int tangent_size_ = 0;
   std::vector<SegmentTangent> a_tan_, b_tan_;
 };
+
+template <class F>
+inline void ExactBarSolution::for_each_front(const Chunked<Segment>& sig, bool from_right, double t,
+                                             F&& f) const {
+  const double L = setup_.material.length;
+  const Local lt = to_local(t);
+  const long k = lt.k;
+  const double rt = lt.r, rest = tau_ - lt.r;  // the window of t ends rest after t
+  for (long kk : {k, k + 1}) {
+    if (kk >= static_cast<long>(sig.first.size())) continue;
+    for (std::size_t i = sig.first[kk]; i < sig.end_of(kk); ++i) {
+      const double r0 = sig.segments[i].r0;
+      double offset;  // s - t
+      if (kk == k) {
+        if (!(r0 > rt)) continue;
+        offset = r0 - rt;
+      } else {
+        if (!(r0 < rt)) break;
+        offset = rest + r0;
+      }
+      f(i, std::clamp(from_right ? L - c_ * offset : c_ * offset, 0.0, L));
+    }
+  }
+}
 
 // Convenience: ExactBarSolution(setup, t_end).
 ExactBarSolution solve(const bar::BarSetup& setup, double t_end);

@@ -51,7 +51,7 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
   const double L = setup_.material.length;
   const Local lt = to_local(t);
   const long k = lt.k;
-  const double rt = lt.r, rest = tau_ - lt.r;
+  const double rt = lt.r;
   const int n = tangent_size_;
   const Sensitivity zero(n);
 
@@ -71,22 +71,9 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
   std::vector<Front> fronts;
   auto add_fronts = [&](const Chunked<Segment>& sig, const std::vector<SegmentTangent>& tan,
                         bool from_right) {
-    for (long kk : {k, k + 1}) {
-      if (kk >= static_cast<long>(sig.first.size())) continue;
-      for (std::size_t i = sig.first[kk]; i < sig.end_of(kk); ++i) {
-        const double r0 = sig.segments[i].r0;
-        double offset;  // s - t
-        if (kk == k) {
-          if (!(r0 > rt)) continue;
-          offset = r0 - rt;
-        } else {
-          if (!(r0 < rt)) break;
-          offset = rest + r0;
-        }
-        const double x = from_right ? L - c_ * offset : c_ * offset;
-        fronts.push_back({std::clamp(x, 0.0, L), from_right, (from_right ? -c_ : c_) * tan[i].dr0});
-      }
-    }
+    for_each_front(sig, from_right, t, [&](std::size_t i, double x) {
+      fronts.push_back({x, from_right, (from_right ? -c_ : c_) * tan[i].dr0});
+    });
   };
   add_fronts(a_, a_tan_, true);
   add_fronts(b_sig_, b_tan_, false);

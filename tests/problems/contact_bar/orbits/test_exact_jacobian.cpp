@@ -25,24 +25,33 @@ struct Case {
   std::function<core::Vector(const ContactBarOrbitProblem&)> point;
 };
 
-std::vector<Case> cases() {
-  std::vector<Case> out;
-  bar::BarSetup one_wall;
-  one_wall.left = {bar::EndType::fixed, 0};
-  one_wall.right = {bar::EndType::contact, 1e-3};
+// The paper's bar (gap 1e-3) and its shooting grid of 20 intervals, 40 test elements.
+bar::BarSetup one_wall() {
+  bar::BarSetup s;
+  s.left = {bar::EndType::fixed, 0};
+  s.right = {bar::EndType::contact, 1e-3};
+  return s;
+}
+OrbitOptions grid_of_twenty() {
   OrbitOptions o;
   o.elements = 20;
   o.steps_per_period = 40;
   o.test_elements = 40;
-  out.push_back({"mode 1", one_wall, o,
+  return o;
+}
+
+std::vector<Case> cases() {
+  std::vector<Case> out;
+  const OrbitOptions o = grid_of_twenty();
+  out.push_back({"mode 1", one_wall(), o,
                  [](const ContactBarOrbitProblem& p) { return p.contact_family_guess(1, 1.7); }});
   OrbitOptions o2 = o;
   o2.free_knots = 1;
   o2.knot_node = 6;
   o2.test_elements = 42;
-  out.push_back({"mode 2", one_wall, o2,
+  out.push_back({"mode 2", one_wall(), o2,
                  [](const ContactBarOrbitProblem& p) { return p.contact_family_guess(2, 2.3); }});
-  bar::BarSetup clearance = one_wall;
+  bar::BarSetup clearance = one_wall();
   clearance.right = {bar::EndType::clearance, 1e-3, 3e-3};
   OrbitOptions oc = o;
   oc.start_on_wall = true;
@@ -92,15 +101,9 @@ TEST(ExactJacobian, MatchesCentralDifferencesAwayFromKinks) {
 // against central differences, and the closed-form tangent d x / d amplitude in its null space
 // (the branch is a curve: J t = 0 exactly). Forward differences leave |J t| / |J| about 1e-10.
 TEST(ExactJacobian, AnnihilatesModeOnesTangentOnItsClosedForm) {
-  bar::BarSetup s;
-  s.left = {bar::EndType::fixed, 0};
-  s.right = {bar::EndType::contact, 1e-3};
-  OrbitOptions o;
-  o.elements = 20;
-  o.steps_per_period = 40;
-  o.test_elements = 40;
+  OrbitOptions o = grid_of_twenty();
   o.exact_jacobian = true;
-  ContactBarOrbitProblem p(s, std::make_shared<TdbemSolver>(ContactMethod::event), o);
+  ContactBarOrbitProblem p(one_wall(), std::make_shared<TdbemSolver>(ContactMethod::event), o);
   for (double ratio : {1.7, 2.2, 3.0}) {
     const core::Vector x = p.contact_family_guess(1, ratio);
     core::Vector t = p.contact_family_guess(1, ratio * (1 + 1e-6)) -
