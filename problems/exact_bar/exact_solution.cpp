@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "core/errors.hpp"
 
@@ -60,35 +61,29 @@ double release_time(double q, double qm) {
 }  // namespace
 
 ExactBarSolution::ExactBarSolution(const bar::BarSetup& setup, double t_end)
-    : setup_(setup), t_end_(t_end) {
-  setup_.validate();
-  if (!std::isfinite(t_end) || t_end < 0)
-    throw InputError("t_end", fmt::format("must be finite and >= 0 (got {})", t_end));
-  c_ = setup_.material.wave_speed();
-  tau_ = setup_.material.length / c_;
-  b_ = setup_.body_force / setup_.material.density;
-  march();
-}
+    : ExactBarSolution(setup, t_end, InitialTangent{}) {}
 
 ExactBarSolution::ExactBarSolution(const bar::BarSetup& setup, double t_end, InitialTangent tangent)
     : setup_(setup), t_end_(t_end), seed_(std::move(tangent)) {
   setup_.validate();
   if (!std::isfinite(t_end) || t_end < 0)
     throw InputError("t_end", fmt::format("must be finite and >= 0 (got {})", t_end));
-  for (double v : setup_.v0.values())
-    if (v != 0) throw InputError("v0", "the tangent of the exact solution needs v0 = 0");
-  if (setup_.body_force != 0)
-    throw InputError("body_force", "the tangent of the exact solution needs no body force");
   const std::size_t knots = setup_.u0.knots().size();
-  if (seed_.d_knot.size() != knots || seed_.d_value.size() != knots || knots == 0)
-    throw InputError("tangent", fmt::format("needs one derivative per knot of u0 ({})", knots));
-  tangent_size_ = static_cast<int>(seed_.d_knot.front().size());
-  for (std::size_t i = 0; i < knots; ++i)
-    if (seed_.d_knot[i].size() != tangent_size_ || seed_.d_value[i].size() != tangent_size_)
-      throw InputError("tangent", "every derivative must have the same size");
+  if (!seed_.d_knot.empty() || !seed_.d_value.empty()) {  // a tangent
+    for (double v : setup_.v0.values())
+      if (v != 0) throw InputError("v0", "the tangent of the exact solution needs v0 = 0");
+    if (setup_.body_force != 0)
+      throw InputError("body_force", "the tangent of the exact solution needs no body force");
+    if (seed_.d_knot.size() != knots || seed_.d_value.size() != knots)
+      throw InputError("tangent", fmt::format("needs one derivative per knot of u0 ({})", knots));
+    tangent_size_ = static_cast<int>(seed_.d_knot.front().size());
+    for (std::size_t i = 0; i < knots; ++i)
+      if (seed_.d_knot[i].size() != tangent_size_ || seed_.d_value[i].size() != tangent_size_)
+        throw InputError("tangent", "every derivative must have the same size");
+  }
   c_ = setup_.material.wave_speed();
   tau_ = setup_.material.length / c_;
-  b_ = 0;
+  b_ = setup_.body_force / setup_.material.density;
   march();
 }
 
@@ -243,15 +238,12 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
           emit_to(s.r1, nullptr, true, true);
           break;
         }
-        Sensitivity d_sr, d_release;
-        if (tangent) {  // q + qm sr = 0 (qm != 0 here: a constant segment releases at its start)
-          d_sr = -piece.dy0 / s.slope;
-          d_release = piece.dr0 + d_sr;
-        }
-        emit_to(rc + sr, tangent ? &d_release : nullptr, true, true);
-        advance(sr, d_sr);
+        // Inside a segment only where its slope is not zero: never with a tangent, whose
+        // segments are constant (they release at a start, above).
+        if (tangent) throw std::logic_error("exact tangent: a release inside a sloped segment");
+        emit_to(rc + sr, nullptr, true, true);
+        advance(sr, Sensitivity());
         yc = 0.0;  // the force vanishes exactly at release
-        if (tangent) piece.dy0.setZero();
         state.closed = false;
       } else {
         const double q = n * yc, qm = n * s.slope;

@@ -345,6 +345,29 @@ std::function<std::string(const core::Vector&)> return_check(const core::Scene& 
   };
 }
 
+// The scene's knot_nodes, when given, replace options.knot_nodes: one node per free knot,
+// increasing in 1..N-1.
+void knot_nodes_from_scene(const core::Scene& scene, OrbitOptions& options) {
+  const std::string nodes = scene.text("knot_nodes");
+  if (nodes.empty()) return;
+  options.knot_nodes =
+      core::parse_increasing_integers(nodes, "knot_nodes", 1, options.elements - 1, "a node");
+  if (static_cast<int>(options.knot_nodes.size()) != options.free_knots)
+    throw core::InputError(
+        "knot_nodes", fmt::format("needs one node per free knot ({}; got {})", options.free_knots,
+                                  options.knot_nodes.size()));
+}
+
+// describe_point of a mode: its frequency against the closed form at the point's own energy.
+std::function<std::string(const continuation::BranchPoint&)> closed_form_error(
+    std::function<double(double)> frequency) {
+  return [frequency](const continuation::BranchPoint& point) {
+    const double exact = frequency(point.observable("energy"));
+    return fmt::format("closed-form rel err {:.2e}",
+                       std::abs(point.observable("frequency") / exact - 1));
+  };
+}
+
 // The reject_point hook of a mode: a point whose orbit never reaches the wall is refused before
 // the return check. Below or near grazing the bar's non-contact orbits (every state is
 // 4L/c-periodic) form a manifold of dimension N beside the mode, and on fine grids a corrector
@@ -397,11 +420,7 @@ void describe_mode(cli::TraceSetup& s, const ContactBarOrbitProblem* p,
                              {"content_wavenumber", c.content_wavenumber},
                              {"resonance_order", c.resonance_order}};
   };
-  s.describe_point = [family](const continuation::BranchPoint& point) {
-    const double exact = family.frequency(point.observable("energy"));
-    return fmt::format("closed-form rel err {:.2e}",
-                       std::abs(point.observable("frequency") / exact - 1));
-  };
+  s.describe_point = closed_form_error([family](double e) { return family.frequency(e); });
   s.write_extra_outputs = [p, family](const std::filesystem::path& out,
                                       const continuation::Branch& b) {
     // Per point: the closed form at the point's own energy, the exact-oracle return error and
@@ -456,13 +475,7 @@ cli::TraceSetup setup_clearance_mode(const core::Scene& scene, const bar::BarSet
     options.knot_nodes[j] =
         std::min(options.knot_nodes[j],
                  j == mode - 1 ? options.elements - 1 : options.knot_nodes[j + 1] - 1);
-  if (const std::string nodes = scene.text("knot_nodes"); !nodes.empty()) {
-    options.knot_nodes =
-        core::parse_increasing_integers(nodes, "knot_nodes", 1, options.elements - 1, "a node");
-    if (static_cast<int>(options.knot_nodes.size()) != mode)
-      throw core::InputError("knot_nodes", fmt::format("needs one node per free knot ({}; got {})",
-                                                       mode, options.knot_nodes.size()));
-  }
+  knot_nodes_from_scene(scene, options);
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements =
       static_cast<int>(test_elements < 0 ? 2 * options.state_size() : test_elements);
@@ -487,11 +500,7 @@ cli::TraceSetup setup_clearance_mode(const core::Scene& scene, const bar::BarSet
   check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
   s.direction = problem->clearance_guess(mode, start_energy * 1.02) - s.guess;
   s.reject_point = mode_check(scene, problem.get(), 4 * problem->state_size());
-  s.describe_point = [family](const continuation::BranchPoint& point) {
-    const double exact = family.frequency(point.observable("energy"));
-    return fmt::format("closed-form rel err {:.2e}",
-                       std::abs(point.observable("frequency") / exact - 1));
-  };
+  s.describe_point = closed_form_error([family](double e) { return family.frequency(e); });
   const ContactBarOrbitProblem* p = problem.get();
   s.write_extra_outputs = [p, family](const std::filesystem::path& out,
                                       const continuation::Branch& b) {
@@ -512,18 +521,13 @@ cli::TraceSetup setup_clearance_mode(const core::Scene& scene, const bar::BarSet
       const double exact = family.frequency(energy);
       const ReturnError re = return_error(*p, point.x, oracle);
       const double period = point.x[p->period_index()];
-      const bar::BarSetup at = p->setup_at(point.x);
-      const ContactStructure cs = contact_structure(at, period);
-      double front = 0, back = 0;
-      for (const auto& ci : exact_bar::ExactBarSolution(at, period).contact_intervals()) {
-        const double d = std::min(ci.t_release, period) - ci.t_close;
-        (ci.back_wall ? back : front) += d;
-      }
+      const ContactStructure cs = contact_structure(p->setup_at(point.x), period);
       check.add_row({static_cast<double>(point.index), energy, w, exact, std::abs(w / exact - 1),
                      re.displacement, re.velocity, static_cast<double>(cs.contact_phases),
-                     static_cast<double>(cs.back_contact_phases), front,
-                     family.front_contact(energy), back, family.back_contact(energy),
-                     cs.min_back_gap, std::abs(w / one_sided.frequency(energy) - 1)});
+                     static_cast<double>(cs.back_contact_phases), cs.contact_time,
+                     family.front_contact(energy), cs.back_contact_time,
+                     family.back_contact(energy), cs.min_back_gap,
+                     std::abs(w / one_sided.frequency(energy) - 1)});
     }
     check.write_csv(out / "closed_form_check.csv");
   };
@@ -568,14 +572,7 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
           family.kinks(0.5 * setup.material.axial_stiffness() * setup.material.length * s0 * s0));
     }
   }
-  if (const std::string nodes = scene.text("knot_nodes"); !nodes.empty()) {
-    options.knot_nodes =
-        core::parse_increasing_integers(nodes, "knot_nodes", 1, options.elements - 1, "a node");
-    if (static_cast<int>(options.knot_nodes.size()) != options.free_knots)
-      throw core::InputError(
-          "knot_nodes", fmt::format("needs one node per free knot ({}; got {})", options.free_knots,
-                                    options.knot_nodes.size()));
-  }
+  knot_nodes_from_scene(scene, options);
   const long test_elements = scene.integer("test_elements", -1);
   options.test_elements = static_cast<int>(
       test_elements < 0 ? 2 * (options.elements + options.free_knots) : test_elements);

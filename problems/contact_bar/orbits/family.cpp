@@ -148,12 +148,19 @@ double ClearanceMode::back_grazing_energy() const {
 // J h (B - A) - h delta = -g_back, so delta = gamma + gamma_b, A = (1 + gamma_b) / J,
 // B = (1 + gamma) / J. The back phase exists while B > delta; at B = delta, A equals mode J's
 // one-sided A, so the two regimes join continuously.
-double ClearanceMode::period(double energy) const {
-  const double s = slope(energy), length = material_.length, c = material_.wave_speed();
-  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s)) return std::nan("");
+ClearanceMode::Blocks ClearanceMode::blocks(double energy) const {
+  const double s = slope(energy), length = material_.length, nan = std::nan("");
+  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s)) return {nan, nan, nan};
   const double j = mode_, gamma = gap_ / (s * length), gamma_b = gap_back_ / (s * length);
-  if (energy <= back_grazing_energy()) return ContactFamily(material_, gap_, mode_).period(energy);
-  return (2 + gamma + gamma_b) * length / (j * c);
+  const double b = (1 + gamma) / j;
+  // One wall: mode J's A (README.md, 'Mode J'); the end recedes for B and approaches for B.
+  if (energy <= back_grazing_energy()) return {(j + 1 - (j - 1) * gamma) / (j * j), b, b};
+  return {(1 + gamma_b) / j, b, gamma + gamma_b};
+}
+
+double ClearanceMode::period(double energy) const {
+  const Blocks k = blocks(energy);
+  return (k.a + k.b) * material_.travel_time();
 }
 
 double ClearanceMode::frequency(double energy) const {
@@ -161,34 +168,26 @@ double ClearanceMode::frequency(double energy) const {
 }
 
 double ClearanceMode::front_contact(double energy) const {
-  const double s = slope(energy), length = material_.length, c = material_.wave_speed();
-  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s)) return std::nan("");
-  const double j = mode_, gamma = gap_ / (s * length), gamma_b = gap_back_ / (s * length);
-  const double b = (1 + gamma) / j;
-  if (energy <= back_grazing_energy())
-    return ((j + 1 - (j - 1) * gamma) / (j * j) - b) * length / c;  // one-sided: A - B
-  return ((1 + gamma_b) / j - gamma - gamma_b) * length / c;
+  const Blocks k = blocks(energy);
+  return (k.a - k.delta) * material_.travel_time();
 }
 
 double ClearanceMode::back_contact(double energy) const {
-  const double s = slope(energy), length = material_.length, c = material_.wave_speed();
-  if (!(s * length >= (2 * mode_ - 1) * gap_) || !std::isfinite(s)) return std::nan("");
-  if (energy <= back_grazing_energy()) return 0;
-  const double j = mode_, gamma = gap_ / (s * length), gamma_b = gap_back_ / (s * length);
-  return ((1 + gamma) / j - gamma - gamma_b) * length / c;
+  const Blocks k = blocks(energy);
+  return (k.b - k.delta) * material_.travel_time();
 }
 
 std::vector<double> ClearanceMode::kinks(double energy) const {
-  const double length = material_.length, c = material_.wave_speed();
-  const double front = front_contact(energy), t = period(energy);
+  const double length = material_.length;
+  const Blocks k = blocks(energy);
   std::vector<double> at;
-  if (!std::isfinite(front)) return at;
-  const double gamma = gap_ / (slope(energy) * length);
-  // In units of L: C/2 + k T and C/2 + B + k T from the end, the first J of them.
-  const double half = 0.5 * front * c / length, p = t * c / length, b = (1 + gamma) / mode_;
-  for (int k = 0; static_cast<int>(at.size()) < mode_; ++k) {
-    at.push_back(length * (1 - (half + k * p)));
-    if (static_cast<int>(at.size()) < mode_) at.push_back(length * (1 - (half + b + k * p)));
+  if (!std::isfinite(k.a)) return at;
+  // In units of L: C/2 + i T and C/2 + B + i T from the end (C = A - delta the front phase,
+  // T = A + B), the first J of them.
+  const double half = 0.5 * (k.a - k.delta), p = k.a + k.b;
+  for (int i = 0; static_cast<int>(at.size()) < mode_; ++i) {
+    at.push_back(length * (1 - (half + i * p)));
+    if (static_cast<int>(at.size()) < mode_) at.push_back(length * (1 - (half + k.b + i * p)));
   }
   std::reverse(at.begin(), at.end());
   return at;

@@ -99,6 +99,13 @@ class ClearanceMode {
   bar::PiecewiseLinear u0(double energy) const;
 
  private:
+  // The pulse lengths of the wave at the end (units of L/c): -h for a, +h for b, and the
+  // flight delta between the walls (b with one wall: recede and approach); NaN below grazing.
+  struct Blocks {
+    double a, b, delta;
+  };
+  Blocks blocks(double energy) const;
+
   bar::Material material_;
   double gap_, gap_back_;
   int mode_;

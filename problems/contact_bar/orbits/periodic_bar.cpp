@@ -126,6 +126,19 @@ double ContactBarOrbitProblem::displacement_scale() const {
   return gap() > 0 ? gap() : 1e-3 * setup_.material.length;
 }
 
+// Segments between consecutive anchors (node 0 at 0, knot nodes at the knots, node N at L):
+// f(i, segment, i0, i1) for node i = 1..N in segment `segment` (0..K) from anchor node i0 to i1.
+template <class F>
+void ContactBarOrbitProblem::for_each_mapped_node(F&& f) const {
+  const int n = options_.elements, k = options_.free_knots;
+  const std::vector<int> m = reference_knot_nodes();
+  int segment = 0;
+  for (int i = 1; i <= n; ++i) {
+    while (segment < k && i > m[segment]) ++segment;
+    f(i, segment, segment == 0 ? 0 : m[segment - 1], segment == k ? n : m[segment]);
+  }
+}
+
 Vector ContactBarOrbitProblem::node_positions(const Vector& x) const {
   const int n = options_.elements;
   const double length = setup_.material.length;
@@ -135,17 +148,11 @@ Vector ContactBarOrbitProblem::node_positions(const Vector& x) const {
     for (int i = 1; i <= n; ++i) y[i - 1] = length * i / n;
     return y;
   }
-  // Segments between consecutive anchors (node 0 at 0, knot nodes at the knots, node N at L).
-  const std::vector<int> m = reference_knot_nodes();
-  int segment = 0;
-  for (int i = 1; i <= n; ++i) {
-    while (segment < k && i > m[segment]) ++segment;
-    const int i0 = segment == 0 ? 0 : m[segment - 1];
-    const int i1 = segment == k ? n : m[segment];
+  for_each_mapped_node([&](int i, int segment, int i0, int i1) {
     const double y0 = segment == 0 ? 0.0 : x[knot_index(segment - 1)];
     const double y1 = segment == k ? length : x[knot_index(segment)];
     y[i - 1] = i == i1 ? y1 : y0 + (y1 - y0) * (i - i0) / (i1 - i0);
-  }
+  });
   for (int j = 0; j < k; ++j) y[n + j] = x[knot_index(j)];
   return y;
 }
@@ -479,10 +486,7 @@ EvalStatus ContactBarOrbitProblem::monodromy(const Vector& x, core::Matrix& M) c
   return full_state_monodromy(*this, x, monodromy_options_, M);
 }
 
-EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
-  const int n = options_.elements;
-  const int m = options_.test_elements > 0 ? options_.test_elements : state_size();  // grid
-  const double length = setup_.material.length;
+EvalStatus ContactBarOrbitProblem::admissible(const Vector& x) const {
   const double period = x[period_index()];
   if (!std::isfinite(period) || !(period > 0)) return EvalStatus::failed;
   // Knots stay ordered inside (0, L): a crossing is outside the representation.
@@ -492,13 +496,21 @@ EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) 
     if (!std::isfinite(knot) || !(knot > previous)) return EvalStatus::failed;
     previous = knot;
   }
-  if (options_.free_knots > 0 && !(previous < length)) return EvalStatus::failed;
+  if (options_.free_knots > 0 && !(previous < setup_.material.length)) return EvalStatus::failed;
   for (int i = 0; i < options_.nodal_unknowns(); ++i)
     if (!std::isfinite(x[i])) return EvalStatus::non_finite;
   // A u0 through a wall is outside the admissible set: no orbit starts there.
-  if (setup_.right.has_wall() && node_value(x, n) > setup_.right.gap) return EvalStatus::failed;
-  if (setup_.right.has_back_wall() && node_value(x, n) < -setup_.right.gap_back)
-    return EvalStatus::failed;
+  const double end = node_value(x, options_.elements);
+  if (setup_.right.has_wall() && end > setup_.right.gap) return EvalStatus::failed;
+  if (setup_.right.has_back_wall() && end < -setup_.right.gap_back) return EvalStatus::failed;
+  return EvalStatus::ok;
+}
+
+EvalStatus ContactBarOrbitProblem::compute_residual(const Vector& x, Vector& r) const {
+  const int m = options_.test_elements > 0 ? options_.test_elements : state_size();  // grid
+  const double length = setup_.material.length;
+  const double period = x[period_index()];
+  if (const EvalStatus status = admissible(x); status != EvalStatus::ok) return status;
 
   const bar::BarSetup s = setup_at(x);
   bar::SnapshotRequest request;
@@ -567,25 +579,18 @@ EvalStatus ContactBarOrbitProblem::compute_jacobian(const Vector& x, core::Matri
   const int n = options_.elements, k = options_.free_knots, unknowns = num_unknowns();
   const int m = options_.test_elements > 0 ? options_.test_elements : state_size();
   const double length = setup_.material.length, period = x[period_index()];
-  if (!std::isfinite(period) || !(period > 0)) return EvalStatus::failed;
-  Vector scratch;
-  if (compute_residual(x, scratch) != EvalStatus::ok) return EvalStatus::failed;
+  if (const EvalStatus status = admissible(x); status != EvalStatus::ok) return status;
   exact_bar::InitialTangent seed;
   seed.d_knot.assign(static_cast<std::size_t>(n) + 1, exact_bar::Sensitivity(unknowns));
   seed.d_value.assign(static_cast<std::size_t>(n) + 1, exact_bar::Sensitivity(unknowns));
   for (int i = 1; i <= options_.nodal_unknowns(); ++i) seed.d_value[i].insert(i - 1) = 1;
-  if (k > 0) {  // node i between the anchors i0 and i1 (node_positions)
-    const std::vector<int> anchors = reference_knot_nodes();
-    int segment = 0;
-    for (int i = 1; i < n; ++i) {
-      while (segment < k && i > anchors[segment]) ++segment;
-      const int i0 = segment == 0 ? 0 : anchors[segment - 1];
-      const int i1 = segment == k ? n : anchors[segment];
-      const double w = static_cast<double>(i - i0) / (i1 - i0);
-      if (segment > 0 && i != i1) seed.d_knot[i].insert(knot_index(segment - 1)) = 1 - w;
-      if (segment < k) seed.d_knot[i].insert(knot_index(segment)) = i == i1 ? 1.0 : w;
-    }
-  }
+  // Node i < N moves with the knots at its anchors (node_positions); node N stays at L.
+  for_each_mapped_node([&](int i, int segment, int i0, int i1) {
+    if (i == n) return;
+    const double w = static_cast<double>(i - i0) / (i1 - i0);
+    if (segment > 0 && i != i1) seed.d_knot[i].insert(knot_index(segment - 1)) = 1 - w;
+    if (segment < k) seed.d_knot[i].insert(knot_index(segment)) = i == i1 ? 1.0 : w;
+  });
   exact_bar::ExactBarSolution solution(setup_at(x), 0.5 * period, std::move(seed));
   if (!solution.ok()) return EvalStatus::failed;
   const exact_bar::ProjectedVelocityTangent d =

@@ -223,6 +223,11 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
 
  protected:
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
+  // ok when x is a state the residual takes: a finite positive period, finite nodal values,
+  // knots ordered inside (0, L), u0(L) on the admissible side of the walls.
+  core::EvalStatus admissible(const core::Vector& x) const;
+  template <class F>
+  void for_each_mapped_node(F&& f) const;  // periodic_bar.cpp
 
  private:
   double gap() const;

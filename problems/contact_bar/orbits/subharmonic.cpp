@@ -28,12 +28,15 @@ ContactStructure contact_structure(const bar::BarSetup& setup, double period) {
   const double g0 = setup.right.gap, tol = 1e-9 * period;
   const auto intervals = sol.contact_intervals(exact_bar::Side::right);
   // The phases on one wall; a phase through t = 0 = T appears as [0, a) and [T - a', T): one
-  // phase. Returns the count and the duration of the phase that contains t = 0.
-  auto phases_on = [&](bool back, double& first_contact) {
+  // phase. Returns the count, the duration of the phase that contains t = 0 and the total.
+  auto phases_on = [&](bool back, double& first_contact, double& total) {
     std::vector<std::pair<double, double>> phases;
     for (const auto& c : intervals) {
       const double release = std::min(c.t_release, period);
-      if (c.back_wall == back && release - c.t_close > tol) phases.emplace_back(c.t_close, release);
+      if (c.back_wall == back && release - c.t_close > tol) {
+        phases.emplace_back(c.t_close, release);
+        total += release - c.t_close;
+      }
     }
     if (phases.size() >= 2 && phases.front().first <= tol && phases.back().second >= period - tol) {
       first_contact = phases.front().second + (period - phases.back().first);
@@ -43,9 +46,9 @@ ContactStructure contact_structure(const bar::BarSetup& setup, double period) {
     }
     return static_cast<int>(phases.size());
   };
-  result.contact_phases = phases_on(false, result.first_contact);
+  result.contact_phases = phases_on(false, result.first_contact, result.contact_time);
   double unused = 0;
-  result.back_contact_phases = phases_on(true, unused);
+  result.back_contact_phases = phases_on(true, unused, result.back_contact_time);
   // Closed during a phase; a closed interval shorter than tol is a grazing instant.
   auto closed_at = [&](double t) {
     for (const auto& c : intervals)

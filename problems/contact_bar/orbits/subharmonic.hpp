@@ -30,9 +30,11 @@ struct ContactStructure {
   int grazing_instants = 0;  // instants where the open end reaches the wall and leaves it
   double min_gap = 0;        // min over the period of g0 - u(L, t) [m]
   double first_contact = 0;  // duration of the phase that contains t = 0 (0 if none) [s]
+  double contact_time = 0;   // total duration of the phases per period [s]
   // A clearance end: phases on the wall behind it, and min over the period of
   // gap_back + u(L, t) on the 4000-sample scan [m] (NaN without a back wall).
   int back_contact_phases = 0;
+  double back_contact_time = 0;  // [s]
   double min_back_gap = std::numeric_limits<double>::quiet_NaN();
 };
 
