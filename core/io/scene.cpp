@@ -335,15 +335,21 @@ std::string scene_problem_name(const std::string& ini_path) {
   return vm["problem"].as<std::string>();
 }
 
+std::vector<std::string> list_words(const std::string& text, const std::string& separators) {
+  std::string spaced = text;
+  for (char& ch : spaced)
+    if (separators.find(ch) != std::string::npos) ch = ' ';
+  std::istringstream in(spaced);
+  std::vector<std::string> words;
+  for (std::string word; in >> word;) words.push_back(word);
+  return words;
+}
+
 std::vector<int> parse_increasing_integers(const std::string& text, const std::string& key,
                                            long min_value, long max_value,
                                            const std::string& what) {
-  std::string spaced = text;
-  std::replace(spaced.begin(), spaced.end(), ',', ' ');
-  std::istringstream words(spaced);
   std::vector<int> list;
-  std::string word;
-  while (words >> word) {
+  for (const std::string& word : list_words(text)) {
     std::size_t used = 0;
     long value = 0;
     try {

@@ -68,6 +68,9 @@ Scene read_scene(const po::options_description& scene_keys, const std::string& i
 po::variables_map parse_options(const po::options_description& keys,
                                 const std::vector<std::string>& arguments);
 
+// The words of a list separated by spaces or any of `separators` ("1, 2 3" -> 1 2 3).
+std::vector<std::string> list_words(const std::string& text, const std::string& separators = ",");
+
 // "20,40,80" or "20 40 80": whole numbers in [min_value, max_value], strictly increasing, at
 // least one; InputError(key) naming the word and `what` each must be ("a node", "a grid of
 // intervals") otherwise.

@@ -72,13 +72,8 @@ po::options_description scene_keys() {
 }
 
 std::vector<double> parse_numbers(const std::string& key, const std::string& text) {
-  std::string cleaned = text;
-  for (char& ch : cleaned)
-    if (ch == ',' || ch == ';') ch = ' ';
-  std::istringstream in(cleaned);
   std::vector<double> values;
-  std::string word;
-  while (in >> word) {
+  for (const std::string& word : core::list_words(text, ",;")) {
     std::size_t used = 0;
     double v = 0;
     try {
