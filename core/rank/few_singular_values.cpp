@@ -124,11 +124,7 @@ struct SparseGram {
   }
   // Factors a (all of J) with the rows marked dense set apart; false when that fails.
   bool factor_with_dense_rows(const Matrix& J, const std::vector<char>& dense_row) {
-    Eigen::SparseMatrix<double> sparse_rows = a;
-    sparse_rows.prune([&](Eigen::Index i, Eigen::Index, double) {
-      return !dense_row[static_cast<std::size_t>(i)];
-    });
-    if (!factor_shifted_normal(sparse_rows, factor)) return false;
+    if (!factor_sparse_rows(a, dense_row, factor)) return false;
     std::vector<Eigen::Index> dense;
     for (std::size_t i = 0; i < dense_row.size(); ++i)
       if (dense_row[i]) dense.push_back(static_cast<Eigen::Index>(i));

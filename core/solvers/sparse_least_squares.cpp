@@ -51,6 +51,15 @@ bool factor_shifted_normal(const Eigen::SparseMatrix<double>& A, NormalFactor& f
   return factor.info() == Eigen::Success;
 }
 
+bool factor_sparse_rows(const Eigen::SparseMatrix<double>& A, const std::vector<char>& dense_row,
+                        NormalFactor& factor, double* shift) {
+  Eigen::SparseMatrix<double> sparse_rows = A;
+  sparse_rows.prune([&](Eigen::Index i, Eigen::Index, double) {
+    return !dense_row[static_cast<std::size_t>(i)];
+  });
+  return factor_shifted_normal(sparse_rows, factor, shift);
+}
+
 bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff, bool damped) {
   const Eigen::Index n = J.cols();
   shift_ = 0;
@@ -60,11 +69,7 @@ bool SparseLeastSquares::compute(const Matrix& J, double rank_cutoff, bool dampe
   };
   std::vector<char> dense_row;
   if (!sparse_view(J, a_, dense_row)) return reject();
-  Eigen::SparseMatrix<double> sparse_rows = a_;
-  sparse_rows.prune([&](Eigen::Index i, Eigen::Index, double) {
-    return !dense_row[static_cast<std::size_t>(i)];
-  });
-  if (!factor_shifted_normal(sparse_rows, factor_, &factor_shift_)) return reject();
+  if (!factor_sparse_rows(a_, dense_row, factor_, &factor_shift_)) return reject();
   double largest_column = 0;
   for (Eigen::Index j = 0; j < n; ++j) largest_column = std::max(largest_column, a_.col(j).norm());
   // sigma_min from above: two steps of inverse iteration on J^T J from a fixed start

@@ -50,6 +50,10 @@ using NormalFactor =
 // shift, when given, receives mu.
 bool factor_shifted_normal(const Eigen::SparseMatrix<double>& A, NormalFactor& factor,
                            double* shift = nullptr);
+// The same for A without the rows dense_row marks (as sparse_view fills it): the factor of
+// S^T S + mu I, S those other rows, which a few dense rows would fill in.
+bool factor_sparse_rows(const Eigen::SparseMatrix<double>& A, const std::vector<char>& dense_row,
+                        NormalFactor& factor, double* shift = nullptr);
 
 class SparseLeastSquares {
  public:

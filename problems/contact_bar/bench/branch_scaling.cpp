@@ -90,9 +90,8 @@ std::string error_text(double value) {
 std::string Mode1BranchSettings::label() const {
   if (study == "grid") return fmt::format("N = {}", elements);
   if (study == "grid_unchecked") return fmt::format("N = {}, no rank checks", elements);
-  if (study == "grid_exact" || study == "grid_exact_differences")
-    return fmt::format("N = {}, {} Jacobian, start 1.3 g0", elements,
-                       jacobian == "exact" ? "exact" : "differences");
+  if (study.starts_with("grid_exact"))
+    return fmt::format("N = {}, {} Jacobian, start 1.3 g0", elements, jacobian);
   std::string text = fmt::format("N = {}", elements);
   if (steps_per_period != 40) text += fmt::format(", steps_per_period = {}", steps_per_period);
   if (formulation != "regular") text += fmt::format(", {} formulation", formulation);
@@ -301,10 +300,10 @@ void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
   // 19/5 L/c, is a branch point of mode 1, where the exact Jacobian's clean two-dimensional
   // null space leaves the first tangent to the direction hint, off the branch.
   for (int n : grids)
-    for (const char* jacobian : {"exact", "differences"}) {
+    for (const auto& [study, jacobian] :
+         {std::pair{"grid_exact", "exact"}, std::pair{"grid_exact_differences", "differences"}}) {
       Mode1BranchSettings s;
-      s.study =
-          std::string("grid_exact") + (jacobian == std::string("exact") ? "" : "_differences");
+      s.study = study;
       s.elements = n;
       s.jacobian = jacobian;
       s.start_offset = 0.3;

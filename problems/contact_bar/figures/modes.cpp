@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -543,6 +544,24 @@ std::vector<cli::ProblemJob> figure_jobs(const FigureInputs& inputs) {
       {"closed_form_summary", "closed_form_summary.csv: acceptance numbers of every branch",
        write_closed_form_summary},
   };
+}
+
+// The value of `key` in a trace's resolved scene.ini ("key = value", a default commented out
+// as "# key = value  (default)"); empty when absent.
+std::string scene_value(const fs::path& scene, const std::string& key) {
+  std::ifstream in(scene);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::string text = line;
+    if (text.rfind("# ", 0) == 0) text = text.substr(2);
+    const auto eq = text.find(" = ");
+    if (eq == std::string::npos || text.substr(0, eq) != key) continue;
+    std::string value = text.substr(eq + 3);
+    const auto note = value.find("  (default)");
+    if (note != std::string::npos) value = value.substr(0, note);
+    return value;
+  }
+  return {};
 }
 
 void render_figure(const fs::path& png, const std::string& plot, int width, int height) {

@@ -82,6 +82,10 @@ std::optional<TracedOrbit> load_traced_orbit_point(const std::filesystem::path& 
 // a branch.csv, sorted; empty when dir does not exist.
 std::vector<std::filesystem::path> followed_branches(const std::filesystem::path& dir);
 
+// The value of `key` in a trace's resolved scene.ini ("key = value", a default written as
+// "# key = value  (default)"); empty when absent.
+std::string scene_value(const std::filesystem::path& scene, const std::string& key);
+
 // Renders plot (gnuplot text) into png at size and says so on stdout, or the renderer's
 // message on stderr (a missing gnuplot leaves the CSV files as the result).
 void render_figure(const std::filesystem::path& png, const std::string& plot, int width,

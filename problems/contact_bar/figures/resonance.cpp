@@ -139,7 +139,7 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
   render_figure(png, plot, 1200, 700);
   if (spectra.empty()) return 0;
   const fs::path spectrum_png = out / "resonant_end_spectrum.png";
-  const core::PlotResult rs = core::render_png(
+  render_figure(
       spectrum_png,
       "set title 'What the attached orbit adds at the contacting end, u_{attached}(L,t) - "
       "u_{mode 1}(L,t): amplitude of each harmonic k {/Symbol w} = 2{/Symbol p}k/T (exact "
@@ -147,11 +147,7 @@ int draw_resonant_end(const fs::path& out, const fs::path& scene_path) {
       "set ylabel 'amplitude [m]'\nset logscale y\nset format y '10^{%L}'\nset grid\n"
       "set xrange [0:41]\nset key top right\n" +
           spectra + "\n",
-      {1200, 600});
-  if (rs.ok)
-    fmt::print("[figures] wrote {}\n", spectrum_png.string());
-  else
-    fmt::print(stderr, "[figures] {}\n", rs.message);
+      1200, 600);
   return 0;
 }
 
@@ -247,34 +243,33 @@ int write_law_table(const fs::path& out) {
     fmt::print("[figures] mode1_law skipped: no {}\n", (dir / "branch_points.csv").string());
     return 0;
   }
-  // The run's resolved scene: its bar, and the grid and energy bound the step set.
-  std::map<std::string, std::string> run;
-  {
-    std::ifstream in(dir / "scene.ini");
-    for (std::string line; std::getline(in, line);) {
-      const auto eq = line.find(" = ");
-      if (line.empty() || line[0] == '#' || eq == std::string::npos) continue;
-      run[line.substr(0, eq)] = line.substr(eq + 3);
-    }
-  }
-  double L = 0, c = 0, g0 = 0, ea = 0, e_max = 0, offset = 0.05;
+  // The run's resolved scene (its bar, and the grid and energy bound the step set) and its
+  // first point's energy, where the branch starts.
+  const fs::path scene = dir / "scene.ini";
+  double L = 0, c = 0, g0 = 0, ea = 0, e_max = 0;
   int n = 0;
   try {
-    L = std::stod(run.at("length"));
-    c = std::sqrt(std::stod(run.at("youngs_modulus")) / std::stod(run.at("density")));
-    g0 = std::stod(run.at("gap"));
-    ea = std::stod(run.at("youngs_modulus")) * std::stod(run.at("area"));
-    n = std::stoi(run.at("shooting_elements"));
-    e_max = std::stod(run.at("energy_max"));
-    if (run.count("start_offset")) offset = std::stod(run.at("start_offset"));
+    auto number = [&](const char* key) { return std::stod(scene_value(scene, key)); };
+    L = number("length");
+    c = std::sqrt(number("youngs_modulus") / number("density"));
+    g0 = number("gap");
+    ea = number("youngs_modulus") * number("area");
+    n = std::stoi(scene_value(scene, "shooting_elements"));
+    e_max = number("energy_max");
   } catch (const std::exception&) {
     fmt::print(stderr,
                "[figures] mode1_law: {} lacks length, youngs_modulus, density, gap, "
                "area, shooting_elements or energy_max\n",
-               (dir / "scene.ini").string());
+               scene.string());
     return 1;
   }
-  const double e_min = ea * std::pow((1 + offset) * g0, 2) / (2 * L);  // the branch's start
+  const std::vector<double> branch_energy =
+      core::Table::read_csv(dir / "branch.csv").column("energy");
+  if (branch_energy.empty()) {
+    fmt::print(stderr, "[figures] mode1_law: {} has no point\n", (dir / "branch.csv").string());
+    return 1;
+  }
+  const double e_min = branch_energy.front();
   const core::Table points = core::Table::read_csv(dir / "branch_points.csv");
   const auto period = points.column("period"), energy = points.column("energy");
   const auto verified = points.column("verified"), dimension = points.column("dimension");

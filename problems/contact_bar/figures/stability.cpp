@@ -22,24 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The value of `key` in a trace's resolved scene.ini ("key = value", a default commented out
-// as "# key = value  (default)"); empty when absent.
-std::string scene_value(const fs::path& scene, const std::string& key) {
-  std::ifstream in(scene);
-  std::string line;
-  while (std::getline(in, line)) {
-    std::string text = line;
-    if (text.rfind("# ", 0) == 0) text = text.substr(2);
-    const auto eq = text.find(" = ");
-    if (eq == std::string::npos || text.substr(0, eq) != key) continue;
-    std::string value = text.substr(eq + 3);
-    const auto note = value.find("  (default)");
-    if (note != std::string::npos) value = value.substr(0, note);
-    return value;
-  }
-  return {};
-}
-
 double median(std::vector<double> v) {
   if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());
