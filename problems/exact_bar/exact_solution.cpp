@@ -133,6 +133,13 @@ void ExactBarSolution::march() {
   const auto& v0 = setup_.v0;
   a_.first.push_back(0);
   b_sig_.first.push_back(0);
+  EndState left_state{false, 1, u0(0.0), 0.0, {}};
+  EndState right_state{false, 1, u0(L), 0.0, {}};
+  if (initial_) {
+    seed_characteristic_state(left_state, right_state);
+    march_windows(left_state, right_state);
+    return;
+  }
   for (std::size_t j = 0; j + 1 < xs.size(); ++j) {  // B on [0, tau): x = c t
     const double xa = xs[j], xb = xs[j + 1], xm = 0.5 * (xa + xb);
     const double t0 = xa / c_, t1 = j + 2 == xs.size() ? tau_ : xb / c_;
@@ -146,13 +153,15 @@ void ExactBarSolution::march() {
         {0, t0, t1, v0(xb) - c_ * u0.slope(xm, 1) + b_ * t0, -c_ * v0.slope(xm, 1) + b_});
   }
 
-  EndState left_state{false, 1, u0(0.0), 0.0, {}};
-  EndState right_state{false, 1, u0(L), 0.0, {}};
   if (tangent_size_ > 0) {
     seed_initial_signals(xs);
     left_state.du = Eigen::VectorXd(seed_.d_value.front());
     right_state.du = Eigen::VectorXd(seed_.d_value.back());
   }
+  march_windows(left_state, right_state);
+}
+
+void ExactBarSolution::march_windows(EndState& left_state, EndState& right_state) {
   // Signals must cover [0, t_end + tau] (a profile at t reads them up to t + tau) and the end
   // tracks [0, t_end]; one more window keeps every query strictly inside.
   const long last_window = static_cast<long>(std::ceil(t_end_ / tau_)) + 1;

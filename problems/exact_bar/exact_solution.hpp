@@ -24,6 +24,7 @@
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,27 @@ enum class Side { left, right };
 using Sensitivity = Eigen::SparseVector<double>;
 struct InitialTangent {
   std::vector<Sensitivity> d_knot, d_value;
+};
+
+// The state of the bar in characteristic form at a time t (README.md, 'Fronts'): A over the
+// next transit, the R+ = v - c u_x that reaches x = L at t + r, r in [0, tau), and B, the R- that
+// reaches x = 0 at t + r, each piecewise constant: start[0] = 0 < start[1] < ... < tau, one value
+// per piece. With a fixed end at x = 0 it is the whole state: R+(x) = A((L - x) / c),
+// R-(x) = B(x / c), and u follows by integrating u_x = (R- - R+) / (2 c) from the fixed end.
+// Every interior start is a front (a jump of the signal).
+struct CharacteristicState {
+  std::vector<double> a_start, a_value, b_start, b_value;
+  int fronts() const { return static_cast<int>(a_start.size() + b_start.size()) - 2; }
+  int pieces() const { return static_cast<int>(a_value.size() + b_value.size()); }
+};
+
+// One constant piece of A or B over [t, t + tau) as the march left it (pieces are not merged
+// across breakpoints without a jump), with its derivatives when the solution carries a
+// tangent: of its start (r, relative to t) and of its value.
+struct SignalPiece {
+  bool of_a = true;
+  double start = 0, end = 0, value = 0;
+  Sensitivity d_start, d_value;
 };
 
 // The derivatives of the hat projections int v(x, t) psi_i dx on a uniform grid: d_p, one
@@ -65,6 +87,13 @@ class ExactBarSolution {
   // The same, carrying the forward sensitivities seeded by `tangent` (InputError "v0" or
   // "body_force" when either is not zero, "tangent" when its sizes do not fit u0).
   ExactBarSolution(const bar::BarSetup& setup, double t_end, InitialTangent tangent);
+
+  // Solves on [0, t_end] from a state in characteristic form (its fronts inside (0, tau), the
+  // left end fixed, the right end free of its walls, no body force; setup.u0 and v0 are not
+  // read). With `tangent` it carries the derivatives in n = fronts + pieces parameters: the
+  // starts of A's fronts, then B's, then A's values, then B's (README.md, 'Fronts').
+  ExactBarSolution(const bar::BarSetup& setup, double t_end, CharacteristicState initial,
+                   bool tangent);
 
   // false if the event march failed (non-finite signal or runaway event count).
   bool ok() const { return ok_; }
@@ -103,6 +132,14 @@ class ExactBarSolution {
   // kink of the solution map (an event exactly on a front, a grazing) one of the one-sided
   // derivatives is taken: the one of the event's side as the march resolved it.
   ProjectedVelocityTangent projected_velocity_tangent(double t, int elements) const;
+
+  // The state at t in characteristic form (neighbouring pieces of equal value merged, so that
+  // every interior start is a front); InputError "t" if a signal is not constant there.
+  CharacteristicState characteristic_state(double t) const;
+  // The pieces of A and of B over [t, t + tau), unmerged, with their derivatives (empty
+  // Sensitivity without a tangent).
+  std::vector<SignalPiece> signal_pieces(double t) const;
+  int tangent_size() const { return tangent_size_; }
 
   // Number of linear pieces stored (both signals and both end tracks): the cost measure.
   std::size_t segment_count() const;
@@ -165,6 +202,8 @@ class ExactBarSolution {
 
   void march();
   void march_end(Side side, long k, EndState& state);
+  void march_windows(EndState& left_state, EndState& right_state);
+  void seed_characteristic_state(EndState& left_state, EndState& right_state);
   void emit(Side side, long k, double r0, double r1, double in0, double in_slope,
             bool reflect_negative, bool closed, EndState& state,
             const SegmentTangent* tangent = nullptr);
@@ -194,6 +233,8 @@ class ExactBarSolution {
   InitialTangent seed_;
   int tangent_size_ = 0;
   std::vector<SegmentTangent> a_tan_, b_tan_;
+  // The initial state in characteristic form, when given instead of u0 and v0.
+  std::optional<CharacteristicState> initial_;
 };
 
 template <class F>

@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -35,6 +36,7 @@
 #include "problems/contact_bar/orbits/family.hpp"
 #include "problems/contact_bar/orbits/grazing_limits.hpp"
 #include "problems/contact_bar/orbits/manifold.hpp"
+#include "problems/contact_bar/orbits/monodromy.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/contact_bar/orbits/subharmonic.hpp"
 #include "problems/contact_bar/solver/scene.hpp"
@@ -105,6 +107,8 @@ SubharmonicBranch subharmonic_branch(const std::string& branch) {
 // threads); InputError naming the key.
 MonodromyOptions monodromy_options(const core::Scene& scene) {
   MonodromyOptions o;
+  o.representation =
+      parse_representation("stability_representation", scene.text("stability_representation"));
   o.elements = static_cast<int>(scene.integer("stability_elements", 0, 2000));
   o.relative_step = scene.number("stability_step");
   o.courant = scene.number("stability_courant");
@@ -180,18 +184,23 @@ po::options_description trace_keys() {
        "Jacobian, m n^2 operations) cost more than this (> 0; 2e10: about 2000 intervals, "
        "seconds per factorization on this machine class): raise it to run larger traces")  //
       ("stability", po::value<bool>()->default_value(false),
-       "Floquet multipliers of every point (branch.csv's stability columns, multipliers.csv): "
-       "the monodromy of the full state (u, v) on a grid of stability_elements, by "
-       "differences of 4 x stability_elements simulations of one period per point "
-       "(problems/contact_bar/orbits/README.md, section 'Stability'). Off by default: it costs "
-       "more than the point itself")  //
-      ("floquet_tolerance", po::value<double>()->default_value(1e-2),
-       "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1). 1e-2 for the bar: its "
-       "monodromy's projection moves multipliers by up to 3e-3 off the circle on mode 1 at 40 "
-       "intervals (problems/contact_bar/orbits/README.md, 'Stability')")  //
-      ("floquet_trivial_tolerance", po::value<double>()->default_value(1e-2),
-       "the two trivial multipliers must lie within this of +1, else the point is undecided, "
-       "in (0, 0.5)")  //
+       "Floquet multipliers of every point (branch.csv's stability columns, multipliers.csv) "
+       "in the stability_representation (problems/contact_bar/orbits/README.md, section "
+       "'Stability')")  //
+      ("stability_representation", po::value<std::string>()->default_value("fronts"),
+       "fronts: the isolated multipliers exactly, from the orbit's fronts, one tangent "
+       "simulation per point (fronts.csv beside the branch: K's checks and Jordan defect); "
+       "grid: the projected full state (u, v) on a grid of stability_elements, by differences "
+       "(problems/contact_bar/orbits/README.md, 'Stability')")  //
+      ("floquet_tolerance", po::value<double>()->default_value(1e-4),
+       "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1). 1e-4 for the fronts: a "
+       "Jordan block of size 2 (modes J >= 2) turns K's error e, the traced orbit's 1e-10, "
+       "into sqrt(e). With the grid representation pass 1e-2: its projection moves "
+       "multipliers by up to 3e-3 off the circle on mode 1 at 40 intervals "
+       "(problems/contact_bar/orbits/README.md, 'Stability')")  //
+      ("floquet_trivial_tolerance", po::value<double>()->default_value(1e-4),
+       "the trivial multipliers must lie within this of +1, else the point is undecided, in "
+       "(0, 0.5); with the grid representation pass 1e-2")  //
       ("stability_elements", po::value<long>()->default_value(0),
        "intervals of a uniform (u, v) grid for the monodromy, in [0, 2000] (0: the shooting "
        "grid itself, mapped by its free knots); M is "
@@ -842,6 +851,45 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
 
 }  // namespace
 
+// With the fronts representation, fronts.csv beside the branch: per point the isolated
+// multipliers' matrix K's checks and its Jordan defect (monodromy.hpp; README.md of orbits/,
+// 'Stability').
+void add_front_report(cli::TraceSetup& s) {
+  const auto* p = dynamic_cast<const ContactBarOrbitProblem*>(s.problem.get());
+  if (!p || p->monodromy_options().representation != MonodromyOptions::Representation::fronts)
+    return;
+  s.write_extra_outputs = [p, inner = std::move(s.write_extra_outputs)](
+                              const std::filesystem::path& out, const continuation::Branch& b) {
+    if (inner) inner(out, b);
+    core::Table table({"point", "energy", "period", "ok", "fronts", "max_modulus_minus_one",
+                       "determinant", "jordan_defect", "time_shift_error", "value_leak",
+                       "isometry_error", "return_error"});
+    for (const auto& point : b.points) {
+      const exact_bar::FrontMonodromy m = orbit_front_monodromy(*p, point.x);
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      double excess = nan, det = nan, defect = nan;
+      if (m.ok) {
+        excess = -1;
+        const Eigen::VectorXcd mu = Eigen::EigenSolver<Eigen::MatrixXd>(m.K, false).eigenvalues();
+        for (const auto& z : mu) excess = std::max(excess, std::abs(z) - 1);
+        det = m.K.determinant();
+        defect = jordan_defect(m.K);
+      }
+      table.add_row({static_cast<double>(point.index), point.observable("energy"),
+                     p->period(point.x), m.ok ? 1.0 : 0.0, static_cast<double>(m.K.rows()), excess,
+                     det, defect, m.ok ? m.time_shift_error : nan, m.ok ? m.value_leak : nan,
+                     m.ok ? m.isometry_error : nan, m.ok ? m.return_error : nan});
+    }
+    table.write_csv(out / "fronts.csv");
+  };
+}
+
+cli::TraceSetup setup_trace_with_reports(const core::Scene& scene, const std::string& branch) {
+  cli::TraceSetup s = setup_trace(scene, branch);
+  if (scene.flag("stability")) add_front_report(s);
+  return s;
+}
+
 cli::ProblemPlugin trace_plugin() {
   cli::ProblemPlugin p;
   p.name = "contact_bar";
@@ -854,7 +902,7 @@ cli::ProblemPlugin trace_plugin() {
   p.branch_family_text =
       "modeJ for every J >= 1; subharmonicJ, subharmonic_continuumJ and subharmonic_manifoldJ "
       "for every even J >= 4";
-  p.setup = &setup_trace;
+  p.setup = &setup_trace_with_reports;
   p.simulate_keys = &simulate_keys;
   p.simulate = &simulate_scene;
   p.units = {{"period", "s"},

@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <cmath>
+#include <complex>
 #include <random>
 #include <vector>
 
@@ -17,6 +20,64 @@ namespace backbone::contact_bar {
 using core::EvalStatus;
 using core::Matrix;
 using core::Vector;
+
+MonodromyOptions::Representation parse_representation(const std::string& key,
+                                                       const std::string& value) {
+  if (value == "fronts") return MonodromyOptions::Representation::fronts;
+  if (value == "grid") return MonodromyOptions::Representation::grid;
+  throw core::InputError(key, fmt::format("must be fronts or grid (got '{}')", value));
+}
+
+exact_bar::FrontMonodromy orbit_front_monodromy(const ContactBarOrbitProblem& problem,
+                                                const core::Vector& x) {
+  exact_bar::FrontMonodromy out;
+  const double period = problem.period(x);
+  try {
+    const exact_bar::ExactBarSolution orbit(problem.setup_at(x), period);
+    if (!orbit.ok()) {
+      out.message = orbit.message();
+      return out;
+    }
+    const exact_bar::OrbitState start = exact_bar::free_flight_state(orbit, period);
+    if (std::isnan(start.t0)) {
+      out.message = "the end is on a wall at every sampled time";
+      return out;
+    }
+    return exact_bar::front_monodromy(problem.setup_at(x), start.state, period);
+  } catch (const core::InputError& e) {
+    out.message = e.what();
+    return out;
+  }
+}
+
+int jordan_defect(const Eigen::MatrixXd& K) {
+  const auto n = K.rows();
+  if (n == 0) return 0;
+  const Eigen::VectorXcd mu = Eigen::EigenSolver<Eigen::MatrixXd>(K, false).eigenvalues();
+  const double scale = std::max(1.0, K.cwiseAbs().maxCoeff());
+  std::vector<bool> done(static_cast<std::size_t>(n), false);
+  int defect = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (done[static_cast<std::size_t>(i)]) continue;
+    std::complex<double> mean = 0;
+    int algebraic = 0;
+    for (Eigen::Index j = i; j < n; ++j)
+      if (!done[static_cast<std::size_t>(j)] && std::abs(mu[j] - mu[i]) <= 1e-4 * scale) {
+        done[static_cast<std::size_t>(j)] = true;
+        mean += mu[j];
+        ++algebraic;
+      }
+    mean /= static_cast<double>(algebraic);
+    const Eigen::MatrixXcd shifted =
+        K.cast<std::complex<double>>() - mean * Eigen::MatrixXcd::Identity(n, n);
+    const Eigen::VectorXd sigma = Eigen::JacobiSVD<Eigen::MatrixXcd>(shifted).singularValues();
+    int geometric = 0;
+    for (Eigen::Index k = 0; k < n; ++k)
+      if (sigma[k] <= 1e-8 * scale) ++geometric;
+    defect += std::max(0, algebraic - std::max(geometric, 1));
+  }
+  return defect;
+}
 
 void MonodromyOptions::validate() const {
   if (elements < 0)

@@ -28,18 +28,24 @@
 //   core::EvalStatus st = contact_bar::full_state_monodromy(problem, x, o, M);   // 2N x 2N
 #pragma once
 
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "core/problem.hpp"
 #include "core/types.hpp"
 #include "problems/bar/bar.hpp"
+#include "problems/exact_bar/front_monodromy.hpp"
 
 namespace backbone::contact_bar {
 
 class ContactBarOrbitProblem;
 
 struct MonodromyOptions {
+  // fronts: the isolated multipliers exactly, from the orbit's fronts (front_monodromy below);
+  // grid: the projected full state on a grid, by differences (the rest of these options).
+  enum class Representation { fronts, grid };
+  Representation representation = Representation::fronts;
   int elements = 0;             // N of a uniform representation; 0: the problem's own nodes
   double relative_step = 1e-6;  // difference step: this times max(max|u0|, gap) for u, times
                                 // c / L that for v
@@ -48,6 +54,8 @@ struct MonodromyOptions {
   int threads = 1;
   void validate() const;  // InputError naming stability_elements / stability_step
 };
+MonodromyOptions::Representation parse_representation(const std::string& key,
+                                                       const std::string& value);  // InputError
 
 // The representation's nodes 0 = y_0 < ... < y_N = L: the uniform grid of `elements` intervals,
 // or with elements = 0 the problem's own node grid at x (mapped by its free knots, so that a
@@ -74,6 +82,20 @@ core::EvalStatus full_state_map(const ContactBarOrbitProblem& problem,
 // an interval under L / (64 N): the time step follows it, and the cost with it.
 core::EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const core::Vector& x,
                                       const MonodromyOptions& options, core::Matrix& M);
+
+// The isolated multipliers' matrix K of the orbit x (exact_bar/front_monodromy.hpp,
+// README.md 'Stability'): the orbit simulated by the exact characteristics solver, its state
+// taken at a time its end is free, K from the tangent over one period. Not ok (with the
+// reason) when the orbit's fronts do not come back.
+exact_bar::FrontMonodromy orbit_front_monodromy(const ContactBarOrbitProblem& problem,
+                                                const core::Vector& x);
+
+// Per cluster of eigenvalues of K within 1e-4 |K| of each other, its size less its
+// eigenvectors (singular values of K - mu I under 1e-8 |K|, mu the cluster's mean), summed: a
+// positive defect is a Jordan block, along which a perturbation grows linearly in the number of
+// periods. The widths: K carries the traced orbit's error e (1e-10), which splits a Jordan
+// block of size 2 by sqrt(e) and leaves K - mu I a singular value of about e.
+int jordan_defect(const Eigen::MatrixXd& K);
 
 // The check that needs no representation: the orbit's state plus a random perturbation (u and
 // v continuous and piecewise linear on `elements` uniform intervals, nodal values uniform in

@@ -483,7 +483,18 @@ std::optional<core::JacobianPattern> ContactBarOrbitProblem::jacobian_pattern(
 }
 
 EvalStatus ContactBarOrbitProblem::monodromy(const Vector& x, core::Matrix& M) const {
-  return full_state_monodromy(*this, x, monodromy_options_, M);
+  if (monodromy_options_.representation == MonodromyOptions::Representation::grid)
+    return full_state_monodromy(*this, x, monodromy_options_, M);
+  const exact_bar::FrontMonodromy fronts = orbit_front_monodromy(*this, x);
+  if (!fronts.ok) return EvalStatus::failed;
+  M = fronts.K;
+  return EvalStatus::ok;
+}
+
+core::FloquetStructure ContactBarOrbitProblem::floquet_structure() const {
+  if (monodromy_options_.representation == MonodromyOptions::Representation::grid)
+    return {2, true, false};
+  return {1, true, true};
 }
 
 EvalStatus ContactBarOrbitProblem::admissible(const Vector& x) const {

@@ -171,13 +171,16 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
   double displacement_scale() const;
 
-  // Floquet multipliers (core::FloquetProblem): the monodromy of the full state (u, v) in the
-  // representation of monodromy.hpp, 2N x 2N, by differences of 4N simulations of one period
-  // (README.md, section 'Stability'). Conservative, two trivial multipliers (time shift and
-  // energy); the projection keeps the isolated multipliers from converging pointwise, so no
-  // bifurcation of the orbits is read from them.
+  // Floquet multipliers (core::FloquetProblem; README.md, section 'Stability'), in the
+  // representation of the monodromy options:
+  //   fronts: K, the isolated multipliers exactly (monodromy.hpp, orbit_front_monodromy), one
+  //   tangent simulation of one period; one trivial multiplier (the time shift; the energy's
+  //   belongs to the continuum on the circle); bifurcations read from them;
+  //   grid: the full state (u, v) on a grid, 2N x 2N, by differences of 4N simulations of one
+  //   period. Two trivial multipliers (time shift and energy); the projection keeps the
+  //   isolated multipliers from converging pointwise, so no bifurcation is read from them.
   core::EvalStatus monodromy(const core::Vector& x, core::Matrix& M) const override;
-  core::FloquetStructure floquet_structure() const override { return {2, true, false}; }
+  core::FloquetStructure floquet_structure() const override;
   void set_monodromy_options(const MonodromyOptions& options) {
     options.validate();
     monodromy_options_ = options;

@@ -1,0 +1,162 @@
+#include "problems/exact_bar/front_monodromy.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace backbone::exact_bar {
+
+CharacteristicState without_small_jumps(const CharacteristicState& state, double tolerance) {
+  double scale = 0;
+  for (const auto* v : {&state.a_value, &state.b_value})
+    for (double y : *v) scale = std::max(scale, std::abs(y));
+  const double tau = 1.0;  // lengths only weigh the averages: any unit will do
+  CharacteristicState out;
+  for (bool of_a : {true, false}) {
+    const auto& start = of_a ? state.a_start : state.b_start;
+    const auto& value = of_a ? state.a_value : state.b_value;
+    auto& out_start = of_a ? out.a_start : out.b_start;
+    auto& out_value = of_a ? out.a_value : out.b_value;
+    double weight = 0;  // of the last output piece, for its running average
+    for (std::size_t i = 0; i < start.size(); ++i) {
+      const double length =
+          (i + 1 < start.size() ? start[i + 1] : std::max(tau, start[i] * 2)) - start[i];
+      if (!out_value.empty() && std::abs(value[i] - out_value.back()) <= tolerance * scale) {
+        out_value.back() = (out_value.back() * weight + value[i] * length) / (weight + length);
+        weight += length;
+        continue;
+      }
+      out_start.push_back(start[i]);
+      out_value.push_back(value[i]);
+      weight = length;
+    }
+  }
+  return out;
+}
+
+OrbitState free_flight_state(const ExactBarSolution& orbit, double period,
+                             double jump_tolerance) {
+  const bar::BarSetup& setup = orbit.setup();
+  const double tau = setup.material.length / setup.material.wave_speed();
+  std::vector<double> events;
+  for (const ContactInterval& c : orbit.contact_intervals(Side::right)) {
+    events.push_back(c.t_close);
+    events.push_back(c.t_release);
+  }
+  OrbitState best{std::numeric_limits<double>::quiet_NaN(), {}};
+  double best_margin = -1;
+  constexpr int candidates = 64;
+  for (int j = 0; j < candidates; ++j) {
+    const double t0 = period * (j + 0.5) / candidates;
+    if (orbit.in_contact(Side::right, t0)) continue;
+    double margin = tau;
+    for (double e : events) margin = std::min(margin, std::abs(e - t0));
+    CharacteristicState s = without_small_jumps(orbit.characteristic_state(t0), jump_tolerance);
+    for (const auto* start : {&s.a_start, &s.b_start})
+      if (start->size() > 1) margin = std::min({margin, (*start)[1], tau - start->back()});
+    if (margin > best_margin) {
+      best_margin = margin;
+      best = {t0, std::move(s)};
+    }
+  }
+  return best;
+}
+
+FrontMonodromy front_monodromy(const bar::BarSetup& setup, const CharacteristicState& state,
+                               double period, double jump_tolerance) {
+  FrontMonodromy out;
+  const ExactBarSolution sol(setup, period, state, true);
+  if (!sol.ok()) {
+    out.message = sol.message();
+    return out;
+  }
+  const double tau = setup.material.length / setup.material.wave_speed();
+  const int fronts = state.fronts(), pieces = state.pieces();
+  const int fa = static_cast<int>(state.a_start.size()) - 1;
+  double scale = 0;
+  for (const auto* v : {&state.a_value, &state.b_value})
+    for (double y : *v) scale = std::max(scale, std::abs(y));
+  if (!(scale > 0)) {
+    out.message = "the state is at rest with no strain";
+    return out;
+  }
+  const std::vector<SignalPiece> at_t = sol.signal_pieces(period);
+
+  // The fronts at T: breakpoints with a jump, matched to the state's fronts by arrival time.
+  out.K.setZero(fronts, fronts);
+  out.C.setZero(fronts, pieces);
+  const double match = 1e-6 * tau, jump = jump_tolerance * scale;
+  int matched = 0;
+  for (bool of_a : {true, false}) {
+    const auto& start = of_a ? state.a_start : state.b_start;
+    const auto& value = of_a ? state.a_value : state.b_value;
+    const SignalPiece* previous = nullptr;
+    for (const SignalPiece& p : at_t) {
+      if (p.of_a != of_a) continue;
+      if (previous && std::abs(p.value - previous->value) > jump) {
+        auto it = std::min_element(start.begin() + 1, start.end(), [&](double a, double b) {
+          return std::abs(a - p.start) < std::abs(b - p.start);
+        });
+        if (it == start.end() || std::abs(*it - p.start) > match) {
+          out.message = fmt::format("a front at T (r = {}) has none at 0 to match", p.start);
+          return out;
+        }
+        const int i = static_cast<int>(it - start.begin()) - 1 + (of_a ? 0 : fa);
+        for (Sensitivity::InnerIterator e(p.d_start); e; ++e) {
+          if (e.index() < fronts)
+            out.K(i, e.index()) += e.value();
+          else
+            out.C(i, e.index() - fronts) += e.value();
+        }
+        out.return_error = std::max(out.return_error, std::abs(*it - p.start) / tau);
+        ++matched;
+      }
+      previous = &p;
+    }
+    // Values: each piece at T against the state's value at the same r.
+    for (const SignalPiece& p : at_t) {
+      if (p.of_a != of_a) continue;
+      const double mid = 0.5 * (p.start + p.end);
+      const auto j = static_cast<std::size_t>(
+          std::upper_bound(start.begin(), start.end(), mid) - start.begin() - 1);
+      out.return_error = std::max(out.return_error, std::abs(p.value - value[j]) / scale);
+    }
+  }
+  if (matched != fronts) {
+    out.message = fmt::format("{} of the {} fronts at 0 found at T", matched, fronts);
+    return out;
+  }
+
+  // The values' images: no front shift may reach them, and they keep the L2 product.
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(at_t.size()), pieces);
+  Eigen::VectorXd w_out(static_cast<Eigen::Index>(at_t.size()));
+  for (std::size_t i = 0; i < at_t.size(); ++i) {
+    const SignalPiece& p = at_t[i];
+    w_out[static_cast<Eigen::Index>(i)] = p.end - p.start;
+    for (Sensitivity::InnerIterator e(p.d_value); e; ++e) {
+      if (e.index() < fronts)
+        out.value_leak = std::max(out.value_leak, std::abs(e.value()) / scale);
+      else
+        D(static_cast<Eigen::Index>(i), e.index() - fronts) = e.value();
+    }
+  }
+  Eigen::VectorXd w_in(pieces);
+  int j = 0;
+  for (bool of_a : {true, false}) {
+    const auto& start = of_a ? state.a_start : state.b_start;
+    for (std::size_t i = 0; i < start.size(); ++i, ++j)
+      w_in[j] = (i + 1 < start.size() ? start[i + 1] : tau) - start[i];
+  }
+  const Eigen::MatrixXd G = D.transpose() * w_out.asDiagonal() * D;
+  const Eigen::MatrixXd W = w_in.asDiagonal();
+  out.isometry_error = (G - W).cwiseAbs().maxCoeff() / w_in.maxCoeff();
+  out.time_shift_error =
+      (out.K * Eigen::VectorXd::Ones(fronts) - Eigen::VectorXd::Ones(fronts)).cwiseAbs().maxCoeff();
+  out.ok = true;
+  return out;
+}
+
+}  // namespace backbone::exact_bar
