@@ -9,11 +9,12 @@
 
 namespace backbone::exact_bar {
 
-CharacteristicState without_small_jumps(const CharacteristicState& state, double tolerance) {
+CharacteristicState without_small_jumps(const CharacteristicState& state, double tolerance,
+                                        double tau) {
   double scale = 0;
   for (const auto* v : {&state.a_value, &state.b_value})
     for (double y : *v) scale = std::max(scale, std::abs(y));
-  const double tau = 1.0;  // lengths only weigh the averages: any unit will do
+  const double sliver = 1e-9 * tau;
   CharacteristicState out;
   for (bool of_a : {true, false}) {
     const auto& start = of_a ? state.a_start : state.b_start;
@@ -22,14 +23,14 @@ CharacteristicState without_small_jumps(const CharacteristicState& state, double
     auto& out_value = of_a ? out.a_value : out.b_value;
     double weight = 0;  // of the last output piece, for its running average
     for (std::size_t i = 0; i < start.size(); ++i) {
-      const double length =
-          (i + 1 < start.size() ? start[i + 1] : std::max(tau, start[i] * 2)) - start[i];
+      const double length = (i + 1 < start.size() ? start[i + 1] : tau) - start[i];
+      if (i > 0 && length < sliver) continue;  // its neighbour on the right starts here
       if (!out_value.empty() && std::abs(value[i] - out_value.back()) <= tolerance * scale) {
         out_value.back() = (out_value.back() * weight + value[i] * length) / (weight + length);
         weight += length;
         continue;
       }
-      out_start.push_back(start[i]);
+      out_start.push_back(i > 0 && start[i] - start[i - 1] < sliver ? start[i - 1] : start[i]);
       out_value.push_back(value[i]);
       weight = length;
     }
@@ -54,7 +55,8 @@ OrbitState free_flight_state(const ExactBarSolution& orbit, double period,
     if (orbit.in_contact(Side::right, t0)) continue;
     double margin = tau;
     for (double e : events) margin = std::min(margin, std::abs(e - t0));
-    CharacteristicState s = without_small_jumps(orbit.characteristic_state(t0), jump_tolerance);
+    CharacteristicState s =
+        without_small_jumps(orbit.characteristic_state(t0), jump_tolerance, tau);
     for (const auto* start : {&s.a_start, &s.b_start})
       if (start->size() > 1) margin = std::min({margin, (*start)[1], tau - start->back()});
     if (margin > best_margin) {
@@ -85,45 +87,65 @@ FrontMonodromy front_monodromy(const bar::BarSetup& setup, const CharacteristicS
   }
   const std::vector<SignalPiece> at_t = sol.signal_pieces(period);
 
-  // The fronts at T: breakpoints with a jump, matched to the state's fronts by arrival time.
+  // The fronts at T. A front of the state at 0 may come back as a few breakpoints within round-
+  // off of each other (events re-created from a traced orbit's slightly imperfect data), each
+  // with part of its jump: to first order they act as one front at their jump-weighted mean
+  // position, so each state front's row is sum(jump_i d_start_i) / sum(jump_i) over the
+  // breakpoints within 1e-6 tau of it. A breakpoint with a jump over the tolerance and no
+  // state front near it means the orbit did not come back.
   out.K.setZero(fronts, fronts);
   out.C.setZero(fronts, pieces);
   const double match = 1e-6 * tau, jump = jump_tolerance * scale;
-  int matched = 0;
+  Eigen::MatrixXd weighted = Eigen::MatrixXd::Zero(fronts, fronts + pieces);
+  Eigen::VectorXd total = Eigen::VectorXd::Zero(fronts), position = Eigen::VectorXd::Zero(fronts);
   for (bool of_a : {true, false}) {
     const auto& start = of_a ? state.a_start : state.b_start;
     const auto& value = of_a ? state.a_value : state.b_value;
     const SignalPiece* previous = nullptr;
     for (const SignalPiece& p : at_t) {
       if (p.of_a != of_a) continue;
-      if (previous && std::abs(p.value - previous->value) > jump) {
+      if (previous) {
+        const double step = p.value - previous->value;
         auto it = std::min_element(start.begin() + 1, start.end(), [&](double a, double b) {
           return std::abs(a - p.start) < std::abs(b - p.start);
         });
-        if (it == start.end() || std::abs(*it - p.start) > match) {
+        if (it != start.end() && std::abs(*it - p.start) <= match) {
+          const int i = static_cast<int>(it - start.begin()) - 1 + (of_a ? 0 : fa);
+          total[i] += step;
+          position[i] += step * p.start;
+          for (Sensitivity::InnerIterator e(p.d_start); e; ++e)
+            weighted(i, e.index()) += step * e.value();
+        } else if (std::abs(step) > jump) {
           out.message = fmt::format("a front at T (r = {}) has none at 0 to match", p.start);
           return out;
         }
-        const int i = static_cast<int>(it - start.begin()) - 1 + (of_a ? 0 : fa);
-        for (Sensitivity::InnerIterator e(p.d_start); e; ++e) {
-          if (e.index() < fronts)
-            out.K(i, e.index()) += e.value();
-          else
-            out.C(i, e.index() - fronts) += e.value();
-        }
-        out.return_error = std::max(out.return_error, std::abs(*it - p.start) / tau);
-        ++matched;
       }
       previous = &p;
     }
-    // Values: each piece at T against the state's value at the same r.
+    // Values: each piece at T (but slivers between parts of one front) against the state's
+    // value at the same r.
     for (const SignalPiece& p : at_t) {
-      if (p.of_a != of_a) continue;
+      if (p.of_a != of_a || p.end - p.start <= match) continue;
       const double mid = 0.5 * (p.start + p.end);
       const auto j = static_cast<std::size_t>(
           std::upper_bound(start.begin(), start.end(), mid) - start.begin() - 1);
       out.return_error = std::max(out.return_error, std::abs(p.value - value[j]) / scale);
     }
+  }
+  // A state front is found when its jump comes back (to half of it: the orbit's error is far
+  // smaller, and a front near the tolerance may come back as parts under it).
+  int matched = 0;
+  for (int i = 0; i < fronts; ++i) {
+    const bool of_a = i < fa;
+    const auto k = static_cast<std::size_t>(of_a ? i + 1 : i - fa + 1);
+    const auto& value = of_a ? state.a_value : state.b_value;
+    const double jump0 = value[k] - value[k - 1];
+    if (!(std::abs(total[i] - jump0) <= 0.5 * std::abs(jump0))) continue;
+    ++matched;
+    out.K.row(i) = weighted.row(i).head(fronts) / total[i];
+    out.C.row(i) = weighted.row(i).tail(pieces) / total[i];
+    const double r0 = of_a ? state.a_start[k] : state.b_start[k];
+    out.return_error = std::max(out.return_error, std::abs(position[i] / total[i] - r0) / tau);
   }
   if (matched != fronts) {
     out.message = fmt::format("{} of the {} fronts at 0 found at T", matched, fronts);

@@ -44,11 +44,14 @@ struct FrontMonodromy {
                             // |value(T) - value(0)| / max |value|: how periodic the orbit is
 };
 
-// Jumps under `tolerance` times the largest |value| are not fronts: a traced orbit's nodal
-// values carry its residual, so its breakpoints between equal slopes jump by round-off. Such
-// neighbours become one piece with their length-weighted mean value.
+// A traced orbit's state carries its residual: breakpoints between equal slopes jump by
+// round-off, and two fronts that meet in the exact orbit sit a few ulps apart with a sliver
+// between them. Here jumps under `tolerance` times the largest |value| are not fronts (such
+// neighbours become one piece with their length-weighted mean value), and pieces shorter than
+// 1e-9 tau are dropped (the fronts on either side become one, with the sum of their jumps).
 constexpr double default_jump_tolerance = 1e-7;
-CharacteristicState without_small_jumps(const CharacteristicState& state, double tolerance);
+CharacteristicState without_small_jumps(const CharacteristicState& state, double tolerance,
+                                        double tau);
 
 // The orbit's state in characteristic form (without_small_jumps) at a time t0 in [0, T) at
 // which its right end is free: of 64 evenly spaced times the one farthest from a contact event

@@ -67,7 +67,10 @@ TEST(ContactBarMonodromy, ModeOnesMultipliersLieOnTheUnitCircleWithTheTrivialPai
   for (int n : {20, 40}) {
     contact_bar::OrbitOptions o;
     o.elements = n;
-    const contact_bar::ContactBarOrbitProblem orbit(setup, tdbem, o);
+    contact_bar::ContactBarOrbitProblem orbit(setup, tdbem, o);
+    contact_bar::MonodromyOptions grid;
+    grid.representation = contact_bar::MonodromyOptions::Representation::grid;
+    orbit.set_monodromy_options(grid);
     const core::Vector x = orbit.contact_family_guess(1, 1.5);  // exact on the grid
     core::Matrix M;
     ASSERT_EQ(orbit.monodromy(x, M), core::EvalStatus::ok);
@@ -157,7 +160,11 @@ TEST(ContactBarMonodromy, TheExactSolversMultipliersAgreeWithTheTdbems) {
   const exact_bar::ExactBarSolver exact;
   contact_bar::OrbitOptions o;
   o.elements = 20;
-  const contact_bar::ContactBarOrbitProblem by_tdbem(setup, tdbem, o), by_exact(setup, exact, o);
+  contact_bar::ContactBarOrbitProblem by_tdbem(setup, tdbem, o), by_exact(setup, exact, o);
+  contact_bar::MonodromyOptions grid;
+  grid.representation = contact_bar::MonodromyOptions::Representation::grid;
+  by_tdbem.set_monodromy_options(grid);
+  by_exact.set_monodromy_options(grid);
   const core::Vector x = by_tdbem.contact_family_guess(1, 2.0);
   core::Matrix a, b;
   ASSERT_EQ(by_tdbem.monodromy(x, a), core::EvalStatus::ok);
