@@ -66,7 +66,9 @@ void read_mode1_scene(Mode1Scene& s, const Mode1BranchSettings& settings) {
                                                 "--rank_check_every",
                                                 std::to_string(settings.rank_check_every),
                                                 "--jacobian",
-                                                settings.jacobian});
+                                                settings.jacobian,
+                                                "--stability",
+                                                settings.stability ? "true" : "false"});
 }
 
 // The 1-minute load average of the machine (Linux /proc/loadavg), "unknown" elsewhere: wall
@@ -90,6 +92,7 @@ std::string error_text(double value) {
 std::string Mode1BranchSettings::label() const {
   if (study == "grid") return fmt::format("N = {}", elements);
   if (study == "grid_unchecked") return fmt::format("N = {}, no rank checks", elements);
+  if (study == "grid_stability") return fmt::format("N = {}, with multipliers", elements);
   if (study.starts_with("grid_exact"))
     return fmt::format("N = {}, {} Jacobian, start 1.3 g0", elements, jacobian);
   std::string text = fmt::format("N = {}", elements);
@@ -237,7 +240,7 @@ constexpr int variant_n = 40, threads_n = 80, jacobian_n = 200;
 
 // Every run of the case: `all` in the table's order, the rest by study.
 struct ScalingRuns {
-  std::vector<Mode1BranchCost> all, grid, fine, unchecked, exact;
+  std::vector<Mode1BranchCost> all, grid, fine, unchecked, exact, stability;
   Mode1BranchCost base, spp80, paper, eigen_square, kinsol_square, threads_base, threads;
   bool threads_same = false;
   int status = 0;  // 1 when a grid run stops early or threads change the branch
@@ -309,6 +312,15 @@ void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
       s.start_offset = 0.3;
       r.run_into(r.exact, s);
     }
+  // The same grids with the multipliers of every point (--stability true, the fronts' K:
+  // orbits/README.md, 'Stability'), against the grid rows above.
+  for (int n : grids) {
+    Mode1BranchSettings s;
+    s.study = "grid_stability";
+    s.elements = n;
+    s.stability = true;
+    r.run_into(r.stability, s);
+  }
   // Without rank reports (--rank_check_every 0), up to N = 640: what the corrections cost
   // alone, without the verification of the many-dimensional start at T = 3.8, which dominates
   // the checked trace at large N (problems/contact_bar/bench/README.md, 'Cost').
@@ -447,6 +459,33 @@ std::string cost_row(const Mode1BranchCost& c) {
                      error_text(c.median_error), error_text(c.sigma_zero));
 }
 
+// The multipliers' cost, grid by grid: ms per point with and without them, and the exponent
+// of their extra cost over N >= 40.
+std::string stability_verdict(const ScalingRuns& r) {
+  std::string rows;
+  std::vector<double> n, extra;
+  for (const Mode1BranchCost& s : r.stability)
+    for (const Mode1BranchCost& g : r.grid)
+      if (g.settings.elements == s.settings.elements) {
+        rows += fmt::format("{}N = {}: {} against {} ({:.2f}x)", rows.empty() ? "" : "; ",
+                            s.settings.elements, significant(s.ms_per_point()),
+                            significant(g.ms_per_point()), s.ms_per_point() / g.ms_per_point());
+        if (s.settings.elements >= 40 && s.ms_per_point() > g.ms_per_point()) {
+          n.push_back(s.settings.elements);
+          extra.push_back(s.ms_per_point() - g.ms_per_point());
+        }
+      }
+  if (rows.empty()) return std::string();
+  const std::string growth =
+      n.size() >= 2 ? fmt::format(" The multipliers' extra ms per point grow like N^{:.2f} over "
+                                  "N >= 40.",
+                                  log_log_slope(n, extra))
+                    : std::string();
+  return " With the multipliers of every point (`--stability true`), ms per point against "
+         "without: " +
+         rows + "." + growth;
+}
+
 // The exact Jacobian against the differences, grid by grid: ms per point and sigma_zero.
 std::string exact_verdict(const ScalingRuns& r) {
   std::string rows;
@@ -551,7 +590,8 @@ std::string scaling_section(const ScalingRuns& r, const JacobianThreadsTiming& j
       "| setting | points | Jacobians/point | ms/point (CPU) | total CPU s | worst error | "
       "median error | sigma_zero max |\n|---|---|---|---|---|---|---|---|\n";
   std::string grid_rows, variant_rows;
-  for (const std::vector<Mode1BranchCost>* study : {&r.grid, &r.fine, &r.unchecked, &r.exact})
+  for (const std::vector<Mode1BranchCost>* study :
+       {&r.grid, &r.fine, &r.unchecked, &r.exact, &r.stability})
     for (const Mode1BranchCost& c : *study) grid_rows += cost_row(c);
   for (const Mode1BranchCost* c : {&r.base, &r.spp80, &r.paper, &r.eigen_square, &r.kinsol_square,
                                    &r.threads_base, &r.threads})
@@ -614,14 +654,15 @@ int bench_mode1_scaling(const std::filesystem::path& out) {
   const std::string grid = grid_verdict(r, fit);
   const std::string unchecked = unchecked_verdict(r);
   const std::string exact = exact_verdict(r);
-  fmt::print("  {}\n  {}\n", unchecked, exact);
+  const std::string stability = stability_verdict(r);
+  fmt::print("  {}\n  {}\n  {}\n", unchecked, exact, stability);
   const std::string fine = fine_verdict(r);
   const std::string variants = variant_verdict(r);
   const std::string jacobian = jacobian_verdict(jt, load);
   fmt::print("  {}\n  {}\n  {}\n", grid, variants, jacobian);
   cli::write_bench_section(
       out, "mode1_scaling",
-      scaling_section(r, jt, grid + fine + unchecked + exact, variants, jacobian));
+      scaling_section(r, jt, grid + fine + unchecked + exact + stability, variants, jacobian));
   return r.status;
 }
 

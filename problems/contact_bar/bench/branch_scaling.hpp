@@ -35,6 +35,7 @@ struct Mode1BranchSettings {
   double energy_max = 5e-3;              // [J]
   std::string jacobian = "differences";  // or exact (--jacobian)
   double start_offset = 0.25;            // --start_offset (0.25: T = 3.8, a branch point)
+  bool stability = false;                // --stability (the multipliers of every point)
   // "N = 40", "steps_per_period = 80", "paper formulation", ...: the row's label.
   std::string label() const;
 };
