@@ -49,9 +49,20 @@ OrbitState free_flight_state(const ExactBarSolution& orbit, double period,
   }
   OrbitState best{std::numeric_limits<double>::quiet_NaN(), {}};
   double best_margin = -1;
-  constexpr int candidates = 64;
-  for (int j = 0; j < candidates; ++j) {
-    const double t0 = period * (j + 0.5) / candidates;
+  // Candidates: 16 evenly spaced times in each free flight within [0, T) (a flight may be far
+  // shorter than T / 16 when both walls of a clearance are near), or in [0, T) without contact.
+  std::vector<double> candidates;
+  std::vector<std::pair<double, double>> flights;
+  double free_from = 0;
+  for (const ContactInterval& c : orbit.contact_intervals(Side::right)) {
+    if (c.t_close > free_from) flights.emplace_back(free_from, std::min(c.t_close, period));
+    free_from = c.t_release;
+  }
+  if (free_from < period) flights.emplace_back(free_from, period);
+  constexpr int per_flight = 16;
+  for (const auto& [a, b] : flights)
+    for (int j = 0; j < per_flight; ++j) candidates.push_back(a + (b - a) * (j + 0.5) / per_flight);
+  for (double t0 : candidates) {
     if (orbit.in_contact(Side::right, t0)) continue;
     double margin = tau;
     for (double e : events) margin = std::min(margin, std::abs(e - t0));

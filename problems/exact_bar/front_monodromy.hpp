@@ -54,9 +54,9 @@ CharacteristicState without_small_jumps(const CharacteristicState& state, double
                                         double tau);
 
 // The orbit's state in characteristic form (without_small_jumps) at a time t0 in [0, T) at
-// which its right end is free: of 64 evenly spaced times the one farthest from a contact event
-// and from a front at an end (t0 NaN if at every one the end is closed). `orbit` is solved over
-// at least [0, T].
+// which its right end is free: of 16 evenly spaced times in each free flight, the one farthest
+// from a contact event and from a front at an end (t0 NaN if the end is closed throughout).
+// `orbit` is solved over at least [0, T].
 struct OrbitState {
   double t0 = 0;
   CharacteristicState state;

@@ -3,6 +3,8 @@
 // main job, `backbone reproduce`.
 #include "continuation/cli/plugin.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <string>
 #include <utility>
@@ -20,49 +22,64 @@ namespace backbone::contact_bar {
 
 namespace {
 
-// The stability study (problems/contact_bar/orbits/README.md, section 'Stability'): modes 1 and
-// 2 with their multipliers at 40 and 80 intervals, at 40 with c dt / dx halved and by the exact
-// solver, and mode 2 at 160, into {out}/stability/<branch>_<run>.
+// The stability study (problems/contact_bar/orbits/README.md, section 'Stability'), into
+// {out}/stability/<name>:
+//   - the fronts' multipliers (the default representation) of modes 1, 2 and 3 at 40, 80 and
+//     160 intervals and at 40 with the shooting's time step halved, of the subharmonic backbone
+//     and its continuum at 1e-3 J at 20 and 40, of the families attached to mode 1 at 70 and 140
+//     intervals (T = 3.6, 3.5, 24/7, 3.2 and 22/7 L/c), and of the clearance modes 1 and 2;
+//   - the projected grid's (grid_<name>), modes 1 and 2 at 40 and 80, at 40 with c dt / dx
+//     halved and by the exact solver, and mode 2 at 160, for the comparison.
 std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
-  const std::vector<std::string> n40{"--shooting_elements", "40"};
-  const std::vector<std::pair<std::string, std::vector<std::string>>> runs{
-      {"N40", n40},
-      {"N80", {"--shooting_elements", "80"}},
-      {"N160", {"--shooting_elements", "160"}},
-      {"N40_dt_half", {"--shooting_elements", "40", "--stability_courant", "0.015625"}},
-      {"N40_exact", {"--shooting_elements", "40", "--shooting_solver", "exact"}}};
-  // The main job's order of the steps (mode 2 alone at 160).
-  const std::vector<std::pair<std::string, std::string>> order{
-      {"mode1", "N40"},       {"mode1", "N80"},  {"mode1", "N40_dt_half"},
-      {"mode2", "N40"},       {"mode2", "N80"},  {"mode1", "N40_exact"},
-      {"mode2", "N40_exact"}, {"mode2", "N160"}, {"mode2", "N40_dt_half"}};
   std::vector<cli::ReproduceStep> steps;
-  for (const auto& [branch, run] : order) {
-    std::vector<std::string> args{scenes + "paper.ini", "--branch", branch};
-    for (const auto& [name, extra] : runs)
-      if (name == run) args.insert(args.end(), extra.begin(), extra.end());
+  auto add = [&](const std::string& name, const std::string& scene,
+                 std::vector<std::string> args) {
+    args.insert(args.begin(), scenes + scene);
     for (const char* word : {"--stability", "true", "--threads", "2", "--out"})
       args.push_back(word);
-    args.push_back("{out}/stability/" + branch + "_" + run);
-    steps.push_back({"stability_" + branch + "_" + run, "trace", std::move(args)});
+    args.push_back("{out}/stability/" + name);
+    steps.push_back({"stability_" + name, "trace", std::move(args)});
+  };
+  for (const char* mode : {"mode1", "mode2", "mode3"}) {
+    for (const char* n : {"40", "80", "160"})
+      add(fmt::format("{}_N{}", mode, n), "paper.ini",
+          {"--branch", mode, "--shooting_elements", n});
+    add(fmt::format("{}_N40_dt_half", mode), "paper.ini",
+        {"--branch", mode, "--shooting_elements", "40", "--steps_per_period", "80"});
   }
-  // The subharmonic backbone and its continuum at 1e-3 J (mode 2 over two periods), at the
-  // branches' own 20 intervals.
-  steps.push_back({"stability_subharmonic_N20",
-                   "trace",
-                   {scenes + "paper.ini", "--branch", "subharmonic", "--stability", "true",
-                    "--threads", "2", "--out", "{out}/stability/subharmonic_N20"}});
-  steps.push_back({"stability_subharmonic_continuum_N20",
-                   "trace",
-                   {scenes + "paper.ini", "--branch", "subharmonic_continuum", "--energy", "1e-3",
-                    "--stability", "true", "--threads", "2", "--out",
-                    "{out}/stability/subharmonic_continuum_N20"}});
-  // The family attached to mode 1 at T = 3.2 L/c, followed with its multipliers.
-  steps.push_back({"stability_mode1_resonances_N40",
-                   "trace",
-                   {scenes + "paper.ini", "--branch", "mode1", "--shooting_elements", "40",
-                    "--energy_max", "3e-5", "--follow", "all", "--stability", "true", "--threads",
-                    "2", "--out", "{out}/stability/mode1_resonances_N40"}});
+  for (const char* n : {"20", "40"}) {
+    add(fmt::format("subharmonic_N{}", n), "paper.ini",
+        {"--branch", "subharmonic", "--shooting_elements", n});
+    add(fmt::format("subharmonic_continuum_N{}", n), "paper.ini",
+        {"--branch", "subharmonic_continuum", "--energy", "1e-3", "--shooting_elements", n});
+  }
+  // Every family the grid finds attached to mode 1 up to 3e-5 J, followed with its multipliers
+  // (the steps of mode1_resonance_twelve: 0.05 of the amplitude).
+  for (const char* n : {"70", "140"})
+    add(fmt::format("mode1_resonances_N{}", n), "paper.ini",
+        {"--branch", "mode1", "--shooting_elements", n, "--detect_branch_points", "true", "--ds",
+         "0.05", "--ds_max", "0.05", "--energy_max", "3e-5", "--follow", "all"});
+  for (const char* mode : {"mode1", "mode2"})
+    add(fmt::format("clearance_{}", mode), "clearance.ini", {"--branch", mode});
+  // The projected grid, its tolerances at the size of its projection's error.
+  const std::vector<std::string> grid{"--stability_representation", "grid",
+                                      "--floquet_tolerance", "1e-2",
+                                      "--floquet_trivial_tolerance", "1e-2"};
+  auto add_grid = [&](const std::string& branch, const std::string& run,
+                      std::vector<std::string> extra) {
+    std::vector<std::string> args{"--branch", branch};
+    args.insert(args.end(), extra.begin(), extra.end());
+    args.insert(args.end(), grid.begin(), grid.end());
+    add("grid_" + branch + "_" + run, "paper.ini", std::move(args));
+  };
+  for (const char* branch : {"mode1", "mode2"}) {
+    add_grid(branch, "N40", {"--shooting_elements", "40"});
+    add_grid(branch, "N80", {"--shooting_elements", "80"});
+    add_grid(branch, "N40_dt_half",
+             {"--shooting_elements", "40", "--stability_courant", "0.015625"});
+    add_grid(branch, "N40_exact", {"--shooting_elements", "40", "--shooting_solver", "exact"});
+  }
+  add_grid("mode2", "N160", {"--shooting_elements", "160"});
   return steps;
 }
 
