@@ -38,6 +38,94 @@ double largest(const std::vector<double>& v) {
 
 }  // namespace
 
+namespace {
+
+// A run's own name: its folder, or <trace>/<branch_point_K> for a family it followed.
+std::string run_name(const fs::path& run, fs::path& scene_dir) {
+  const bool followed = run.filename().string().rfind("branch_point_", 0) == 0;
+  scene_dir = followed ? run.parent_path() : run;
+  return followed ? scene_dir.filename().string() + "/" + run.filename().string()
+                  : run.filename().string();
+}
+
+double number_or_nan(const std::string& text) {
+  return text.empty() ? std::nan("") : std::stod(text);
+}
+
+// The frequency-energy figure of the fronts' runs: every point coloured by the Jordan defect
+// of its K (0: every multiplier on the circle with its eigenvectors; 1, 2: linear growth along
+// as many chains), an unstable point (none so far) circled.
+void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path>& runs) {
+  std::string curves;
+  for (const fs::path& run : runs) {
+    if (!fs::exists(run / "fronts.csv")) continue;
+    fs::path scene_dir;
+    const std::string name = run_name(run, scene_dir);
+    if (name.find("_N") == std::string::npos || name.find("dt_half") != std::string::npos)
+      continue;
+    if (name.find("_N40") == std::string::npos && name.find("_N20") == std::string::npos &&
+        name.find("_N70") == std::string::npos)
+      continue;
+    const std::string fronts = core::gnuplot_quote(run / "fronts.csv");
+    const std::string branch = core::gnuplot_quote(run / "branch.csv");
+    curves += fmt::format(
+        "{}{} using 'energy':(2*pi/column('period')):(column('jordan_defect')+1) with "
+        "linespoints lc variable pt 7 ps 0.6 notitle, {} using 'energy':(column('stable')==0 ? "
+        "column('frequency') : NaN) with points pt 6 ps 2 lc 'black' notitle",
+        curves.empty() ? "plot " : ", ", fronts, branch);
+    // The first point of each run named, but the families attached to mode 1 (on top of it).
+    if (name.find("resonances") == std::string::npos)
+      curves += fmt::format(
+          ", {} every ::0::0 using 'energy':(2*pi/column('period')):('{}') with labels right "
+          "offset -1,0 font ',9' noenhanced notitle",
+          fronts, name.substr(0, name.find("_N")));
+  }
+  if (curves.empty()) return;
+  curves +=
+      ", NaN with points pt 7 lc 1 title 'Jordan defect 0 (neutral)', NaN with points pt 7 lc 2 "
+      "title 'defect 1 (linear growth)', NaN with points pt 7 lc 3 title 'defect 2', NaN with "
+      "points pt 6 ps 2 lc 'black' title 'unstable (|mu| > 1 + tol)'";
+  const core::PlotResult r = core::render_png(
+      folder / "stability_backbones.png",
+      "set datafile separator ','\nset key noenhanced\nset grid\nset logscale x\nset format x "
+      "'%.0e'\nset xrange [1e-7:2e-2]\nset xlabel 'energy [J]'\nset ylabel 'frequency [rad/s]'\nset key outside right\n"
+      "set title 'Fronts multipliers: all on the unit circle; colour: Jordan defect of K'\n" +
+          curves + "\n");
+  if (!r.ok) fmt::print("[figures] stability_backbones.png skipped: {}\n", r.message);
+}
+
+// The multipliers in the complex plane: the fronts' K of modes 1 to 3 and the subharmonic
+// backbone (every point), against the projected grid's at 160 intervals on mode 2.
+void plot_multipliers(const fs::path& folder) {
+  std::string curves = "plot cos(t), sin(t) with lines lc 'grey' title 'unit circle'";
+  const std::vector<std::pair<std::string, std::string>> runs{
+      {"grid_mode2_N160", "projected grid, mode 2, N = 160"},
+      {"mode1_N40", "fronts, mode 1"},
+      {"mode2_N40", "fronts, mode 2"},
+      {"mode3_N40", "fronts, mode 3"},
+      {"subharmonic_N20", "fronts, subharmonic backbone"}};
+  bool any = false;
+  for (const auto& [run, title] : runs) {
+    const fs::path csv = folder / run / "multipliers.csv";
+    if (!fs::exists(csv)) continue;
+    any = true;
+    curves += fmt::format(", {} using 're':'im' with points pt {} ps {} title '{}'",
+                          core::gnuplot_quote(csv), run.starts_with("grid") ? 7 : 6,
+                          run.starts_with("grid") ? "0.3" : "2", title);
+  }
+  if (!any) return;
+  const core::PlotResult r = core::render_png(
+      folder / "multipliers.png",
+      "set datafile separator ','\nset key noenhanced\nset parametric\nset trange [0:2*pi]\nset "
+      "size ratio -1\nset grid\nset xlabel 'Re mu'\nset ylabel 'Im mu'\nset key outside right\n"
+      "set title 'Floquet multipliers of every point: the fronts (exact, at roots of unity) and "
+      "the projected grid'\n" +
+          curves + "\n");
+  if (!r.ok) fmt::print("[figures] multipliers.png skipped: {}\n", r.message);
+}
+
+}  // namespace
+
 int write_stability_summary(const fs::path& out) {
   const fs::path folder = out / "stability";
   std::vector<fs::path> runs;
@@ -56,9 +144,11 @@ int write_stability_summary(const fs::path& out) {
     return 0;
   }
   std::sort(runs.begin(), runs.end());
-  core::Table summary({"run", "branch", "elements", "courant", "points", "unstable_points",
-                       "undecided_points", "max_modulus_worst", "max_modulus_median",
-                       "trivial_distance_worst", "trivial_distance_median",
+  core::Table summary({"run", "branch", "representation", "elements", "steps_per_period",
+                       "courant", "points", "unstable_points", "undecided_points",
+                       "max_modulus_worst", "max_modulus_median", "trivial_distance_worst",
+                       "determinant_error_worst", "fronts_min", "fronts_max", "jordan_defect_min",
+                       "jordan_defect_max", "structure_error_worst", "return_error_worst",
                        "real_negative_modulus_worst", "complex_modulus_worst"});
   std::string curves;
   for (const fs::path& run : runs) {
@@ -79,36 +169,66 @@ int write_stability_summary(const fs::path& out) {
       if (im[i] == 0 && re[i] < 0) negative.push_back(modulus[i]);
       if (im[i] != 0) complex.push_back(modulus[i]);
     }
-    const bool followed = run.filename().string().rfind("branch_point_", 0) == 0;
-    const fs::path scene_dir = followed ? run.parent_path() : run;
-    const std::string name = followed
-                                 ? scene_dir.filename().string() + "/" + run.filename().string()
-                                 : run.filename().string();
-    const std::string elements = scene_value(scene_dir / "scene.ini", "shooting_elements");
-    const std::string courant = scene_value(scene_dir / "scene.ini", "stability_courant");
-    summary.add_cells({name, name.substr(0, name.find('_')),
-                       elements.empty() ? std::nan("") : std::stod(elements),
-                       courant.empty() ? std::nan("") : std::stod(courant), double(stable.size()),
-                       double(unstable), double(undecided),
+    std::vector<double> determinant_error;
+    for (double d : branch.column("monodromy_determinant")) determinant_error.push_back(std::abs(d - 1));
+    fs::path scene_dir;
+    const std::string name = run_name(run, scene_dir);
+    const fs::path scene = scene_dir / "scene.ini";
+    std::string representation = scene_value(scene, "stability_representation");
+    if (representation.empty()) representation = "fronts";
+    // The fronts' own checks (fronts.csv): sizes, Jordan defects, structure and return errors.
+    const double nan = std::nan("");
+    double fronts_min = nan, fronts_max = nan, defect_min = nan, defect_max = nan,
+           structure = nan, returned = nan;
+    if (fs::exists(run / "fronts.csv")) {
+      const core::Table f = core::Table::read_csv(run / "fronts.csv");
+      auto lowest = [](const std::vector<double>& v) {
+        double m = std::nan("");
+        for (double x : v)
+          if (!std::isnan(x) && !(x >= m)) m = x;
+        return m;
+      };
+      fronts_min = lowest(f.column("fronts"));
+      fronts_max = largest(f.column("fronts"));
+      defect_min = lowest(f.column("jordan_defect"));
+      defect_max = largest(f.column("jordan_defect"));
+      structure = std::max({largest(f.column("time_shift_error")),
+                            largest(f.column("value_leak")),
+                            largest(f.column("isometry_error"))});
+      returned = largest(f.column("return_error"));
+    }
+    const std::string bare = name.starts_with("grid_") ? name.substr(5) : name;
+    summary.add_cells({name, bare.substr(0, bare.find('_')), representation,
+                       number_or_nan(scene_value(scene, "shooting_elements")),
+                       number_or_nan(scene_value(scene, "steps_per_period")),
+                       representation == "grid"
+                           ? number_or_nan(scene_value(scene, "stability_courant"))
+                           : nan,
+                       double(stable.size()), double(unstable), double(undecided),
                        largest(branch.column("max_multiplier_modulus")),
                        median(branch.column("max_multiplier_modulus")),
                        largest(branch.column("trivial_multiplier_distance")),
-                       median(branch.column("trivial_multiplier_distance")), largest(negative),
-                       largest(complex)});
-    curves +=
-        fmt::format("{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",
-                    curves.empty() ? "plot " : ", ", core::gnuplot_quote(run / "branch.csv"), name);
+                       largest(determinant_error), fronts_min, fronts_max, defect_min, defect_max,
+                       structure, returned, largest(negative), largest(complex)});
+    if (representation == "grid")
+      curves += fmt::format(
+          "{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",
+          curves.empty() ? "plot " : ", ", core::gnuplot_quote(run / "branch.csv"), name);
   }
   summary.write_csv(folder / "summary.csv");
   fmt::print("[figures] wrote {}\n{}", (folder / "summary.csv").string(), summary.aligned(4));
-  const core::PlotResult r = core::render_png(
-      folder / "max_modulus.png",
-      "set datafile separator ','\nset key autotitle columnhead noenhanced\nset grid\nset logscale "
-      "x\nset format x '%.0e'\n"
-      "set xlabel 'energy [J]'\nset ylabel 'largest non-trivial |mu|'\nset key outside right\n"
-      "set title 'Bar modes: the largest Floquet multiplier by run (grid, c dt / dx)'\n" +
-          curves + "\n");
-  if (!r.ok) fmt::print("[figures] max_modulus.png skipped: {}\n", r.message);
+  if (!curves.empty()) {
+    const core::PlotResult r = core::render_png(
+        folder / "max_modulus.png",
+        "set datafile separator ','\nset key autotitle columnhead noenhanced\nset grid\nset "
+        "logscale x\nset format x '%.0e'\n"
+        "set xlabel 'energy [J]'\nset ylabel 'largest non-trivial |mu|'\nset key outside right\n"
+        "set title 'Bar modes, projected grid: the largest Floquet multiplier by run'\n" +
+            curves + "\n");
+    if (!r.ok) fmt::print("[figures] max_modulus.png skipped: {}\n", r.message);
+  }
+  plot_stability_backbones(folder, runs);
+  plot_multipliers(folder);
   return 0;
 }
 
@@ -145,7 +265,8 @@ int write_perturbation_growth(const fs::path& out) {
 
 std::vector<cli::ProblemJob> stability_figure_jobs() {
   return {{"stability_summary",
-           "stability/summary.csv and max_modulus.png from the traces in OUT/stability",
+           "stability/summary.csv, stability_backbones.png, multipliers.png and max_modulus.png "
+           "from the traces in OUT/stability",
            write_stability_summary},
           {"perturbation_growth",
            "stability/perturbation_growth.csv: random perturbations of modes 1 to 3 over 1000 "
