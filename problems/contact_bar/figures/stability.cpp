@@ -124,6 +124,25 @@ void plot_multipliers(const fs::path& folder) {
   if (!r.ok) fmt::print("[figures] multipliers.png skipped: {}\n", r.message);
 }
 
+// What a run's numbers say (orbits/README.md, 'Stability'): the fronts' K decides; the
+// projected grid's counts are its own and no verdict on the bar.
+std::string verdict(const std::string& representation, int unstable, int undecided,
+                    double defect_min, double defect_max) {
+  if (representation == "grid") return "projected grid: no verdict (see the fronts' runs)";
+  std::string text;
+  if (unstable > 0)
+    text = fmt::format("unstable at {} points", unstable);
+  else if (defect_max > 0)
+    text = fmt::format(
+        "no multiplier off the unit circle; Jordan defect {}{}: perturbations along it grow "
+        "linearly in the number of periods",
+        defect_min == defect_max ? "" : fmt::format("{:g} to ", defect_min), defect_max);
+  else
+    text = "neutral: every multiplier on the unit circle, with its eigenvectors";
+  if (undecided > 0) text += fmt::format(" ({} points undecided)", undecided);
+  return text;
+}
+
 }  // namespace
 
 int write_stability_summary(const fs::path& out) {
@@ -149,7 +168,7 @@ int write_stability_summary(const fs::path& out) {
                        "max_modulus_worst", "max_modulus_median", "trivial_distance_worst",
                        "determinant_error_worst", "fronts_min", "fronts_max", "jordan_defect_min",
                        "jordan_defect_max", "structure_error_worst", "return_error_worst",
-                       "real_negative_modulus_worst", "complex_modulus_worst"});
+                       "real_negative_modulus_worst", "complex_modulus_worst", "verdict"});
   std::string curves;
   for (const fs::path& run : runs) {
     const core::Table branch = core::Table::read_csv(run / "branch.csv");
@@ -209,7 +228,8 @@ int write_stability_summary(const fs::path& out) {
                        median(branch.column("max_multiplier_modulus")),
                        largest(branch.column("trivial_multiplier_distance")),
                        largest(determinant_error), fronts_min, fronts_max, defect_min, defect_max,
-                       structure, returned, largest(negative), largest(complex)});
+                       structure, returned, largest(negative), largest(complex),
+                       verdict(representation, unstable, undecided, defect_min, defect_max)});
     if (representation == "grid")
       curves += fmt::format(
           "{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",
