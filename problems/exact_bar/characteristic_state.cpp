@@ -28,12 +28,12 @@ void check_signal(const char* key, const std::vector<double>& start,
     if (!std::isfinite(start[i]) || !std::isfinite(value[i]))
       throw InputError(key, fmt::format("piece {} is not finite", i));
     if (i > 0 && !(start[i] > start[i - 1]))
-      throw InputError(key, fmt::format("starts must increase strictly ({} after {})", start[i],
-                                        start[i - 1]));
+      throw InputError(
+          key, fmt::format("starts must increase strictly ({} after {})", start[i], start[i - 1]));
   }
   if (!(start.back() < tau))
-    throw InputError(key, fmt::format("every start must lie below tau = {} (got {})", tau,
-                                      start.back()));
+    throw InputError(
+        key, fmt::format("every start must lie below tau = {} (got {})", tau, start.back()));
 }
 
 }  // namespace
@@ -87,8 +87,8 @@ void ExactBarSolution::seed_characteristic_state(EndState& left_state, EndState&
       u_right += sign * value[i] * (r1 - start[i]);
       if (n == 0) continue;
       const int j = static_cast<int>(i);
-      tan.push_back({i == 0 ? zero : unit(front0 + j - 1), last ? zero : unit(front0 + j),
-                     unit(value0 + j)});
+      tan.push_back(
+          {i == 0 ? zero : unit(front0 + j - 1), last ? zero : unit(front0 + j), unit(value0 + j)});
       du[value0 + j] += sign * (r1 - start[i]);
       if (i > 0) du[front0 + j - 1] += sign * (value[i - 1] - value[i]);
     }
@@ -158,8 +158,8 @@ CharacteristicState ExactBarSolution::characteristic_state(double t) const {
   for (const SignalPiece& p : signal_pieces(t)) {
     auto& start = p.of_a ? s.a_start : s.b_start;
     auto& value = p.of_a ? s.a_value : s.b_value;
-    if (!value.empty() &&
-        std::abs(value.back() - p.value) <= 8 * epsilon * (std::abs(value.back()) + std::abs(p.value)))
+    if (!value.empty() && std::abs(value.back() - p.value) <=
+                              8 * epsilon * (std::abs(value.back()) + std::abs(p.value)))
       continue;
     start.push_back(value.empty() ? 0.0 : p.start);
     value.push_back(p.value);

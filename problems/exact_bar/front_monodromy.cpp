@@ -38,8 +38,7 @@ CharacteristicState without_small_jumps(const CharacteristicState& state, double
   return out;
 }
 
-OrbitState free_flight_state(const ExactBarSolution& orbit, double period,
-                             double jump_tolerance) {
+OrbitState free_flight_state(const ExactBarSolution& orbit, double period, double jump_tolerance) {
   const bar::BarSetup& setup = orbit.setup();
   const double tau = setup.material.length / setup.material.wave_speed();
   std::vector<double> events;
@@ -138,8 +137,8 @@ FrontMonodromy front_monodromy(const bar::BarSetup& setup, const CharacteristicS
     for (const SignalPiece& p : at_t) {
       if (p.of_a != of_a || p.end - p.start <= match) continue;
       const double mid = 0.5 * (p.start + p.end);
-      const auto j = static_cast<std::size_t>(
-          std::upper_bound(start.begin(), start.end(), mid) - start.begin() - 1);
+      const auto j = static_cast<std::size_t>(std::upper_bound(start.begin(), start.end(), mid) -
+                                              start.begin() - 1);
       out.return_error = std::max(out.return_error, std::abs(p.value - value[j]) / scale);
     }
   }

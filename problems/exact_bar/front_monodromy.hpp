@@ -36,12 +36,12 @@ struct FrontMonodromy {
   // fronts x pieces: the same arrival times' derivatives in the values.
   Eigen::MatrixXd C;
   // Checks of the block structure, relative (0 in exact arithmetic):
-  double value_leak = 0;      // max |d(value at T) / d(front)| over max |value|
-  double isometry_error = 0;  // max |G - W| / max W: G the Gram matrix of the values' images
-                              // in the L2 product (piece lengths W), W = diag(lengths)
+  double value_leak = 0;        // max |d(value at T) / d(front)| over max |value|
+  double isometry_error = 0;    // max |G - W| / max W: G the Gram matrix of the values' images
+                                // in the L2 product (piece lengths W), W = diag(lengths)
   double time_shift_error = 0;  // max |K 1 - 1|
-  double return_error = 0;  // max over fronts |start(T) - start(0)| / tau and over pieces
-                            // |value(T) - value(0)| / max |value|: how periodic the orbit is
+  double return_error = 0;      // max over fronts |start(T) - start(0)| / tau and over pieces
+                                // |value(T) - value(0)| / max |value|: how periodic the orbit is
 };
 
 // A traced orbit's state carries its residual: breakpoints between equal slopes jump by

@@ -477,9 +477,10 @@ std::string stability_verdict(const ScalingRuns& r) {
       }
   if (rows.empty()) return std::string();
   const std::string growth =
-      n.size() >= 2 ? fmt::format(" The multipliers' extra ms per point grow like N^{:.2f} over "
-                                  "N >= 40.",
-                                  log_log_slope(n, extra))
+      n.size() >= 2 ? fmt::format(
+                          " The multipliers' extra ms per point grow like N^{:.2f} over "
+                          "N >= 40.",
+                          log_log_slope(n, extra))
                     : std::string();
   return " With the multipliers of every point (`--stability true`), ms per point against "
          "without: " +

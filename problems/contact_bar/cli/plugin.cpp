@@ -32,8 +32,7 @@ namespace {
 //     halved and by the exact solver, and mode 2 at 160, for the comparison.
 std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
   std::vector<cli::ReproduceStep> steps;
-  auto add = [&](const std::string& name, const std::string& scene,
-                 std::vector<std::string> args) {
+  auto add = [&](const std::string& name, const std::string& scene, std::vector<std::string> args) {
     args.insert(args.begin(), scenes + scene);
     for (const char* word : {"--stability", "true", "--threads", "2", "--out"})
       args.push_back(word);
@@ -54,16 +53,18 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
         {"--branch", "subharmonic_continuum", "--energy", "1e-3", "--shooting_elements", n});
   }
   // Every family the grid finds attached to mode 1 up to 3e-5 J, followed with its multipliers
-  // (the steps of mode1_resonance_twelve: 0.05 of the amplitude).
+  // (the steps of mode1_resonance_twelve: 0.05 of the amplitude); at 140 intervals 8 points of
+  // each (the seven families' rank reports there take minutes per 30 points).
   for (const char* n : {"70", "140"})
     add(fmt::format("mode1_resonances_N{}", n), "paper.ini",
         {"--branch", "mode1", "--shooting_elements", n, "--detect_branch_points", "true", "--ds",
-         "0.05", "--ds_max", "0.05", "--energy_max", "3e-5", "--follow", "all"});
+         "0.05", "--ds_max", "0.05", "--energy_max", "3e-5", "--follow", "all",
+         "--follow_max_points", std::string(n) == "70" ? "30" : "8"});
   for (const char* mode : {"mode1", "mode2"})
     add(fmt::format("clearance_{}", mode), "clearance.ini", {"--branch", mode});
   // The projected grid, its tolerances at the size of its projection's error.
-  const std::vector<std::string> grid{"--stability_representation", "grid",
-                                      "--floquet_tolerance", "1e-2",
+  const std::vector<std::string> grid{"--stability_representation",  "grid",
+                                      "--floquet_tolerance",         "1e-2",
                                       "--floquet_trivial_tolerance", "1e-2"};
   auto add_grid = [&](const std::string& branch, const std::string& run,
                       std::vector<std::string> extra) {

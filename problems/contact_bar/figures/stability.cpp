@@ -61,8 +61,7 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
     if (!fs::exists(run / "fronts.csv")) continue;
     fs::path scene_dir;
     const std::string name = run_name(run, scene_dir);
-    if (name.find("_N") == std::string::npos || name.find("dt_half") != std::string::npos)
-      continue;
+    if (name.find("_N") == std::string::npos || name.find("dt_half") != std::string::npos) continue;
     if (name.find("_N40") == std::string::npos && name.find("_N20") == std::string::npos &&
         name.find("_N70") == std::string::npos)
       continue;
@@ -88,7 +87,8 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
   const core::PlotResult r = core::render_png(
       folder / "stability_backbones.png",
       "set datafile separator ','\nset key noenhanced\nset grid\nset logscale x\nset format x "
-      "'%.0e'\nset xrange [1e-7:2e-2]\nset xlabel 'energy [J]'\nset ylabel 'frequency [rad/s]'\nset key outside right\n"
+      "'%.0e'\nset xrange [1e-7:2e-2]\nset xlabel 'energy [J]'\nset ylabel 'frequency "
+      "[rad/s]'\nset key outside right\n"
       "set title 'Fronts multipliers: all on the unit circle; colour: Jordan defect of K'\n" +
           curves + "\n");
   if (!r.ok) fmt::print("[figures] stability_backbones.png skipped: {}\n", r.message);
@@ -163,12 +163,28 @@ int write_stability_summary(const fs::path& out) {
     return 0;
   }
   std::sort(runs.begin(), runs.end());
-  core::Table summary({"run", "branch", "representation", "elements", "steps_per_period",
-                       "courant", "points", "unstable_points", "undecided_points",
-                       "max_modulus_worst", "max_modulus_median", "trivial_distance_worst",
-                       "determinant_error_worst", "fronts_min", "fronts_max", "jordan_defect_min",
-                       "jordan_defect_max", "structure_error_worst", "return_error_worst",
-                       "real_negative_modulus_worst", "complex_modulus_worst", "verdict"});
+  core::Table summary({"run",
+                       "branch",
+                       "representation",
+                       "elements",
+                       "steps_per_period",
+                       "courant",
+                       "points",
+                       "unstable_points",
+                       "undecided_points",
+                       "max_modulus_worst",
+                       "max_modulus_median",
+                       "trivial_distance_worst",
+                       "determinant_error_worst",
+                       "fronts_min",
+                       "fronts_max",
+                       "jordan_defect_min",
+                       "jordan_defect_max",
+                       "structure_error_worst",
+                       "return_error_worst",
+                       "real_negative_modulus_worst",
+                       "complex_modulus_worst",
+                       "verdict"});
   std::string curves;
   for (const fs::path& run : runs) {
     const core::Table branch = core::Table::read_csv(run / "branch.csv");
@@ -189,7 +205,8 @@ int write_stability_summary(const fs::path& out) {
       if (im[i] != 0) complex.push_back(modulus[i]);
     }
     std::vector<double> determinant_error;
-    for (double d : branch.column("monodromy_determinant")) determinant_error.push_back(std::abs(d - 1));
+    for (double d : branch.column("monodromy_determinant"))
+      determinant_error.push_back(std::abs(d - 1));
     fs::path scene_dir;
     const std::string name = run_name(run, scene_dir);
     const fs::path scene = scene_dir / "scene.ini";
@@ -197,8 +214,8 @@ int write_stability_summary(const fs::path& out) {
     if (representation.empty()) representation = "fronts";
     // The fronts' own checks (fronts.csv): sizes, Jordan defects, structure and return errors.
     const double nan = std::nan("");
-    double fronts_min = nan, fronts_max = nan, defect_min = nan, defect_max = nan,
-           structure = nan, returned = nan;
+    double fronts_min = nan, fronts_max = nan, defect_min = nan, defect_max = nan, structure = nan,
+           returned = nan;
     if (fs::exists(run / "fronts.csv")) {
       const core::Table f = core::Table::read_csv(run / "fronts.csv");
       auto lowest = [](const std::vector<double>& v) {
@@ -211,25 +228,34 @@ int write_stability_summary(const fs::path& out) {
       fronts_max = largest(f.column("fronts"));
       defect_min = lowest(f.column("jordan_defect"));
       defect_max = largest(f.column("jordan_defect"));
-      structure = std::max({largest(f.column("time_shift_error")),
-                            largest(f.column("value_leak")),
+      structure = std::max({largest(f.column("time_shift_error")), largest(f.column("value_leak")),
                             largest(f.column("isometry_error"))});
       returned = largest(f.column("return_error"));
     }
     const std::string bare = name.starts_with("grid_") ? name.substr(5) : name;
-    summary.add_cells({name, bare.substr(0, bare.find('_')), representation,
-                       number_or_nan(scene_value(scene, "shooting_elements")),
-                       number_or_nan(scene_value(scene, "steps_per_period")),
-                       representation == "grid"
-                           ? number_or_nan(scene_value(scene, "stability_courant"))
-                           : nan,
-                       double(stable.size()), double(unstable), double(undecided),
-                       largest(branch.column("max_multiplier_modulus")),
-                       median(branch.column("max_multiplier_modulus")),
-                       largest(branch.column("trivial_multiplier_distance")),
-                       largest(determinant_error), fronts_min, fronts_max, defect_min, defect_max,
-                       structure, returned, largest(negative), largest(complex),
-                       verdict(representation, unstable, undecided, defect_min, defect_max)});
+    summary.add_cells(
+        {name,
+         bare.substr(0, bare.find('_')),
+         representation,
+         number_or_nan(scene_value(scene, "shooting_elements")),
+         number_or_nan(scene_value(scene, "steps_per_period")),
+         representation == "grid" ? number_or_nan(scene_value(scene, "stability_courant")) : nan,
+         double(stable.size()),
+         double(unstable),
+         double(undecided),
+         largest(branch.column("max_multiplier_modulus")),
+         median(branch.column("max_multiplier_modulus")),
+         largest(branch.column("trivial_multiplier_distance")),
+         largest(determinant_error),
+         fronts_min,
+         fronts_max,
+         defect_min,
+         defect_max,
+         structure,
+         returned,
+         largest(negative),
+         largest(complex),
+         verdict(representation, unstable, undecided, defect_min, defect_max)});
     if (representation == "grid")
       curves += fmt::format(
           "{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",

@@ -2,9 +2,9 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <random>
@@ -22,7 +22,7 @@ using core::Matrix;
 using core::Vector;
 
 MonodromyOptions::Representation parse_representation(const std::string& key,
-                                                       const std::string& value) {
+                                                      const std::string& value) {
   if (value == "fronts") return MonodromyOptions::Representation::fronts;
   if (value == "grid") return MonodromyOptions::Representation::grid;
   throw core::InputError(key, fmt::format("must be fronts or grid (got '{}')", value));

@@ -49,8 +49,8 @@ std::vector<Orbit> closed_form_orbits() {
   }
   const contact_bar::ContactFamily mode2(s.material, 1e-3, 2);
   for (double shape : {0.25, 0.6}) {
-    const auto m = contact_bar::subharmonic_member(s.material, 1e-3, 3 * mode2.grazing_energy(),
-                                                   shape);
+    const auto m =
+        contact_bar::subharmonic_member(s.material, 1e-3, 3 * mode2.grazing_energy(), shape);
     orbits.push_back(orbit_of(s, m.u0, m.period));
   }
   for (double gap_back : {1e-3, 3e-3}) {
@@ -75,7 +75,8 @@ Eigen::VectorXd fronts_at(const ExactBarSolution& sol, double t, const Character
     for (std::size_t j = 1; j < want.size(); ++j, ++i) {
       double best = std::numeric_limits<double>::quiet_NaN();
       for (std::size_t k = 1; k < have.size(); ++k)
-        if (std::abs(have[k] - want[j]) < 1e-3 && !(std::abs(best - want[j]) <= std::abs(have[k] - want[j])))
+        if (std::abs(have[k] - want[j]) < 1e-3 &&
+            !(std::abs(best - want[j]) <= std::abs(have[k] - want[j])))
           best = have[k];
       out[i] = best;
     }
@@ -115,8 +116,8 @@ TEST(FrontMonodromy, TangentMatchesCentralDifferencesOfTheExactMap) {
       const ExactBarSolution minus(o.setup, o.period, moved(o.state, -shift, -dvalue), false);
       const Eigen::VectorXd diff =
           (fronts_at(plus, o.period, o.state) - fronts_at(minus, o.period, o.state)) / (2 * step);
-      const Eigen::VectorXd tangent = col < f ? Eigen::VectorXd(m.K.col(col))
-                                              : Eigen::VectorXd(m.C.col(col - f));
+      const Eigen::VectorXd tangent =
+          col < f ? Eigen::VectorXd(m.K.col(col)) : Eigen::VectorXd(m.C.col(col - f));
       const double unit = col < f ? 1.0 : 1.0 / scale;
       EXPECT_LT((diff - tangent).cwiseAbs().maxCoeff(), 1e-6 * unit)
           << "period " << o.period << " column " << col;
@@ -186,8 +187,7 @@ TEST(FrontMonodromy, PredictsTheFrontsOfThePerturbedMarchOverManyPeriods) {
     const double e = 5 * mode.grazing_energy();
     const Orbit o = J > 0 ? orbit_of(s, mode.u0(e), mode.period(e))
                           : orbit_of(c, clearance.u0(ec), clearance.period(ec));
-    EXPECT_EQ(contact_bar::jordan_defect(
-                  exact_bar::front_monodromy(o.setup, o.state, o.period).K),
+    EXPECT_EQ(contact_bar::jordan_defect(exact_bar::front_monodromy(o.setup, o.state, o.period).K),
               J == 2 ? 1 : 0);
     const exact_bar::FrontMonodromy m = exact_bar::front_monodromy(o.setup, o.state, o.period);
     ASSERT_TRUE(m.ok) << m.message;
@@ -197,8 +197,8 @@ TEST(FrontMonodromy, PredictsTheFrontsOfThePerturbedMarchOverManyPeriods) {
     const int periods = 20;
     const ExactBarSolution march(o.setup, periods * o.period,
                                  moved(o.state, d, Eigen::VectorXd::Zero(o.state.pieces())), false);
-    const Eigen::VectorXd base = fronts_at(ExactBarSolution(o.setup, o.period, o.state, false),
-                                           0, o.state);
+    const Eigen::VectorXd base =
+        fronts_at(ExactBarSolution(o.setup, o.period, o.state, false), 0, o.state);
     Eigen::VectorXd predicted = d;
     double largest = 0;
     for (int k = 1; k <= periods; ++k) {
