@@ -24,13 +24,16 @@ CharacteristicState without_small_jumps(const CharacteristicState& state, double
     double weight = 0;  // of the last output piece, for its running average
     for (std::size_t i = 0; i < start.size(); ++i) {
       const double length = (i + 1 < start.size() ? start[i + 1] : tau) - start[i];
-      if (i > 0 && length < sliver) continue;  // its neighbour on the right starts here
+      // A sliver is dropped; the piece after it starts where it did.
+      if (length < sliver && i + 1 < start.size()) continue;
       if (!out_value.empty() && std::abs(value[i] - out_value.back()) <= tolerance * scale) {
         out_value.back() = (out_value.back() * weight + value[i] * length) / (weight + length);
         weight += length;
         continue;
       }
-      out_start.push_back(i > 0 && start[i] - start[i - 1] < sliver ? start[i - 1] : start[i]);
+      out_start.push_back(out_start.empty()                           ? 0.0
+                          : i > 0 && start[i] - start[i - 1] < sliver ? start[i - 1]
+                                                                      : start[i]);
       out_value.push_back(value[i]);
       weight = length;
     }
@@ -42,38 +45,75 @@ OrbitState free_flight_state(const ExactBarSolution& orbit, double period, doubl
   const bar::BarSetup& setup = orbit.setup();
   const double tau = setup.material.length / setup.material.wave_speed();
   std::vector<double> events;
+  std::vector<std::pair<double, double>> flights;  // the free flights within [0, T)
+  double free_from = 0;
   for (const ContactInterval& c : orbit.contact_intervals(Side::right)) {
     events.push_back(c.t_close);
     events.push_back(c.t_release);
-  }
-  OrbitState best{std::numeric_limits<double>::quiet_NaN(), {}};
-  double best_margin = -1;
-  // Candidates: 16 evenly spaced times in each free flight within [0, T) (a flight may be far
-  // shorter than T / 16 when both walls of a clearance are near), or in [0, T) without contact.
-  std::vector<double> candidates;
-  std::vector<std::pair<double, double>> flights;
-  double free_from = 0;
-  for (const ContactInterval& c : orbit.contact_intervals(Side::right)) {
     if (c.t_close > free_from) flights.emplace_back(free_from, std::min(c.t_close, period));
     free_from = c.t_release;
   }
   if (free_from < period) flights.emplace_back(free_from, period);
-  constexpr int per_flight = 16;
-  for (const auto& [a, b] : flights)
-    for (int j = 0; j < per_flight; ++j) candidates.push_back(a + (b - a) * (j + 0.5) / per_flight);
-  for (double t0 : candidates) {
-    if (orbit.in_contact(Side::right, t0)) continue;
-    double margin = tau;
-    for (double e : events) margin = std::min(margin, std::abs(e - t0));
-    CharacteristicState s =
-        without_small_jumps(orbit.characteristic_state(t0), jump_tolerance, tau);
-    for (const auto* start : {&s.a_start, &s.b_start})
-      if (start->size() > 1) margin = std::min({margin, (*start)[1], tau - start->back()});
-    if (margin > best_margin) {
-      best_margin = margin;
-      best = {t0, std::move(s)};
-    }
+  OrbitState best{std::numeric_limits<double>::quiet_NaN(), {}};
+  if (flights.empty()) return best;
+
+  // A front with start r at t_ref reaches an end at t_ref + r + k tau. The tangent march from t0
+  // reads the fronts at t0 + T, and its windows start at t0 + k tau: a front on a window's edge
+  // there or at t0 has no derivative of its own. So the fronts' phases at t0 must stay away from
+  // 0 and from -T (mod tau): t0's phase (from t_ref) away from every r and every r + T.
+  // Candidates: 16 evenly spaced times in each flight (a flight may be far shorter than T / 16
+  // when both walls of a clearance are near) and the middle of each gap between those phases
+  // that falls in a flight (a followed family has a front on every node).
+  const double t_ref = flights.front().first;
+  auto wrap = [&](double r) {
+    r = std::fmod(r, tau);
+    return r < 0 ? r + tau : r;
+  };
+  // t_ref is a flight's start or 0, where a front may sit at an end (a release emits one): its
+  // phase, 0, counts too.
+  std::vector<double> phases{0.0, wrap(period)};
+  {
+    const CharacteristicState ref =
+        without_small_jumps(orbit.characteristic_state(t_ref), jump_tolerance, tau);
+    for (const auto* start : {&ref.a_start, &ref.b_start})
+      for (std::size_t i = 1; i < start->size(); ++i) {
+        phases.push_back((*start)[i]);
+        phases.push_back(wrap((*start)[i] + period));
+      }
+    std::sort(phases.begin(), phases.end());
   }
+  auto margin = [&](double t, double a, double b) {
+    double m = std::min({tau, t - a, b - t});
+    for (double e : events) m = std::min(m, std::abs(e - t));
+    const double r = wrap(t - t_ref);
+    auto it = std::lower_bound(phases.begin(), phases.end(), r);
+    const double above = it != phases.end() ? *it : phases.front() + tau;
+    const double below = it != phases.begin() ? *(it - 1) : phases.back() - tau;
+    return std::min({m, above - r, r - below});
+  };
+  std::vector<double> gaps;  // the middle of each gap between consecutive phases
+  for (std::size_t i = 0; i < phases.size(); ++i)
+    gaps.push_back(
+        wrap(0.5 * (phases[i] + (i + 1 < phases.size() ? phases[i + 1] : phases.front() + tau))));
+  double best_margin = -1, best_t = 0;
+  auto consider = [&](double t, double a, double b) {
+    if (!(t > a && t < b)) return;
+    const double m = margin(t, a, b);
+    if (m > best_margin) {
+      best_margin = m;
+      best_t = t;
+    }
+  };
+  constexpr int per_flight = 16;
+  for (const auto& [a, b] : flights) {
+    for (int j = 0; j < per_flight; ++j) consider(a + (b - a) * (j + 0.5) / per_flight, a, b);
+    for (double g : gaps)
+      for (double t = t_ref + g + std::floor((a - t_ref - g) / tau) * tau; t < b; t += tau)
+        consider(t, a, b);
+  }
+  if (!(best_margin > 0) || orbit.in_contact(Side::right, best_t)) return best;
+  best.t0 = best_t;
+  best.state = without_small_jumps(orbit.characteristic_state(best_t), jump_tolerance, tau);
   return best;
 }
 

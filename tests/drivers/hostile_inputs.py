@@ -195,6 +195,9 @@ c("impact_unknown_parameter", "trace", ["{I}", "--continuation_parameter", "mass
 c("impact_rtol_too_loose", "trace", ["{I}", "--rtol", "0.1"], "rtol")
 c("impact_contact_key", "trace", ["{I}", "--gap", "1e-3"], "gap")
 c("stability_not_a_bool", "trace", ["{I}", "--stability", "maybe"], "stability")
+c("stability_representation_typo", "trace",
+  ["{S}", "--branch", "mode1", "--stability", "true", "--stability_representation", "front"],
+  "stability_representation")
 c("floquet_tolerance_zero", "trace", ["{I}", "--floquet_tolerance", "0"], "floquet_tolerance")
 c("floquet_tolerance_huge", "trace", ["{D}", "--floquet_tolerance", "5"], "floquet_tolerance")
 c("floquet_trivial_tolerance_nan", "trace", ["{D}", "--floquet_trivial_tolerance", "nan"],

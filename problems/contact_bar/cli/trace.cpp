@@ -866,6 +866,7 @@ void add_front_report(cli::TraceSetup& s) {
                        "isometry_error", "return_error"});
     for (const auto& point : b.points) {
       const exact_bar::FrontMonodromy m = orbit_front_monodromy(*p, point.x);
+      if (!m.ok) fmt::print("  fronts.csv: point {} has no K: {}\n", point.index, m.message);
       const double nan = std::numeric_limits<double>::quiet_NaN();
       double excess = nan, det = nan, defect = nan;
       if (m.ok) {
