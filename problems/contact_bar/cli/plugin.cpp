@@ -26,7 +26,8 @@ namespace {
 // {out}/stability/<name>:
 //   - the fronts' multipliers (the default representation) of modes 1, 2 and 3 at 40, 80 and
 //     160 intervals and at 40 with the shooting's time step halved, of the subharmonic backbone
-//     and its continuum at 1e-3 J at 20 and 40, of the families attached to mode 1 at 70 and 140
+//     (20 to 160 intervals, and 20 with the time step halved) and its continuum at 1e-3 J (20 to
+//     80), of the families attached to mode 1 at 70 and 140
 //     intervals (T = 3.6, 3.5, 24/7, 3.2 and 22/7 L/c), and of the clearance modes 1 and 2;
 //   - the projected grid's (grid_<name>), modes 1 and 2 at 40 and 80, at 40 with c dt / dx
 //     halved and by the exact solver, and mode 2 at 160, for the comparison.
@@ -46,12 +47,14 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
     add(fmt::format("{}_N40_dt_half", mode), "paper.ini",
         {"--branch", mode, "--shooting_elements", "40", "--steps_per_period", "80"});
   }
-  for (const char* n : {"20", "40"}) {
+  for (const char* n : {"20", "40", "80", "160"})
     add(fmt::format("subharmonic_N{}", n), "paper.ini",
         {"--branch", "subharmonic", "--shooting_elements", n});
+  add("subharmonic_N20_dt_half", "paper.ini",
+      {"--branch", "subharmonic", "--shooting_elements", "20", "--steps_per_period", "80"});
+  for (const char* n : {"20", "40", "80"})
     add(fmt::format("subharmonic_continuum_N{}", n), "paper.ini",
         {"--branch", "subharmonic_continuum", "--energy", "1e-3", "--shooting_elements", n});
-  }
   // Every family the grid finds attached to mode 1 up to 3e-5 J, followed with its multipliers
   // (the steps of mode1_resonance_twelve: 0.05 of the amplitude); at 140 intervals 8 points of
   // each (the seven families' rank reports there take minutes per 30 points).
