@@ -54,9 +54,9 @@ CharacteristicState without_small_jumps(const CharacteristicState& state, double
                                         double tau);
 
 // The orbit's state in characteristic form (without_small_jumps) at a time t0 in [0, T) at
-// which its right end is free: of 16 evenly spaced times in each free flight, the one farthest
-// from a contact event and from a front at an end (t0 NaN if the end is closed throughout).
-// `orbit` is solved over at least [0, T].
+// which its right end is free, as far as the free flights allow from a contact event and from
+// a front at an end, at t0 and at t0 + T (where the tangent march reads it). t0 NaN if the end
+// is closed throughout. `orbit` is solved over at least [0, T].
 struct OrbitState {
   double t0 = 0;
   CharacteristicState state;
