@@ -1,11 +1,13 @@
 // The stability study of the bar's modes (problems/contact_bar/orbits/README.md, section
 // 'Stability'), from the traces with --stability true that the main job writes into
-// OUT/stability/<run>/ (plugin.cpp: mode 1 and mode 2 at two grids and a halved time step).
-//   stability_summary  stability/summary.csv: per run its branch, grid, c dt / dx, points and
-//                      the multipliers' worst and median distances from the circle and from +1,
-//                      the largest |mu| of a real negative and of a complex multiplier; and
-//                      stability/max_modulus.png: the largest non-trivial |mu| against energy,
-//                      one curve per run (convergence under refinement)
+// OUT/stability/<run>/ (plugin.cpp, stability_steps).
+//   stability_summary  stability/summary.csv: per run its branch, representation, grid, time
+//                      step, points, the multipliers' worst and median distances from the circle
+//                      and from +1, |det - 1|, the fronts' count, Jordan defects, structure and
+//                      return errors (fronts.csv), and a verdict; stability_backbones.png (the
+//                      fronts' runs coloured by Jordan defect), multipliers.png (the fronts'
+//                      multipliers against the projected grid's) and max_modulus.png (the
+//                      projected grid's largest non-trivial |mu| against energy)
 //   perturbation_growth  stability/perturbation_growth.csv: the closed-form orbits of modes 1
 //                      to 3 at 2, 20 and 200 times their grazing energy, perturbed at random by
 //                      1e-6 and simulated by the exact solver for 1000 periods
