@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "continuation/methods/pseudo_arclength.hpp"
 #include "continuation/outputs.hpp"
@@ -129,7 +130,7 @@ std::vector<FollowedBranch> follow_branch_points(
       // A start whose branch ends early, or at the family's boundary (a face of a family of
       // several dimensions, where another start may reach the budget), is retried from the next
       // fastest probe. The files hold the last attempt, or the first that ended at the
-      // boundary when every later one ended early (followed again: the same bits).
+      // boundary when every later one ended early (its points kept and written again).
       auto attempt_from = [&](int attempt) {
         BranchWriter writer(dir, periodic);
         ContinuationHooks h = hooks;
@@ -142,20 +143,23 @@ std::vector<FollowedBranch> follow_branch_points(
         return g;
       };
       const auto cancelled = [&] { return hooks.cancel_requested && hooks.cancel_requested(); };
-      int at_boundary = -1, attempts = 0;
+      std::optional<FollowedBranch> at_boundary;
+      int attempts = 0;
       for (int attempt = 0; attempt < std::max(1, run.start_attempts); ++attempt) {
         if (attempt > 0 && !attached_start(problem, report, run.observable, attempt)) break;
         f = attempt_from(attempt);
         attempts = attempt + 1;
         if (cancelled()) break;
         if (f.branch.reason == StopReason::boundary_reached) {
-          if (at_boundary < 0) at_boundary = attempt;
+          if (!at_boundary) at_boundary = f;
           continue;
         }
         if (!f.branch.ended_early()) break;
       }
-      if (f.branch.ended_early() && at_boundary >= 0 && !cancelled()) {
-        f = attempt_from(at_boundary);
+      if (f.branch.ended_early() && at_boundary && !cancelled()) {
+        BranchWriter writer(dir, periodic);
+        for (const BranchPoint& p : at_boundary->branch.points) writer.append(p);
+        f = std::move(*at_boundary);
         f.attempts = attempts;
       }
     }
