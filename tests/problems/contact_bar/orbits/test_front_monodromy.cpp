@@ -97,6 +97,29 @@ CharacteristicState moved(CharacteristicState s, const Eigen::VectorXd& shift,
   return s;
 }
 
+TEST(FrontMonodromy, JordanDefectCountsTheMissingEigenvectors) {
+  // Exact Jordan forms, conjugated by a fixed invertible matrix so that the blocks are not
+  // visible in the entries; the defect does not change under similarity.
+  Eigen::Matrix3d S;
+  S << 2, 1, 0, 1, 3, 1, 0, 1, 4;
+  auto conjugated = [&](const Eigen::Matrix3d& J) { return Eigen::MatrixXd(S * J * S.inverse()); };
+  Eigen::Matrix3d J;
+  J << -1, 1, 0, 0, -1, 0, 0, 0, 1;  // a block of size 2 at -1, a 1
+  EXPECT_EQ(contact_bar::jordan_defect(conjugated(J)), 1);
+  J << -1, 0, 0, 0, -1, 0, 0, 0, 1;  // -1 twice with two eigenvectors
+  EXPECT_EQ(contact_bar::jordan_defect(conjugated(J)), 0);
+  J << 1, 1, 0, 0, 1, 1, 0, 0, 1;  // one block of size 3
+  EXPECT_EQ(contact_bar::jordan_defect(conjugated(J)), 2);
+  J << 1, 1, 0, 0, 1, 0, 0, 0, 1;  // +1 three times, two eigenvectors
+  EXPECT_EQ(contact_bar::jordan_defect(conjugated(J)), 1);
+  // A block split by an error of 1e-10 in one entry (eigenvalues -1 +- 1e-5) is still one.
+  J << -1, 1, 0, 1e-10, -1, 0, 0, 0, 1;
+  EXPECT_EQ(contact_bar::jordan_defect(conjugated(J)), 1);
+  const double c = std::cos(1.0), s = std::sin(1.0);  // a rotation: distinct, on the circle
+  J << c, -s, 0, s, c, 0, 0, 0, 1;
+  EXPECT_EQ(contact_bar::jordan_defect(conjugated(J)), 0);
+}
+
 TEST(FrontMonodromy, TangentMatchesCentralDifferencesOfTheExactMap) {
   // The map is affine while the contact sequence stays the same, so central differences of the
   // plain march (no tangent code) are exact but for round-off: event times carry a few ulps of
