@@ -25,7 +25,8 @@ namespace {
 // The stability study (problems/contact_bar/orbits/README.md, section 'Stability'), into
 // {out}/stability/<name>:
 //   - the fronts' multipliers (the default representation) of modes 1, 2 and 3 at 40, 80 and
-//     160 intervals and at 40 with the shooting's time step halved, of the subharmonic backbone
+//     160 intervals, at 40 with the shooting's time step halved and with the orbits traced by
+//     the exact solver, of the subharmonic backbone
 //     (20 to 160 intervals, and 20 with the time step halved) and its continuum at 1e-3 J (20 to
 //     80), of the families attached to mode 1 at 70 and 140
 //     intervals (T = 3.6, 3.5, 24/7, 3.2 and 22/7 L/c), and of the clearance modes 1 and 2;
@@ -46,6 +47,8 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
           {"--branch", mode, "--shooting_elements", n});
     add(fmt::format("{}_N40_dt_half", mode), "paper.ini",
         {"--branch", mode, "--shooting_elements", "40", "--steps_per_period", "80"});
+    add(fmt::format("{}_N40_exact", mode), "paper.ini",
+        {"--branch", mode, "--shooting_elements", "40", "--shooting_solver", "exact"});
   }
   for (const char* n : {"20", "40", "80", "160"})
     add(fmt::format("subharmonic_N{}", n), "paper.ini",
