@@ -9,11 +9,21 @@
 
 namespace backbone::exact_bar {
 
-CharacteristicState without_small_jumps(const CharacteristicState& state, double tolerance,
-                                        double tau) {
+namespace {
+
+// The largest |value| of the state: the scale of its jumps.
+double value_scale(const CharacteristicState& state) {
   double scale = 0;
   for (const auto* v : {&state.a_value, &state.b_value})
     for (double y : *v) scale = std::max(scale, std::abs(y));
+  return scale;
+}
+
+}  // namespace
+
+CharacteristicState without_small_jumps(const CharacteristicState& state, double tolerance,
+                                        double tau) {
+  const double scale = value_scale(state);
   const double sliver = 1e-9 * tau;
   CharacteristicState out;
   for (bool of_a : {true, false}) {
@@ -128,9 +138,7 @@ FrontMonodromy front_monodromy(const bar::BarSetup& setup, const CharacteristicS
   const double tau = setup.material.length / setup.material.wave_speed();
   const int fronts = state.fronts(), pieces = state.pieces();
   const int fa = static_cast<int>(state.a_start.size()) - 1;
-  double scale = 0;
-  for (const auto* v : {&state.a_value, &state.b_value})
-    for (double y : *v) scale = std::max(scale, std::abs(y));
+  const double scale = value_scale(state);
   if (!(scale > 0)) {
     out.message = "the state is at rest with no strain";
     return out;

@@ -29,6 +29,13 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+double smallest(const std::vector<double>& v) {
+  double m = std::nan("");
+  for (double x : v)
+    if (!std::isnan(x) && !(x >= m)) m = x;
+  return m;
+}
+
 double largest(const std::vector<double>& v) {
   double m = std::nan("");
   for (double x : v)
@@ -61,10 +68,10 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
     if (!fs::exists(run / "fronts.csv")) continue;
     fs::path scene_dir;
     const std::string name = run_name(run, scene_dir);
-    if (name.find("_N") == std::string::npos || name.find("dt_half") != std::string::npos) continue;
-    if (name.find("_N40") == std::string::npos && name.find("_N20") == std::string::npos &&
-        name.find("_N70") == std::string::npos)
-      continue;
+    // One run per branch: the trace's own settings at 20, 40 or 70 intervals (and what it
+    // followed), not its refinements or its exact-solver twin.
+    const std::string trace = name.substr(0, name.find('/'));
+    if (!trace.ends_with("_N20") && !trace.ends_with("_N40") && !trace.ends_with("_N70")) continue;
     const std::string fronts = core::gnuplot_quote(run / "fronts.csv");
     const std::string branch = core::gnuplot_quote(run / "branch.csv");
     curves += fmt::format(
@@ -89,7 +96,8 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
       "set datafile separator ','\nset key noenhanced\nset grid\nset logscale x\nset format x "
       "'%.0e'\nset xrange [1e-7:2e-2]\nset xlabel 'energy [J]'\nset ylabel 'frequency "
       "[rad/s]'\nset key outside right\n"
-      "set title 'Fronts multipliers: all on the unit circle; colour: Jordan defect of K'\n" +
+      "set title 'Multipliers from the fronts: colour, the Jordan defect of K; circled, "
+      "unstable points'\n" +
           curves + "\n");
   if (!r.ok) fmt::print("[figures] stability_backbones.png skipped: {}\n", r.message);
 }
@@ -218,15 +226,9 @@ int write_stability_summary(const fs::path& out) {
            returned = nan;
     if (fs::exists(run / "fronts.csv")) {
       const core::Table f = core::Table::read_csv(run / "fronts.csv");
-      auto lowest = [](const std::vector<double>& v) {
-        double m = std::nan("");
-        for (double x : v)
-          if (!std::isnan(x) && !(x >= m)) m = x;
-        return m;
-      };
-      fronts_min = lowest(f.column("fronts"));
+      fronts_min = smallest(f.column("fronts"));
       fronts_max = largest(f.column("fronts"));
-      defect_min = lowest(f.column("jordan_defect"));
+      defect_min = smallest(f.column("jordan_defect"));
       defect_max = largest(f.column("jordan_defect"));
       structure = std::max({largest(f.column("time_shift_error")), largest(f.column("value_leak")),
                             largest(f.column("isometry_error"))});

@@ -33,7 +33,8 @@ exact_bar::FrontMonodromy orbit_front_monodromy(const ContactBarOrbitProblem& pr
   exact_bar::FrontMonodromy out;
   const double period = problem.period(x);
   try {
-    const exact_bar::ExactBarSolution orbit(problem.setup_at(x), period);
+    const bar::BarSetup setup = problem.setup_at(x);
+    const exact_bar::ExactBarSolution orbit(setup, period);
     if (!orbit.ok()) {
       out.message = orbit.message();
       return out;
@@ -43,7 +44,7 @@ exact_bar::FrontMonodromy orbit_front_monodromy(const ContactBarOrbitProblem& pr
       out.message = "the end is on a wall at every sampled time";
       return out;
     }
-    return exact_bar::front_monodromy(problem.setup_at(x), start.state, period);
+    return exact_bar::front_monodromy(setup, start.state, period);
   } catch (const core::InputError& e) {
     out.message = e.what();
     return out;
