@@ -51,7 +51,9 @@ TEST(ClearanceCli, ModesOneAndTwoHoldOneWallThenBoth) {
       if (std::abs(energy[i] / back_grazing - 1) < 1e-8) continue;
       const bool above = energy[i] > back_grazing;
       EXPECT_EQ(back[i], above ? 1 : 0) << mode << " point " << i << " E " << energy[i];
-      if (!above) EXPECT_LT(one_sided[i], 1e-10) << "one-sided mode recovered, point " << i;
+      if (!above) {
+        EXPECT_LT(one_sided[i], 1e-10) << "one-sided mode recovered, point " << i;
+      }
       (above ? both : one) += 1;
     }
     EXPECT_GE(one, 3) << "points below the back wall's grazing";
