@@ -48,6 +48,13 @@ double Material::travel_time() const {
 }
 
 PiecewiseLinear::PiecewiseLinear(std::vector<double> x, std::vector<double> y)
+    : PiecewiseLinear(std::move(x), std::move(y), false) {}
+
+PiecewiseLinear PiecewiseLinear::with_jumps(std::vector<double> x, std::vector<double> y) {
+  return {std::move(x), std::move(y), true};
+}
+
+PiecewiseLinear::PiecewiseLinear(std::vector<double> x, std::vector<double> y, bool jumps)
     : x_(std::move(x)), y_(std::move(y)) {
   if (x_.empty() || x_.size() != y_.size())
     throw InputError("knots", fmt::format("need as many values as knots, at least one ({} vs {})",
@@ -55,9 +62,13 @@ PiecewiseLinear::PiecewiseLinear(std::vector<double> x, std::vector<double> y)
   for (std::size_t i = 0; i < x_.size(); ++i) {
     if (!std::isfinite(x_[i]) || !std::isfinite(y_[i]))
       throw InputError("knots", fmt::format("knot {} is not finite ({}, {})", i, x_[i], y_[i]));
-    if (i > 0 && !(x_[i] > x_[i - 1]))
-      throw InputError("knots",
-                       fmt::format("knots must increase strictly ({} after {})", x_[i], x_[i - 1]));
+    // A jump sits between interior knots: neither end's value is ambiguous.
+    const bool jump =
+        jumps && i >= 2 && i + 1 < x_.size() && x_[i] == x_[i - 1] && x_[i - 1] != x_[i - 2];
+    has_jumps_ = has_jumps_ || jump;
+    if (i > 0 && !(x_[i] > x_[i - 1]) && !jump)
+      throw InputError("knots", fmt::format("knots must increase strictly ({} after {}){}", x_[i],
+                                            x_[i - 1], jumps ? ", or once by a jump" : ""));
   }
   // Near uniform: every knot within a quarter spacing of its grid point, so that the guessed
   // index is at most one off and the corrective walk is a step or two.
@@ -107,6 +118,7 @@ double PiecewiseLinear::slope(double x, int side) const {
 double PiecewiseLinear::integral(double a, double b) const {
   if (a == b) return 0;
   if (a > b) return -integral(b, a);
+  if (has_jumps_) return integral_with_jumps(a, b);
   // Points where the integrand changes form: a, the knots inside (a, b), b.
   double total = 0;
   double left = a;
@@ -118,6 +130,33 @@ double PiecewiseLinear::integral(double a, double b) const {
     left = k;
   }
   piece(left, b);
+  return total;
+}
+
+// Segment by segment from the knots' own values: at a jump operator() gives the right limit,
+// and the segment that ends there needs the left one.
+double PiecewiseLinear::integral_with_jumps(double a, double b) const {
+  double total = 0;
+  if (a < x_.front()) {
+    const double e = std::min(b, x_.front());
+    total += y_.front() * (e - a);
+    a = e;
+  }
+  if (b > x_.back()) {
+    const double s = std::max(a, x_.back());
+    total += y_.back() * (b - s);
+    b = s;
+  }
+  for (std::size_t i = std::max<std::size_t>(first_knot_above(a, false), 1);
+       i < x_.size() && x_[i - 1] < b; ++i) {
+    const double x0 = x_[i - 1], x1 = x_[i];
+    if (!(x1 > x0)) continue;
+    const double l = std::max(a, x0), r = std::min(b, x1);
+    const auto at = [&](double x) {
+      return y_[i - 1] + (y_[i] - y_[i - 1]) * (x - x0) / (x1 - x0);
+    };
+    if (r > l) total += 0.5 * (at(l) + at(r)) * (r - l);
+  }
   return total;
 }
 

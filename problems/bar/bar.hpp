@@ -61,6 +61,11 @@ class PiecewiseLinear {
  public:
   PiecewiseLinear() : x_{0.0}, y_{0.0} {}
   PiecewiseLinear(std::vector<double> x, std::vector<double> y);  // throws InputError
+  // The same with jumps: two consecutive interior knots may share an x (never three), the left
+  // limit then the right one. The function takes the right limit there, slope() the one-sided
+  // slopes; integral() stays exact.
+  // A velocity in characteristic form has them (exact_bar, 'Fronts').
+  static PiecewiseLinear with_jumps(std::vector<double> x, std::vector<double> y);
   static PiecewiseLinear zero(double length) { return {{0.0, length}, {0.0, 0.0}}; }
   double operator()(double x) const;
   double slope(double x, int side) const;     // side -1: left derivative, +1: right derivative
@@ -69,10 +74,14 @@ class PiecewiseLinear {
   const std::vector<double>& values() const { return y_; }
 
  private:
+  PiecewiseLinear(std::vector<double> x, std::vector<double> y, bool jumps);
   // Index of the first knot > x (or_equal: >= x), as std::upper_bound (std::lower_bound).
   std::size_t first_knot_above(double x, bool or_equal) const;
 
+  double integral_with_jumps(double a, double b) const;
+
   std::vector<double> x_, y_;
+  bool has_jumps_ = false;
   double inverse_spacing_ = 0;  // (knots - 1) / (x_back - x_front) when near uniform, else 0
 };
 

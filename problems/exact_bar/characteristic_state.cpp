@@ -38,6 +38,37 @@ void check_signal(const char* key, const std::vector<double>& start,
 
 }  // namespace
 
+bar::BarSetup with_characteristic_state(bar::BarSetup setup, const CharacteristicState& state) {
+  const double length = setup.material.length, c = setup.material.wave_speed();
+  const double tau = length / c;
+  check_signal("a_signal", state.a_start, state.a_value, tau);
+  check_signal("b_signal", state.b_start, state.b_value, tau);
+  // R+(x) = A((L - x) / c), R-(x) = B(x / c): breakpoints at L - c r (A) and c r (B).
+  std::vector<double> cuts{0.0, length};
+  for (std::size_t i = 1; i < state.a_start.size(); ++i)
+    cuts.push_back(length - c * state.a_start[i]);
+  for (std::size_t i = 1; i < state.b_start.size(); ++i) cuts.push_back(c * state.b_start[i]);
+  std::sort(cuts.begin(), cuts.end());
+  cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+  auto value_at = [](const std::vector<double>& start, const std::vector<double>& value, double r) {
+    const auto it = std::upper_bound(start.begin(), start.end(), r);
+    return value[static_cast<std::size_t>(it - start.begin()) - 1];
+  };
+  std::vector<double> ux{0.0}, u{0.0}, vx, v;
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const double mid = 0.5 * (cuts[i] + cuts[i + 1]);
+    const double plus = value_at(state.a_start, state.a_value, (length - mid) / c);
+    const double minus = value_at(state.b_start, state.b_value, mid / c);
+    ux.push_back(cuts[i + 1]);
+    u.push_back(u.back() + (minus - plus) / (2 * c) * (cuts[i + 1] - cuts[i]));
+    vx.insert(vx.end(), {cuts[i], cuts[i + 1]});
+    v.insert(v.end(), 2, 0.5 * (plus + minus));
+  }
+  setup.u0 = bar::PiecewiseLinear(std::move(ux), std::move(u));
+  setup.v0 = bar::PiecewiseLinear::with_jumps(std::move(vx), std::move(v));
+  return setup;
+}
+
 ExactBarSolution::ExactBarSolution(const bar::BarSetup& setup, double t_end,
                                    CharacteristicState initial, bool tangent)
     : setup_(setup), t_end_(t_end), initial_(std::move(initial)) {

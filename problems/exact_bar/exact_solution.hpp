@@ -80,6 +80,12 @@ struct ContactInterval {
   bool back_wall = false;  // on the wall behind a clearance end
 };
 
+// The same state as initial data of any bar solver: `setup` with u0 continuous and piecewise
+// linear (u_x = (R- - R+) / (2 c) integrated from u(0) = 0) and v0 = (R+ + R-) / 2 piecewise
+// constant, its jumps on the fronts (bar::PiecewiseLinear::with_jumps). InputError "a_signal",
+// "b_signal" as the constructor below.
+bar::BarSetup with_characteristic_state(bar::BarSetup setup, const CharacteristicState& state);
+
 class ExactBarSolution {
  public:
   // Solves on [0, t_end]. Throws core::InputError for a bad setup or t_end (key "t_end").

@@ -198,6 +198,9 @@ c("stability_not_a_bool", "trace", ["{I}", "--stability", "maybe"], "stability")
 c("stability_representation_typo", "trace",
   ["{S}", "--branch", "mode1", "--stability", "true", "--stability_representation", "front"],
   "stability_representation")
+c("stability_tdbem_check_on_exact_solver", "trace",
+  ["{S}", "--branch", "mode1", "--stability", "true", "--stability_tdbem_check", "true",
+   "--shooting_solver", "exact"], "stability_tdbem_check")
 c("floquet_tolerance_zero", "trace", ["{I}", "--floquet_tolerance", "0"], "floquet_tolerance")
 c("floquet_tolerance_huge", "trace", ["{D}", "--floquet_tolerance", "5"], "floquet_tolerance")
 c("floquet_trivial_tolerance_nan", "trace", ["{D}", "--floquet_trivial_tolerance", "nan"],

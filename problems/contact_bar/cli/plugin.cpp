@@ -24,7 +24,8 @@ namespace {
 
 // The stability study (problems/contact_bar/orbits/README.md, section 'Stability'), into
 // {out}/stability/<name>:
-//   - the fronts' multipliers (the default representation) of modes 1, 2 and 3 at 40, 80 and
+//   - the fronts' multipliers (the default representation; K also by the TD-BEM's own march
+//     where the TD-BEM traces the orbits) of modes 1, 2 and 3 at 40, 80 and
 //     160 intervals, at 40 with the shooting's time step halved and with the orbits traced by
 //     the exact solver, of the subharmonic backbone
 //     (20 to 160 intervals, and 20 with the time step halved) and its continuum at 1e-3 J (20 to
@@ -34,8 +35,13 @@ namespace {
 //     halved and by the exact solver, and mode 2 at 160, for the comparison.
 std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
   std::vector<cli::ReproduceStep> steps;
+  // Every run of the fronts traced by the TD-BEM also computes K by the TD-BEM's own march.
   auto add = [&](const std::string& name, const std::string& scene, std::vector<std::string> args) {
+    const bool tdbem_fronts = std::find(args.begin(), args.end(), "grid") == args.end() &&
+                              std::find(args.begin(), args.end(), "exact") == args.end();
     args.insert(args.begin(), scenes + scene);
+    if (tdbem_fronts)
+      for (const char* word : {"--stability_tdbem_check", "true"}) args.push_back(word);
     for (const char* word : {"--stability", "true", "--threads", "2", "--out"})
       args.push_back(word);
     args.push_back("{out}/stability/" + name);

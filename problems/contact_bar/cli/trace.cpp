@@ -192,6 +192,11 @@ po::options_description trace_keys() {
        "simulation per point (fronts.csv beside the branch: K's checks and Jordan defect); "
        "grid: the projected full state (u, v) on a grid of stability_elements, by differences "
        "(problems/contact_bar/orbits/README.md, 'Stability')")  //
+      ("stability_tdbem_check", po::value<bool>()->default_value(false),
+       "with stability_representation fronts: K also by central differences of the TD-BEM's "
+       "own march (shooting_solver tdbem, contact event), two simulations of a period per front "
+       "and point; fronts.csv gains tdbem_ok, tdbem_k_difference (largest |K_tdbem - K|) and "
+       "tdbem_multiplier_difference (problems/contact_bar/orbits/README.md, 'Stability')")  //
       ("floquet_tolerance", po::value<double>()->default_value(1e-4),
        "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1). 1e-4 for the fronts: a "
        "Jordan block of size 2 (modes J >= 2) turns K's error e, the traced orbit's 1e-10, "
@@ -854,16 +859,21 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
 // With the fronts representation, fronts.csv beside the branch: per point the isolated
 // multipliers' matrix K's checks and its Jordan defect (monodromy.hpp; README.md of orbits/,
 // 'Stability').
-void add_front_report(cli::TraceSetup& s) {
+void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
   const auto* p = dynamic_cast<const ContactBarOrbitProblem*>(s.problem.get());
   if (!p || p->monodromy_options().representation != MonodromyOptions::Representation::fronts)
     return;
-  s.write_extra_outputs = [p, inner = std::move(s.write_extra_outputs)](
+  s.write_extra_outputs = [p, tdbem_check, inner = std::move(s.write_extra_outputs)](
                               const std::filesystem::path& out, const continuation::Branch& b) {
     if (inner) inner(out, b);
-    core::Table table({"point", "energy", "period", "ok", "fronts", "max_modulus_minus_one",
-                       "determinant", "jordan_defect", "time_shift_error", "value_leak",
-                       "isometry_error", "return_error"});
+    std::vector<std::string> columns{"point",       "energy",         "period",
+                                     "ok",          "fronts",         "max_modulus_minus_one",
+                                     "determinant", "jordan_defect",  "time_shift_error",
+                                     "value_leak",  "isometry_error", "return_error"};
+    if (tdbem_check)
+      columns.insert(columns.end(),
+                     {"tdbem_ok", "tdbem_k_difference", "tdbem_multiplier_difference"});
+    core::Table table(columns);
     for (const auto& point : b.points) {
       const exact_bar::FrontMonodromy m = orbit_front_monodromy(*p, point.x);
       if (!m.ok) fmt::print("  fronts.csv: point {} has no K: {}\n", point.index, m.message);
@@ -876,18 +886,43 @@ void add_front_report(cli::TraceSetup& s) {
         det = m.K.determinant();
         defect = jordan_defect(m.K);
       }
-      table.add_row({static_cast<double>(point.index), point.observable("energy"),
-                     p->period(point.x), m.ok ? 1.0 : 0.0, static_cast<double>(m.K.rows()), excess,
-                     det, defect, m.ok ? m.time_shift_error : nan, m.ok ? m.value_leak : nan,
-                     m.ok ? m.isometry_error : nan, m.ok ? m.return_error : nan});
+      std::vector<double> row{static_cast<double>(point.index),
+                              point.observable("energy"),
+                              p->period(point.x),
+                              m.ok ? 1.0 : 0.0,
+                              static_cast<double>(m.K.rows()),
+                              excess,
+                              det,
+                              defect,
+                              m.ok ? m.time_shift_error : nan,
+                              m.ok ? m.value_leak : nan,
+                              m.ok ? m.isometry_error : nan,
+                              m.ok ? m.return_error : nan};
+      if (tdbem_check) {
+        const TdbemFronts t = orbit_tdbem_front_monodromy(*p, point.x);
+        const bool both = m.ok && t.ok && t.K.rows() == m.K.rows();
+        if (!t.ok)
+          fmt::print("  fronts.csv: point {} has no TD-BEM K: {}\n", point.index, t.message);
+        row.insert(row.end(), {t.ok ? 1.0 : 0.0, both ? (t.K - m.K).cwiseAbs().maxCoeff() : nan,
+                               both ? multiplier_distance(t.K, m.K) : nan});
+      }
+      table.add_row(row);
     }
     table.write_csv(out / "fronts.csv");
   };
 }
 
 cli::TraceSetup setup_trace_with_reports(const core::Scene& scene, const std::string& branch) {
+  const bool tdbem_check = scene.flag("stability_tdbem_check");
+  if (tdbem_check &&
+      (!scene.flag("stability") || scene.text("stability_representation") != "fronts" ||
+       scene.text("shooting_solver") != "tdbem" ||
+       contact_method_from_scene(scene) != ContactMethod::event))
+    throw core::InputError("stability_tdbem_check",
+                           "needs stability true, stability_representation fronts, "
+                           "shooting_solver tdbem and contact event");
   cli::TraceSetup s = setup_trace(scene, branch);
-  if (scene.flag("stability")) add_front_report(s);
+  if (scene.flag("stability")) add_front_report(s, tdbem_check);
   return s;
 }
 

@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <random>
 #include <vector>
 
 #include "core/errors.hpp"
 #include "core/job_queue.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
+#include "problems/contact_bar/solver/tdbem.hpp"
 #include "problems/exact_bar/exact_solution.hpp"
 
 namespace backbone::contact_bar {
@@ -28,23 +30,53 @@ MonodromyOptions::Representation parse_representation(const std::string& key,
   throw core::InputError(key, fmt::format("must be fronts or grid (got '{}')", value));
 }
 
+namespace {
+
+// The orbit x simulated by the exact solver and its state at a time of free flight
+// (exact_bar::free_flight_state); t0 NaN with the reason in `why`.
+exact_bar::OrbitState orbit_free_flight_state(const bar::BarSetup& setup, double period,
+                                              std::string& why) {
+  const exact_bar::ExactBarSolution orbit(setup, period);
+  if (!orbit.ok()) {
+    why = orbit.message();
+    return {std::numeric_limits<double>::quiet_NaN(), {}};
+  }
+  exact_bar::OrbitState start = exact_bar::free_flight_state(orbit, period);
+  if (std::isnan(start.t0)) why = "the end is on a wall at every sampled time";
+  return start;
+}
+
+}  // namespace
+
 exact_bar::FrontMonodromy orbit_front_monodromy(const ContactBarOrbitProblem& problem,
                                                 const core::Vector& x) {
   exact_bar::FrontMonodromy out;
   const double period = problem.period(x);
   try {
     const bar::BarSetup setup = problem.setup_at(x);
-    const exact_bar::ExactBarSolution orbit(setup, period);
-    if (!orbit.ok()) {
-      out.message = orbit.message();
-      return out;
-    }
-    const exact_bar::OrbitState start = exact_bar::free_flight_state(orbit, period);
-    if (std::isnan(start.t0)) {
-      out.message = "the end is on a wall at every sampled time";
-      return out;
-    }
+    const exact_bar::OrbitState start = orbit_free_flight_state(setup, period, out.message);
+    if (std::isnan(start.t0)) return out;
     return exact_bar::front_monodromy(setup, start.state, period);
+  } catch (const core::InputError& e) {
+    out.message = e.what();
+    return out;
+  }
+}
+
+TdbemFronts orbit_tdbem_front_monodromy(const ContactBarOrbitProblem& problem,
+                                        const core::Vector& x) {
+  TdbemFronts out;
+  const auto* tdbem = dynamic_cast<const TdbemSolver*>(&problem.solver());
+  if (!tdbem || tdbem->method() != ContactMethod::event) {
+    out.message = "the problem's solver is not the TD-BEM's event march";
+    return out;
+  }
+  const double period = problem.period(x);
+  try {
+    const bar::BarSetup setup = problem.setup_at(x);
+    const exact_bar::OrbitState start = orbit_free_flight_state(setup, period, out.message);
+    if (std::isnan(start.t0)) return out;
+    return tdbem_front_monodromy(setup, start.t0, period, problem.time_step(period));
   } catch (const core::InputError& e) {
     out.message = e.what();
     return out;

@@ -35,6 +35,7 @@
 #include "core/problem.hpp"
 #include "core/types.hpp"
 #include "problems/bar/bar.hpp"
+#include "problems/contact_bar/orbits/tdbem_fronts.hpp"
 #include "problems/exact_bar/front_monodromy.hpp"
 
 namespace backbone::contact_bar {
@@ -89,6 +90,12 @@ core::EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, con
 // reason) when the orbit's fronts do not come back.
 exact_bar::FrontMonodromy orbit_front_monodromy(const ContactBarOrbitProblem& problem,
                                                 const core::Vector& x);
+
+// K of the orbit x by the TD-BEM's own march (tdbem_fronts.hpp) at the problem's time step,
+// from the same t0 as orbit_front_monodromy, so that the two K share their fronts' order. Not ok
+// unless the problem's solver is the TD-BEM's event march.
+TdbemFronts orbit_tdbem_front_monodromy(const ContactBarOrbitProblem& problem,
+                                        const core::Vector& x);
 
 // Per cluster of eigenvalues of K within 1e-4 |K| of each other, its size less its
 // eigenvectors (singular values of K - mu I under 1e-8 |K|, mu the cluster's mean), summed: a

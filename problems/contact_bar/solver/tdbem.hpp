@@ -66,6 +66,7 @@ class TdbemMarch {
   bool advance_to(double t);
   double time() const { return t_; }
   bool ok() const { return ok_; }
+  const bar::BarSetup& setup() const { return setup_; }
 
   double end_displacement(bool right) const;  // U_e at the current time [m]
   double end_force(bool right) const;  // compressive end force -EA u_x over the last sub-step [N]
@@ -84,6 +85,10 @@ class TdbemMarch {
   std::vector<double> projected_velocity(const std::vector<double>& nodes) const;
   // 1/2 int (rho A v^2 + EA u_x^2) dx - int body_force A u dx, integrated exactly.
   double energy() const;
+  // Where the field may change form at the current time, increasing from 0 to L: the data's
+  // knots carried along both characteristics and the ends' history knots. Between two of them
+  // u, v and u_x are polynomials (v and u_x linear).
+  std::vector<double> breakpoints() const { return breakpoints(std::vector<double>{0.0, L_}); }
   std::size_t stored_knots() const;  // history window size (both ends)
 
  private:

@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "problems/bar/bar.hpp"
 
 namespace backbone::bar {
@@ -119,6 +120,40 @@ TEST(PiecewiseLinear, IntegralMatchesTrapezoidsOverTheScannedPieces) {
       EXPECT_NEAR(f.integral(a, b), expected, 1e-15 * scale) << a << " " << b;
     }
   }
+}
+
+// A velocity in characteristic form is piecewise constant: with_jumps holds it. The values are
+// the right limits at a jump and the integral is that of the step function, both by hand.
+TEST(PiecewiseLinear, WithJumpsHoldsAStepFunction) {
+  const PiecewiseLinear f =
+      PiecewiseLinear::with_jumps({0.0, 0.3, 0.3, 1.0}, {2.0, 2.0, -1.0, -1.0});
+  EXPECT_EQ(f(0.1), 2.0);
+  EXPECT_EQ(f(0.3), -1.0);  // the right limit
+  EXPECT_EQ(f(0.7), -1.0);
+  EXPECT_EQ(f.slope(0.3, -1), 0.0);
+  EXPECT_EQ(f.slope(0.3, +1), 0.0);
+  // 2 * 0.3 - 1 * 0.7 = -0.1, and pieces of it; round-off of a few products.
+  EXPECT_NEAR(f.integral(0.0, 1.0), -0.1, 1e-15);
+  EXPECT_NEAR(f.integral(0.2, 0.5), 2 * 0.1 - 0.2, 1e-15);
+  EXPECT_NEAR(f.integral(0.5, 0.2), -(2 * 0.1 - 0.2), 1e-15);
+  EXPECT_NEAR(f.integral(-1.0, 2.0), 2 * 1.3 - 1.7, 1e-15);  // constant beyond the ends
+  EXPECT_NEAR(f.integral(0.3, 0.3), 0.0, 0.0);
+  // Ramps around a jump: the slopes on either side.
+  const PiecewiseLinear g = PiecewiseLinear::with_jumps({0.0, 0.5, 0.5, 1.0}, {0.0, 1.0, 3.0, 2.0});
+  EXPECT_DOUBLE_EQ(g(0.25), 0.5);
+  EXPECT_DOUBLE_EQ(g(0.75), 2.5);
+  EXPECT_DOUBLE_EQ(g.slope(0.5, -1), 2.0);
+  EXPECT_DOUBLE_EQ(g.slope(0.5, +1), -2.0);
+  EXPECT_NEAR(g.integral(0.0, 1.0), 0.25 + 1.25, 1e-15);
+}
+
+TEST(PiecewiseLinear, JumpsOnlyWhereAsked) {
+  EXPECT_THROW(PiecewiseLinear({0.0, 0.5, 0.5, 1.0}, {0.0, 1.0, 2.0, 0.0}), core::InputError);
+  // Never three knots at one x, never a jump at an end.
+  EXPECT_THROW(PiecewiseLinear::with_jumps({0.0, 0.5, 0.5, 0.5, 1.0}, {0, 1, 2, 3, 0}),
+               core::InputError);
+  EXPECT_THROW(PiecewiseLinear::with_jumps({0.0, 0.0, 1.0}, {0, 1, 0}), core::InputError);
+  EXPECT_THROW(PiecewiseLinear::with_jumps({0.0, 1.0, 1.0}, {0, 1, 0}), core::InputError);
 }
 
 }  // namespace

@@ -1,0 +1,224 @@
+#include "problems/contact_bar/orbits/tdbem_fronts.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "problems/exact_bar/front_monodromy.hpp"
+
+namespace backbone::contact_bar {
+
+namespace {
+
+constexpr double epsilon = std::numeric_limits<double>::epsilon();
+
+// The jump-weighted position of the breakpoints of `s` near each front of `base` (within
+// `window`), the fronts in base's order: to first order a front that comes back as a few
+// breakpoints acts as one at that position (as in exact_bar::front_monodromy); a sliver's
+// value, inexact, moves that position by its error times the sliver's length only. Empty, with
+// the reason, when jumps over `jump` (summed over breakpoints within `sliver` of each other)
+// have no front of base near them or a front of base gets back less than half its jump.
+Eigen::VectorXd front_positions(const exact_bar::CharacteristicState& base,
+                                const exact_bar::CharacteristicState& s, double window,
+                                double jump, double sliver, std::string& why) {
+  const int fa = static_cast<int>(base.a_start.size()) - 1;
+  Eigen::VectorXd total = Eigen::VectorXd::Zero(base.fronts());
+  Eigen::VectorXd moment = Eigen::VectorXd::Zero(base.fronts());
+  // Breakpoints with no front of base near them: a run of them within `sliver` of each other
+  // counts by its summed jump (a sliver's two jumps cancel but for its value's round-off).
+  double stray = 0, stray_at = -1;
+  auto stray_ok = [&] {
+    if (!(std::abs(stray) > jump)) return true;
+    why = fmt::format("a front at r = {} (a jump of {} of the largest value) has none within {} "
+                      "at t0 to match",
+                      stray_at, std::abs(stray) / jump * exact_bar::default_jump_tolerance, window);
+    return false;
+  };
+  for (bool of_a : {true, false}) {
+    const auto& start0 = of_a ? base.a_start : base.b_start;
+    const auto& start = of_a ? s.a_start : s.b_start;
+    const auto& value = of_a ? s.a_value : s.b_value;
+    stray = 0;
+    stray_at = -1;
+    for (std::size_t k = 1; k < start.size(); ++k) {
+      const double step = value[k] - value[k - 1];
+      const auto it = std::min_element(start0.begin() + 1, start0.end(), [&](double a, double b) {
+        return std::abs(a - start[k]) < std::abs(b - start[k]);
+      });
+      if (it != start0.end() && std::abs(*it - start[k]) <= window) {
+        const int i = static_cast<int>(it - start0.begin()) - 1 + (of_a ? 0 : fa);
+        total[i] += step;
+        moment[i] += step * start[k];
+        continue;
+      }
+      if (!(stray_at >= 0 && start[k] - stray_at <= sliver)) {
+        if (!stray_ok()) return {};
+        stray = 0;
+      }
+      stray += step;
+      stray_at = start[k];
+    }
+    if (!stray_ok()) return {};
+  }
+  Eigen::VectorXd position(base.fronts());
+  for (int i = 0; i < base.fronts(); ++i) {
+    const bool of_a = i < fa;
+    const auto k = static_cast<std::size_t>(of_a ? i + 1 : i - fa + 1);
+    const auto& value0 = of_a ? base.a_value : base.b_value;
+    const double jump0 = value0[k] - value0[k - 1];
+    if (!(std::abs(total[i] - jump0) <= 0.5 * std::abs(jump0))) {
+      why = fmt::format("front {} (r = {}) does not come back", i,
+                        of_a ? base.a_start[k] : base.b_start[k]);
+      return {};
+    }
+    position[i] = moment[i] / total[i];
+  }
+  return position;
+}
+
+}  // namespace
+
+exact_bar::CharacteristicState tdbem_characteristic_state(const TdbemMarch& march) {
+  const bar::BarSetup& setup = march.setup();
+  const double length = setup.material.length, c = setup.material.wave_speed();
+  const std::vector<double> cuts = march.breakpoints();
+  struct Piece {
+    double x0, x1, plus, minus, spread;  // spread: R+- at the quarter points, largest difference
+  };
+  std::vector<Piece> pieces;
+  auto riemann = [&](double x, double& plus, double& minus) {
+    const double v = march.velocity(x), cux = c * march.strain(x);
+    plus = v - cux;
+    minus = v + cux;
+  };
+  double scale = 0;
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const double a = cuts[i], b = cuts[i + 1];
+    if (!(b - a > 1e-12 * length)) continue;
+    Piece p{a, b, 0, 0, 0};
+    riemann(0.5 * (a + b), p.plus, p.minus);
+    double plus1, minus1, plus3, minus3;
+    riemann(0.75 * a + 0.25 * b, plus1, minus1);
+    riemann(0.25 * a + 0.75 * b, plus3, minus3);
+    // A sliver's value is formed from knots that close in time, with round-off over its length:
+    // only longer pieces are checked.
+    if (b - a > 1e-9 * length)
+      p.spread = std::max(std::abs(plus1 - plus3), std::abs(minus1 - minus3));
+    scale = std::max({scale, std::abs(p.plus), std::abs(p.minus)});
+    pieces.push_back(p);
+  }
+  for (const Piece& p : pieces)
+    if (p.spread > 1e-9 * scale)
+      throw core::InputError("tdbem_fronts",
+                             fmt::format("the field is not piecewise constant in R+- on [{}, {}] "
+                                         "(a state with body force or a smooth v0)",
+                                         p.x0, p.x1));
+  if (pieces.empty()) throw core::InputError("tdbem_fronts", "the field has no piece");
+  exact_bar::CharacteristicState s;
+  auto push = [&](std::vector<double>& start, std::vector<double>& value, double r, double y) {
+    if (!value.empty() &&
+        std::abs(value.back() - y) <= 8 * epsilon * (std::abs(value.back()) + std::abs(y)))
+      return;
+    start.push_back(value.empty() ? 0.0 : r);
+    value.push_back(y);
+  };
+  // A(r) = R+ at x = L - c r: pieces from the right end; B(r) = R- at x = c r: from the left.
+  for (auto p = pieces.rbegin(); p != pieces.rend(); ++p)
+    push(s.a_start, s.a_value, (length - p->x1) / c, p->plus);
+  for (const Piece& p : pieces) push(s.b_start, s.b_value, p.x0 / c, p.minus);
+  return s;
+}
+
+TdbemFronts tdbem_front_monodromy(const bar::BarSetup& setup, double t0, double period, double dt,
+                                  double relative_step) {
+  TdbemFronts out;
+  try {
+    const double tau = setup.material.travel_time();
+    TdbemMarch orbit(setup, dt, ContactMethod::event);
+    if (!orbit.advance_to(t0)) {
+      out.message = "the TD-BEM march to t0 failed";
+      return out;
+    }
+    if (orbit.in_contact(true) || orbit.in_contact(false)) {
+      out.message = fmt::format("an end is on a wall at t0 = {}", t0);
+      return out;
+    }
+    out.state = exact_bar::without_small_jumps(tdbem_characteristic_state(orbit),
+                                               exact_bar::default_jump_tolerance, tau);
+    const exact_bar::CharacteristicState& base = out.state;
+    const int fronts = base.fronts(), fa = static_cast<int>(base.a_start.size()) - 1;
+    double scale = 0, spacing = tau;
+    for (bool of_a : {true, false}) {
+      const auto& start = of_a ? base.a_start : base.b_start;
+      for (double y : of_a ? base.a_value : base.b_value) scale = std::max(scale, std::abs(y));
+      for (std::size_t i = 1; i <= start.size(); ++i)
+        spacing = std::min(spacing, (i < start.size() ? start[i] : tau) - start[i - 1]);
+    }
+    const double h = relative_step * tau;
+    const double window = std::min(1e-4 * tau, 0.25 * spacing);
+    if (!(h < 0.1 * window)) {
+      out.message = fmt::format("the fronts at t0 are {} tau apart: too close for a step of {} tau",
+                                spacing / tau, relative_step);
+      return out;
+    }
+    const double jump = exact_bar::default_jump_tolerance * scale;
+    std::string why;
+    auto fronts_at_t = [&](const exact_bar::CharacteristicState& s) {
+      TdbemMarch m(exact_bar::with_characteristic_state(setup, s), dt, ContactMethod::event);
+      if (!m.advance_to(period)) {
+        why = "the TD-BEM march over a period failed";
+        return Eigen::VectorXd{};
+      }
+      return front_positions(base, tdbem_characteristic_state(m), window, jump, 1e-9 * tau, why);
+    };
+    if (fronts_at_t(base).size() != fronts) {
+      out.message = "the orbit's fronts do not come back: " + why;
+      return out;
+    }
+    out.K.resize(fronts, fronts);
+    for (int i = 0; i < fronts; ++i) {
+      Eigen::VectorXd moved[2];
+      for (int side = 0; side < 2; ++side) {
+        exact_bar::CharacteristicState s = base;
+        auto& start = i < fa ? s.a_start : s.b_start;
+        start[static_cast<std::size_t>(i < fa ? i + 1 : i - fa + 1)] += side == 0 ? h : -h;
+        moved[side] = fronts_at_t(s);
+        if (moved[side].size() != fronts) {
+          out.message = fmt::format("front {} moved by {}h: {}", i, side == 0 ? "+" : "-", why);
+          return out;
+        }
+      }
+      out.K.col(i) = (moved[0] - moved[1]) / (2 * h);
+    }
+    out.ok = out.K.allFinite();
+    if (!out.ok) out.message = "K is not finite";
+  } catch (const core::InputError& e) {
+    out.message = e.what();
+  }
+  return out;
+}
+
+double multiplier_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  if (a.rows() != b.rows()) return std::numeric_limits<double>::infinity();
+  const Eigen::VectorXcd x = Eigen::EigenSolver<Eigen::MatrixXd>(a, false).eigenvalues();
+  const Eigen::VectorXcd y = Eigen::EigenSolver<Eigen::MatrixXd>(b, false).eigenvalues();
+  std::vector<bool> used(static_cast<std::size_t>(y.size()), false);
+  double worst = 0;
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    Eigen::Index best = -1;
+    for (Eigen::Index j = 0; j < y.size(); ++j)
+      if (!used[static_cast<std::size_t>(j)] &&
+          (best < 0 || std::abs(y[j] - x[i]) < std::abs(y[best] - x[i])))
+        best = j;
+    used[static_cast<std::size_t>(best)] = true;
+    worst = std::max(worst, std::abs(y[best] - x[i]));
+  }
+  return worst;
+}
+
+}  // namespace backbone::contact_bar
