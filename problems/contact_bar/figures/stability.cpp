@@ -192,6 +192,9 @@ int write_stability_summary(const fs::path& out) {
                        "return_error_worst",
                        "real_negative_modulus_worst",
                        "complex_modulus_worst",
+                       "tdbem_points",
+                       "tdbem_k_difference_worst",
+                       "tdbem_multiplier_difference_worst",
                        "verdict"});
   std::string curves;
   for (const fs::path& run : runs) {
@@ -224,6 +227,9 @@ int write_stability_summary(const fs::path& out) {
     const double nan = std::nan("");
     double fronts_min = nan, fronts_max = nan, defect_min = nan, defect_max = nan, structure = nan,
            returned = nan;
+    // K by the TD-BEM's own march against it (--stability_tdbem_check): how many points have it,
+    // and the worst differences.
+    double tdbem_points = nan, tdbem_k = nan, tdbem_mu = nan;
     if (fs::exists(run / "fronts.csv")) {
       const core::Table f = core::Table::read_csv(run / "fronts.csv");
       fronts_min = smallest(f.column("fronts"));
@@ -233,6 +239,13 @@ int write_stability_summary(const fs::path& out) {
       structure = std::max({largest(f.column("time_shift_error")), largest(f.column("value_leak")),
                             largest(f.column("isometry_error"))});
       returned = largest(f.column("return_error"));
+      const auto& names = f.columns();
+      if (std::find(names.begin(), names.end(), "tdbem_ok") != names.end()) {
+        tdbem_points = 0;
+        for (double ok : f.column("tdbem_ok")) tdbem_points += ok;
+        tdbem_k = largest(f.column("tdbem_k_difference"));
+        tdbem_mu = largest(f.column("tdbem_multiplier_difference"));
+      }
     }
     const std::string bare = name.starts_with("grid_") ? name.substr(5) : name;
     summary.add_cells(
@@ -257,6 +270,9 @@ int write_stability_summary(const fs::path& out) {
          returned,
          largest(negative),
          largest(complex),
+         tdbem_points,
+         tdbem_k,
+         tdbem_mu,
          verdict(representation, unstable, undecided, defect_min, defect_max)});
     if (representation == "grid")
       curves += fmt::format(
