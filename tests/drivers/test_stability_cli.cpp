@@ -17,6 +17,8 @@ const std::string impact =
     std::string(BACKBONE_SOURCE_DIR) + "/problems/impact_oscillator/scenes/impact.ini";
 const std::string duffing =
     std::string(BACKBONE_SOURCE_DIR) + "/problems/duffing/scenes/duffing.ini";
+const std::string paper =
+    std::string(BACKBONE_SOURCE_DIR) + "/problems/contact_bar/scenes/paper.ini";
 
 }  // namespace
 
@@ -80,4 +82,32 @@ TEST(StabilityFiles, StabilityOffWritesNoMultipliers) {
   EXPECT_FALSE(fs::exists(out / "multipliers.csv"));
   const backbone::core::Table branch = backbone::core::Table::read_csv(out / "branch.csv");
   EXPECT_EQ(std::count(branch.columns().begin(), branch.columns().end(), "stable"), 0);
+}
+
+// The bar's mode 2 with K also by the TD-BEM's own march: every point has both, and they agree
+// to the differences' round-off (the unit test TheTdbemsKMatchesTheExactSolversTangent bounds
+// it by 1e-8 on closed forms; a traced orbit's K carries its residual too: 1e-6).
+TEST(StabilityFiles, BarModeTwoWritesTheTdbemsKBesideTheExactOne) {
+  const fs::path out = cli::scratch("stability_cli", "bar_mode2_tdbem");
+  const cli::Run r = cli::run("trace",
+                              paper +
+                                  " --branch mode2 --shooting_elements 20 --max_points 8 "
+                                  "--stability true --stability_tdbem_check true",
+                              out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const backbone::core::Table fronts = backbone::core::Table::read_csv(out / "fronts.csv");
+  ASSERT_GT(fronts.rows(), 0u);
+  for (const double ok : fronts.column("tdbem_ok")) EXPECT_EQ(ok, 1.0);
+  for (const double d : fronts.column("tdbem_k_difference")) EXPECT_LT(d, 1e-6);
+  for (const double n : fronts.column("fronts")) EXPECT_EQ(n, 3.0);
+}
+
+TEST(StabilityInput, TdbemCheckNeedsTheTdbemAndTheFronts) {
+  cli::expect_bad_input("trace",
+                        paper +
+                            " --branch mode1 --stability true --stability_tdbem_check true "
+                            "--stability_representation grid",
+                        "stability_tdbem_check", "stability_cli");
+  cli::expect_bad_input("trace", paper + " --branch mode1 --stability_tdbem_check true",
+                        "stability_tdbem_check", "stability_cli");
 }

@@ -195,8 +195,10 @@ po::options_description trace_keys() {
       ("stability_tdbem_check", po::value<bool>()->default_value(false),
        "with stability_representation fronts: K also by central differences of the TD-BEM's "
        "own march (shooting_solver tdbem, contact event), two simulations of a period per front "
-       "and point; fronts.csv gains tdbem_ok, tdbem_k_difference (largest |K_tdbem - K|) and "
-       "tdbem_multiplier_difference (problems/contact_bar/orbits/README.md, 'Stability')")  //
+       "and point; fronts.csv gains tdbem_ok, tdbem_kink (largest difference of the two one-sided "
+       "differences: of order 1 on a grazing), tdbem_k_difference (largest |K_tdbem - K|, the "
+       "nearest of the central and one-sided K_tdbem) and tdbem_multiplier_difference "
+       "(problems/contact_bar/orbits/README.md, 'Stability')")  //
       ("floquet_tolerance", po::value<double>()->default_value(1e-4),
        "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1). 1e-4 for the fronts: a "
        "Jordan block of size 2 (modes J >= 2) turns K's error e, the traced orbit's 1e-10, "
@@ -871,8 +873,8 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
                                      "determinant", "jordan_defect",  "time_shift_error",
                                      "value_leak",  "isometry_error", "return_error"};
     if (tdbem_check)
-      columns.insert(columns.end(),
-                     {"tdbem_ok", "tdbem_k_difference", "tdbem_multiplier_difference"});
+      columns.insert(columns.end(), {"tdbem_ok", "tdbem_kink", "tdbem_k_difference",
+                                     "tdbem_multiplier_difference"});
     core::Table table(columns);
     for (const auto& point : b.points) {
       const exact_bar::FrontMonodromy m = orbit_front_monodromy(*p, point.x);
@@ -903,8 +905,16 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
         const bool both = m.ok && t.ok && t.K.rows() == m.K.rows();
         if (!t.ok)
           fmt::print("  fronts.csv: point {} has no TD-BEM K: {}\n", point.index, t.message);
-        row.insert(row.end(), {t.ok ? 1.0 : 0.0, both ? (t.K - m.K).cwiseAbs().maxCoeff() : nan,
-                               both ? multiplier_distance(t.K, m.K) : nan});
+        // On a kink the exact K is one side's derivative (exact_bar/README.md, 'Fronts'): it
+        // is set against the TD-BEM's nearest of its central and one-sided differences.
+        const Eigen::MatrixXd* nearest = &t.K;
+        if (both)
+          for (const Eigen::MatrixXd* side : {&t.K_forward, &t.K_backward})
+            if ((*side - m.K).cwiseAbs().maxCoeff() < (*nearest - m.K).cwiseAbs().maxCoeff())
+              nearest = side;
+        row.insert(row.end(), {t.ok ? 1.0 : 0.0, t.ok ? t.kink : nan,
+                               both ? (*nearest - m.K).cwiseAbs().maxCoeff() : nan,
+                               both ? multiplier_distance(*nearest, m.K) : nan});
       }
       table.add_row(row);
     }

@@ -193,6 +193,7 @@ int write_stability_summary(const fs::path& out) {
                        "real_negative_modulus_worst",
                        "complex_modulus_worst",
                        "tdbem_points",
+                       "tdbem_kink_points",
                        "tdbem_k_difference_worst",
                        "tdbem_multiplier_difference_worst",
                        "verdict"});
@@ -228,8 +229,9 @@ int write_stability_summary(const fs::path& out) {
     double fronts_min = nan, fronts_max = nan, defect_min = nan, defect_max = nan, structure = nan,
            returned = nan;
     // K by the TD-BEM's own march against it (--stability_tdbem_check): how many points have it,
-    // and the worst differences.
-    double tdbem_points = nan, tdbem_k = nan, tdbem_mu = nan;
+    // how many sit on a kink of the map (one-sided differences apart by over 1e-3; 1e-5 at most
+    // elsewhere in the main job), and the worst differences off the kinks.
+    double tdbem_points = nan, tdbem_kinks = nan, tdbem_k = nan, tdbem_mu = nan;
     if (fs::exists(run / "fronts.csv")) {
       const core::Table f = core::Table::read_csv(run / "fronts.csv");
       fronts_min = smallest(f.column("fronts"));
@@ -242,9 +244,22 @@ int write_stability_summary(const fs::path& out) {
       const auto& names = f.columns();
       if (std::find(names.begin(), names.end(), "tdbem_ok") != names.end()) {
         tdbem_points = 0;
-        for (double ok : f.column("tdbem_ok")) tdbem_points += ok;
-        tdbem_k = largest(f.column("tdbem_k_difference"));
-        tdbem_mu = largest(f.column("tdbem_multiplier_difference"));
+        tdbem_kinks = 0;
+        const std::vector<double> ok = f.column("tdbem_ok"), kink = f.column("tdbem_kink"),
+                                  dk = f.column("tdbem_k_difference"),
+                                  dmu = f.column("tdbem_multiplier_difference");
+        std::vector<double> smooth_k, smooth_mu;
+        for (std::size_t i = 0; i < ok.size(); ++i) {
+          tdbem_points += ok[i];
+          if (kink[i] > 1e-3) {
+            tdbem_kinks += 1;
+            continue;
+          }
+          smooth_k.push_back(dk[i]);
+          smooth_mu.push_back(dmu[i]);
+        }
+        tdbem_k = largest(smooth_k);
+        tdbem_mu = largest(smooth_mu);
       }
     }
     const std::string bare = name.starts_with("grid_") ? name.substr(5) : name;
@@ -271,6 +286,7 @@ int write_stability_summary(const fs::path& out) {
          largest(negative),
          largest(complex),
          tdbem_points,
+         tdbem_kinks,
          tdbem_k,
          tdbem_mu,
          verdict(representation, unstable, undecided, defect_min, defect_max)});

@@ -24,8 +24,8 @@ constexpr double epsilon = std::numeric_limits<double>::epsilon();
 // the reason, when jumps over `jump` (summed over breakpoints within `sliver` of each other)
 // have no front of base near them or a front of base gets back less than half its jump.
 Eigen::VectorXd front_positions(const exact_bar::CharacteristicState& base,
-                                const exact_bar::CharacteristicState& s, double window,
-                                double jump, double sliver, std::string& why) {
+                                const exact_bar::CharacteristicState& s, double window, double jump,
+                                double sliver, std::string& why) {
   const int fa = static_cast<int>(base.a_start.size()) - 1;
   Eigen::VectorXd total = Eigen::VectorXd::Zero(base.fronts());
   Eigen::VectorXd moment = Eigen::VectorXd::Zero(base.fronts());
@@ -34,9 +34,10 @@ Eigen::VectorXd front_positions(const exact_bar::CharacteristicState& base,
   double stray = 0, stray_at = -1;
   auto stray_ok = [&] {
     if (!(std::abs(stray) > jump)) return true;
-    why = fmt::format("a front at r = {} (a jump of {} of the largest value) has none within {} "
-                      "at t0 to match",
-                      stray_at, std::abs(stray) / jump * exact_bar::default_jump_tolerance, window);
+    why = fmt::format(
+        "a front at r = {} (a jump of {} of the largest value) has none within {} "
+        "at t0 to match",
+        stray_at, std::abs(stray) / jump * exact_bar::default_jump_tolerance, window);
     return false;
   };
   for (bool of_a : {true, false}) {
@@ -119,6 +120,16 @@ exact_bar::CharacteristicState tdbem_characteristic_state(const TdbemMarch& marc
                                          "(a state with body force or a smooth v0)",
                                          p.x0, p.x1));
   if (pieces.empty()) throw core::InputError("tdbem_fronts", "the field has no piece");
+  // A sliver at an end (a front reflecting there at this instant, or a breakpoint a few ulps
+  // off it) belongs to the window's edge, not to the state: its neighbour takes it over.
+  if (pieces.size() > 1 && pieces.front().x1 - pieces.front().x0 < 1e-9 * length) {
+    pieces[1].x0 = pieces.front().x0;
+    pieces.erase(pieces.begin());
+  }
+  if (pieces.size() > 1 && pieces.back().x1 - pieces.back().x0 < 1e-9 * length) {
+    pieces[pieces.size() - 2].x1 = pieces.back().x1;
+    pieces.pop_back();
+  }
   exact_bar::CharacteristicState s;
   auto push = [&](std::vector<double>& start, std::vector<double>& value, double r, double y) {
     if (!value.empty() &&
@@ -176,11 +187,14 @@ TdbemFronts tdbem_front_monodromy(const bar::BarSetup& setup, double t0, double 
       }
       return front_positions(base, tdbem_characteristic_state(m), window, jump, 1e-9 * tau, why);
     };
-    if (fronts_at_t(base).size() != fronts) {
+    const Eigen::VectorXd at_t = fronts_at_t(base);
+    if (at_t.size() != fronts) {
       out.message = "the orbit's fronts do not come back: " + why;
       return out;
     }
     out.K.resize(fronts, fronts);
+    out.K_forward.resize(fronts, fronts);
+    out.K_backward.resize(fronts, fronts);
     for (int i = 0; i < fronts; ++i) {
       Eigen::VectorXd moved[2];
       for (int side = 0; side < 2; ++side) {
@@ -194,8 +208,11 @@ TdbemFronts tdbem_front_monodromy(const bar::BarSetup& setup, double t0, double 
         }
       }
       out.K.col(i) = (moved[0] - moved[1]) / (2 * h);
+      out.K_forward.col(i) = (moved[0] - at_t) / h;
+      out.K_backward.col(i) = (at_t - moved[1]) / h;
     }
-    out.ok = out.K.allFinite();
+    out.kink = (out.K_forward - out.K_backward).cwiseAbs().maxCoeff();
+    out.ok = out.K.allFinite() && std::isfinite(out.kink);
     if (!out.ok) out.message = "K is not finite";
   } catch (const core::InputError& e) {
     out.message = e.what();

@@ -27,18 +27,23 @@ namespace backbone::contact_bar {
 
 // The march's field at its current time in characteristic form: R+ = v - c u_x and
 // R- = v + c u_x on each piece between the field's breakpoints (read at its middle; pieces
-// under 1e-12 L dropped), neighbours within 8 ulps merged. A sliver's value (a piece between
-// two fronts that nearly meet) is formed from knots that close in time and carries round-off
-// over its length.
-// InputError "tdbem_fronts" when the field is not piecewise constant in R+- (a piece over
-// 1e-9 L whose two quarter points differ by more than 1e-9 of the largest value).
+// under 1e-12 L dropped, and under 1e-9 L at an end), neighbours within 8 ulps merged. A sliver's
+// value (a piece between two fronts that nearly meet) is formed from knots that close in time and
+// carries round-off over its length. InputError "tdbem_fronts" when the field is not piecewise
+// constant in R+- (a piece over 1e-9 L whose two quarter points differ by more than 1e-9 of the
+// largest value).
 exact_bar::CharacteristicState tdbem_characteristic_state(const TdbemMarch& march);
 
 struct TdbemFronts {
   bool ok = false;
-  std::string message;                  // why not ok
+  std::string message;                   // why not ok
   exact_bar::CharacteristicState state;  // the TD-BEM's state at t0
-  Eigen::MatrixXd K;                    // d(front times at t0 + T) / d(front times at t0)
+  Eigen::MatrixXd K;                     // d(front times at t0 + T) / d(front times at t0)
+  // The one-sided differences (steps +h and -h alone) and their largest difference: round-off
+  // over h (1e-10) where the map is smooth; of order 1 where the orbit sits on a kink of it (a
+  // grazing contact: one side touches the wall, the other does not), and K is their mean.
+  Eigen::MatrixXd K_forward, K_backward;
+  double kink = 0;
 };
 
 // K of the orbit that starts at rest from `setup` (period T), by the TD-BEM (event method) at
