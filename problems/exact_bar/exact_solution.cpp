@@ -165,6 +165,14 @@ void ExactBarSolution::march_windows(EndState& left_state, EndState& right_state
   // Signals must cover [0, t_end + tau] (a profile at t reads them up to t + tau) and the end
   // tracks [0, t_end]; one more window keeps every query strictly inside.
   const long last_window = static_cast<long>(std::ceil(t_end_ / tau_)) + 1;
+  if (tangent_size_ > 0) {
+    // A segment's tangent holds sparse vectors, which std::vector copies (Eigen's have no move
+    // constructor) each time it grows: room for every window's pieces at the first window's
+    // count, plus events, avoids that.
+    const auto windows = static_cast<std::size_t>(last_window) + 2;
+    a_tan_.reserve(windows * (a_tan_.size() + 4));
+    b_tan_.reserve(windows * (b_tan_.size() + 4));
+  }
   for (long k = 0; k <= last_window; ++k) {
     right_.first.push_back(right_.segments.size());
     b_sig_.first.push_back(b_sig_.segments.size());
@@ -310,8 +318,14 @@ void ExactBarSolution::emit(Side side, long k, double r0, double r1, double in0,
     const double sign = reflect_negative ? -1.0 : 1.0;
     auto& other_tangent = side == Side::right ? b_tan_ : a_tan_;
     other_tangent.push_back({tangent->dr0, tangent->dr1, sign * tangent->dy0});
-    if (!reflect_negative)  // the free end's displacement gains int in = in0 (r1 - r0)
-      state.du += (r1 - r0) * tangent->dy0 + in0 * (tangent->dr1 - tangent->dr0);
+    if (!reflect_negative) {  // the free end's displacement gains int in = in0 (r1 - r0)
+      // Into the dense du in place: sparse temporaries would allocate once per segment.
+      double* du = state.du.data();
+      for (Sensitivity::InnerIterator e(tangent->dy0); e; ++e)
+        du[e.index()] += (r1 - r0) * e.value();
+      for (Sensitivity::InnerIterator e(tangent->dr1); e; ++e) du[e.index()] += in0 * e.value();
+      for (Sensitivity::InnerIterator e(tangent->dr0); e; ++e) du[e.index()] -= in0 * e.value();
+    }
   }
   const double sign = reflect_negative ? -1.0 : 1.0;
   const double out0 = sign * in0, out_slope = sign * in_slope;

@@ -53,26 +53,29 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
   const long k = lt.k;
   const double rt = lt.r;
   const int n = tangent_size_;
-  const Sensitivity zero(n);
 
-  // The fronts at t, as profile() finds them, with their derivatives in p and their speed.
-  // Fronts of A and of B that coincide at t (as a mode's closing and release fronts do at T/2)
-  // pass through each other: each keeps its own motion, so a breakpoint carries both.
+  // The fronts at t, as profile() finds them, with their derivatives in p (factor times a
+  // segment's d r0, read in place) and their speed. Fronts of A and of B that coincide at t (as
+  // a mode's closing and release fronts do at T/2) pass through each other: each keeps its own
+  // motion, so a breakpoint carries both.
+  struct Motion {
+    const Sensitivity* dr0 = nullptr;  // none: no front of that signal here
+    double factor = 0;
+  };
   struct Front {
     double x;
     bool of_a;  // a front of A (runs towards x = 0 as t grows), else of B
-    Sensitivity dx;
+    Motion dx;
   };
   struct Breakpoint {
     double x;
-    Sensitivity dx_a, dx_b;  // zero when no front of that signal sits here
-    bool has_a = false, has_b = false;
+    Motion dx_a, dx_b;
   };
   std::vector<Front> fronts;
   auto add_fronts = [&](const Chunked<Segment>& sig, const std::vector<SegmentTangent>& tan,
                         bool from_right) {
     for_each_front(sig, from_right, t, [&](std::size_t i, double x) {
-      fronts.push_back({x, from_right, (from_right ? -c_ : c_) * tan[i].dr0});
+      fronts.push_back({x, from_right, {&tan[i].dr0, from_right ? -c_ : c_}});
     });
   };
   add_fronts(a_, a_tan_, true);
@@ -80,26 +83,26 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
   std::stable_sort(fronts.begin(), fronts.end(),
                    [](const Front& a, const Front& b) { return a.x < b.x; });
   const double tol = front_tolerance(t);
-  std::vector<Breakpoint> kept{{0.0, zero, zero}};
+  std::vector<Breakpoint> kept{{0.0, {}, {}}};
   for (const Front& f : fronts) {
     if (!(L - f.x > tol)) continue;
-    if (f.x - kept.back().x > tol) kept.push_back({f.x, zero, zero});
+    if (f.x - kept.back().x > tol) kept.push_back({f.x, {}, {}});
     if (kept.size() == 1) continue;  // at x = 0
-    Breakpoint& at = kept.back();
-    if (f.of_a && !at.has_a) {
-      at.dx_a = f.dx;
-      at.has_a = true;
-    } else if (!f.of_a && !at.has_b) {
-      at.dx_b = f.dx;
-      at.has_b = true;
-    }
+    Motion& m = f.of_a ? kept.back().dx_a : kept.back().dx_b;
+    if (!m.dr0) m = f.dx;
   }
-  kept.push_back({L, zero, zero});
+  kept.push_back({L, {}, {}});
 
-  // A signal's value at argument t + offset with its derivative at fixed argument and its
-  // slope, from the segment that holds t + mid_offset (the piece's own side of a front).
+  // A signal's value at argument t + offset, from the segment that holds t + mid_offset (the
+  // piece's own side of a front), with that segment's tangent and slope: the value's derivative
+  // at fixed argument is dy0 - slope dr0.
+  struct Value {
+    double y;
+    const SegmentTangent* g;
+    double slope;
+  };
   auto value = [&](const Chunked<Segment>& sig, const std::vector<SegmentTangent>& tan,
-                   double offset, double mid_offset, Sensitivity& d, double& slope) {
+                   double offset, double mid_offset) {
     const double rm = rt + mid_offset;
     const long kk = rm < tau_ ? k : k + 1;
     const double shift = kk == k ? 0.0 : tau_;
@@ -110,16 +113,24 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
                                [](double x, const Segment& seg) { return x < seg.r0; });
     if (it != first) --it;
     const auto i = static_cast<std::size_t>(it - sig.segments.begin());
-    const Segment& seg = *it;
-    const double arg = rt + offset - shift;
-    const SegmentTangent& g = tan[i];
-    d = g.dy0 - seg.slope * g.dr0;  // constant segments: the value's derivative
-    slope = seg.slope;
-    return seg.at(arg);
+    return Value{it->at(rt + offset - shift), &tan[i], it->slope};
   };
 
   Eigen::MatrixXd d_pt = Eigen::MatrixXd::Zero(n, elements + 1);  // one column per node
   Eigen::VectorXd d_t = Eigen::VectorXd::Zero(elements + 1);
+  // column += w * (derivative of the value), read from the sparse tangent in place.
+  auto add_value = [&](int column, double w, const Value& v) {
+    double* col = d_pt.col(column).data();
+    for (Sensitivity::InnerIterator e(v.g->dy0); e; ++e) col[e.index()] += w * e.value();
+    if (v.slope != 0)
+      for (Sensitivity::InnerIterator e(v.g->dr0); e; ++e)
+        col[e.index()] -= w * v.slope * e.value();
+  };
+  auto add_motion = [&](int column, double w, const Motion& m) {
+    if (!m.dr0 || w == 0) return;
+    double* col = d_pt.col(column).data();
+    for (Sensitivity::InnerIterator e(*m.dr0); e; ++e) col[e.index()] += w * m.factor * e.value();
+  };
   const double h = L / elements;
   auto hat = [&](int i, double x) { return std::max(0.0, 1 - std::abs(x - i * h) / h); };
   // Per breakpoint between two pieces: the jumps of A and of B, each moved by its own front,
@@ -127,33 +138,30 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
   double a_left = 0, b_left = 0;  // A and B just left of the breakpoint (from the piece before)
   for (std::size_t j = 0; j + 1 < kept.size(); ++j) {
     const double xa = kept[j].x, xb = kept[j + 1].x, xm = 0.5 * (xa + xb);
-    Sensitivity dpa, dpb, dma, dmb;
-    double slope_a, slope_b;
-    const double plus_a = value(a_, a_tan_, (L - xa) / c_, (L - xm) / c_, dpa, slope_a);
-    const double plus_b = value(a_, a_tan_, (L - xb) / c_, (L - xm) / c_, dpb, slope_a);
-    const double minus_a = value(b_sig_, b_tan_, xa / c_, xm / c_, dma, slope_b);
-    const double minus_b = value(b_sig_, b_tan_, xb / c_, xm / c_, dmb, slope_b);
-    const Sensitivity ga = 0.5 * (dpa + dma), gb = 0.5 * (dpb + dmb);
-    const double vt = 0.5 * (slope_a + slope_b);  // dv/dt at fixed x
-    if (j > 0) {                                  // the breakpoint at xa
-      const double jump_a = 0.5 * (a_left - plus_a), jump_b = 0.5 * (b_left - minus_a);
-      const Sensitivity dx = jump_a * kept[j].dx_a + jump_b * kept[j].dx_b;
+    const Value pa = value(a_, a_tan_, (L - xa) / c_, (L - xm) / c_);
+    const Value pb = value(a_, a_tan_, (L - xb) / c_, (L - xm) / c_);
+    const Value ma = value(b_sig_, b_tan_, xa / c_, xm / c_);
+    const Value mb = value(b_sig_, b_tan_, xb / c_, xm / c_);
+    const double vt = 0.5 * (pb.slope + mb.slope);  // dv/dt at fixed x
+    if (j > 0) {                                    // the breakpoint at xa
+      const double jump_a = 0.5 * (a_left - pa.y), jump_b = 0.5 * (b_left - ma.y);
       const double dx_dt = (jump_a - jump_b) * c_;
       const int cell = static_cast<int>(std::floor(xa / h));
       for (int i = std::max(0, cell); i <= std::min(elements, cell + 1); ++i) {
         const double w = hat(i, xa);
         if (w == 0) continue;
-        d_pt.col(i) += w * dx;
+        add_motion(i, w * jump_a, kept[j].dx_a);
+        add_motion(i, w * jump_b, kept[j].dx_b);
         d_t[i] += w * dx_dt;
       }
     }
-    a_left = plus_b;
-    b_left = minus_b;
+    a_left = pb.y;
+    b_left = mb.y;
     if (!(xb > xa)) continue;
     // int g psi_i and int vt psi_i over the piece: g linear, psi_i linear on each cell, so
     // Simpson's rule on every (piece x cell) intersection is exact; with g = ga + f (gb - ga),
-    // f = (x - xa) / (xb - xa), each weight splits into a multiple of ga and one of gb - ga.
-    const Sensitivity diff = gb - ga;
+    // f = (x - xa) / (xb - xa), ga = (pa + ma) / 2 and gb = (pb + mb) / 2, each weight splits
+    // into a multiple of ga and one of gb - ga.
     const double width = xb - xa;
     const int first_cell = std::clamp(static_cast<int>(std::floor(xa / h)), 0, elements - 1);
     for (int cell = first_cell; cell < elements && cell * h < xb; ++cell) {
@@ -164,8 +172,10 @@ ProjectedVelocityTangent ExactBarSolution::projected_velocity_tangent(double t,
       for (int i : {cell, cell + 1}) {
         const double ha = hat(i, a), hm = hat(i, m), hb = hat(i, b);
         const double whole = w * (ha + 4 * hm + hb), along = w * (ha * fa + 4 * hm * fm + hb * fb);
-        d_pt.col(i) += whole * ga;
-        d_pt.col(i) += along * diff;
+        add_value(i, 0.5 * (whole - along), pa);
+        add_value(i, 0.5 * (whole - along), ma);
+        add_value(i, 0.5 * along, pb);
+        add_value(i, 0.5 * along, mb);
         d_t[i] += whole * vt;
       }
     }
