@@ -30,7 +30,8 @@ namespace {
 //     the exact solver, of the subharmonic backbone
 //     (20 to 160 intervals, and 20 with the time step halved) and its continuum at 1e-3 J (20 to
 //     80), of the families attached to mode 1 at 70 and 140
-//     intervals (T = 3.6, 3.5, 24/7, 3.2 and 22/7 L/c), and of the clearance modes 1 and 2;
+//     intervals and at 70 with the time step halved (T = 3.6, 3.5, 24/7, 3.2 and 22/7 L/c), and
+//     of the clearance modes 1 and 2;
 //   - the projected grid's (grid_<name>), modes 1 and 2 at 40 and 80, at 40 with c dt / dx
 //     halved and by the exact solver, and mode 2 at 160, for the comparison.
 std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
@@ -72,6 +73,10 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
         {"--branch", "mode1", "--shooting_elements", n, "--detect_branch_points", "true", "--ds",
          "0.05", "--ds_max", "0.05", "--energy_max", "3e-5", "--follow", "all",
          "--follow_max_points", std::string(n) == "70" ? "30" : "8"});
+  add("mode1_resonances_N70_dt_half", "paper.ini",
+      {"--branch", "mode1", "--shooting_elements", "70", "--steps_per_period", "80",
+       "--detect_branch_points", "true", "--ds", "0.05", "--ds_max", "0.05", "--energy_max", "3e-5",
+       "--follow", "all", "--follow_max_points", "30"});
   for (const char* mode : {"mode1", "mode2"})
     add(fmt::format("clearance_{}", mode), "clearance.ini", {"--branch", mode});
   // The projected grid, its tolerances at the size of its projection's error.

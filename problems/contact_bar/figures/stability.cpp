@@ -134,8 +134,10 @@ void plot_multipliers(const fs::path& folder) {
 
 // What a run's numbers say (orbits/README.md, 'Stability'): the fronts' K decides; the
 // projected grid's counts are its own and no verdict on the bar.
+// kinks: points where the TD-BEM's one-sided differences of K disagree (a grazing within the
+// step): the map has no derivative there, and K is one side's.
 std::string verdict(const std::string& representation, int unstable, int undecided,
-                    double defect_min, double defect_max) {
+                    double defect_min, double defect_max, double kinks) {
   if (representation == "grid") return "projected grid: no verdict (see the fronts' runs)";
   std::string text;
   if (unstable > 0)
@@ -148,6 +150,9 @@ std::string verdict(const std::string& representation, int unstable, int undecid
   else
     text = "neutral: every multiplier on the unit circle, with its eigenvectors";
   if (undecided > 0) text += fmt::format(" ({} points undecided)", undecided);
+  if (kinks > 0)
+    text += fmt::format(" ({:g} points on a kink of the period map, a grazing: one-sided there)",
+                        kinks);
   return text;
 }
 
@@ -289,7 +294,7 @@ int write_stability_summary(const fs::path& out) {
          tdbem_kinks,
          tdbem_k,
          tdbem_mu,
-         verdict(representation, unstable, undecided, defect_min, defect_max)});
+         verdict(representation, unstable, undecided, defect_min, defect_max, tdbem_kinks)});
     if (representation == "grid")
       curves += fmt::format(
           "{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",

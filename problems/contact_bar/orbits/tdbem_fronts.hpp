@@ -41,7 +41,9 @@ struct TdbemFronts {
   Eigen::MatrixXd K;                     // d(front times at t0 + T) / d(front times at t0)
   // The one-sided differences (steps +h and -h alone) and their largest difference: round-off
   // over h (1e-10) where the map is smooth; of order 1 where the orbit sits on a kink of it (a
-  // grazing contact: one side touches the wall, the other does not), and K is their mean.
+  // grazing contact: one side touches the wall, the other does not), and K is their mean;
+  // infinity where one side's march changes the fronts within h (a new front, or one lost),
+  // and K is the other side's difference.
   Eigen::MatrixXd K_forward, K_backward;
   double kink = 0;
 };
