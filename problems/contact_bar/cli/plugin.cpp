@@ -38,8 +38,13 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
   std::vector<cli::ReproduceStep> steps;
   // Every run of the fronts traced by the TD-BEM also computes K by the TD-BEM's own march.
   auto add = [&](const std::string& name, const std::string& scene, std::vector<std::string> args) {
-    const bool tdbem_fronts = std::find(args.begin(), args.end(), "grid") == args.end() &&
-                              std::find(args.begin(), args.end(), "exact") == args.end();
+    auto has = [&](const std::string& key, const std::string& value) {
+      for (std::size_t i = 0; i + 1 < args.size(); ++i)
+        if (args[i] == key && args[i + 1] == value) return true;
+      return false;
+    };
+    const bool tdbem_fronts =
+        !has("--stability_representation", "grid") && !has("--shooting_solver", "exact");
     args.insert(args.begin(), scenes + scene);
     if (tdbem_fronts)
       for (const char* word : {"--stability_tdbem_check", "true"}) args.push_back(word);

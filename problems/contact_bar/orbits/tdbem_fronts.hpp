@@ -8,9 +8,11 @@
 // exact_bar::with_characteristic_state), marched over one period T, and its fronts read again:
 // K's column is the motion of every front at T over 2h. With the event method the march is
 // exact for such data (solver/README.md) and its map is affine in h while no event crosses a
-// front or a step boundary that matters, so the differences carry only round-off over h. No
-// derivative, no grid and no code of the exact solver enter: only its choice of t0 (any time of
-// free flight gives K up to a similarity).
+// front or a step boundary that matters, so the differences carry only round-off over h. Near a
+// grazing a front may leave the matching window: the column is retried with h / 10 and h / 100;
+// a side that still changes the fronts leaves the other side's difference (TdbemFronts::kink). No
+// derivative, no grid and no march of the exact solver enter: only exact_bar's helpers of the
+// characteristic form and its choice of t0 (any time of free flight gives K up to a similarity).
 //
 //   contact_bar::TdbemFronts f = contact_bar::tdbem_front_monodromy(setup, t0, T, dt);
 //   f.K;  // fronts x fronts, the fronts ordered as in exact_bar::CharacteristicState
