@@ -195,8 +195,11 @@ po::options_description trace_keys() {
       ("stability_tdbem_check", po::value<bool>()->default_value(false),
        "with stability_representation fronts: K also by central differences of the TD-BEM's "
        "own march (shooting_solver tdbem, contact event), two simulations of a period per front "
-       "and point; fronts.csv gains tdbem_ok, tdbem_kink (largest difference of the two one-sided "
-       "differences: of order 1 on a grazing), tdbem_k_difference (largest |K_tdbem - K|, the "
+       "and point (steps 10 and 100 times smaller near a grazing); fronts.csv gains tdbem_ok (1: "
+       "the TD-BEM's K was computed; no tolerance), tdbem_kink (largest difference of the two "
+       "one-sided "
+       "differences: of order 1 on a grazing, infinite where one side fails), tdbem_k_difference "
+       "(largest |K_tdbem - K|, the "
        "nearest of the central and one-sided K_tdbem) and tdbem_multiplier_difference "
        "(problems/contact_bar/orbits/README.md, 'Stability')")  //
       ("floquet_tolerance", po::value<double>()->default_value(1e-4),
@@ -924,13 +927,23 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
 
 cli::TraceSetup setup_trace_with_reports(const core::Scene& scene, const std::string& branch) {
   const bool tdbem_check = scene.flag("stability_tdbem_check");
-  if (tdbem_check &&
-      (!scene.flag("stability") || scene.text("stability_representation") != "fronts" ||
-       scene.text("shooting_solver") != "tdbem" ||
-       contact_method_from_scene(scene) != ContactMethod::event))
-    throw core::InputError("stability_tdbem_check",
-                           "needs stability true, stability_representation fronts, "
-                           "shooting_solver tdbem and contact event");
+  if (tdbem_check) {
+    // Each key's own check first (a typo names its key), then what the TD-BEM's K needs.
+    const bool fronts =
+        parse_representation("stability_representation", scene.text("stability_representation")) ==
+        MonodromyOptions::Representation::fronts;
+    const bool tdbem = scene.choice("shooting_solver", {"tdbem", "exact"}) == "tdbem";
+    const bool event = contact_method_from_scene(scene) == ContactMethod::event;
+    const char* missing = !scene.flag("stability") ? "stability true"
+                          : !fronts                ? "stability_representation fronts"
+                          : !tdbem                 ? "shooting_solver tdbem"
+                          : !event                 ? "contact event"
+                                                   : nullptr;
+    if (missing)
+      throw core::InputError(
+          "stability_tdbem_check",
+          fmt::format("needs {} (the TD-BEM's own K from the orbit's fronts)", missing));
+  }
   cli::TraceSetup s = setup_trace(scene, branch);
   if (scene.flag("stability")) add_front_report(s, tdbem_check);
   return s;
