@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -73,15 +74,14 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
   // Every family the grid finds attached to mode 1 up to 3e-5 J, followed with its multipliers
   // (the steps of mode1_resonance_twelve: 0.05 of the amplitude); at 140 intervals 8 points of
   // each (the seven families' rank reports there take minutes per 30 points).
-  for (const char* n : {"70", "140"})
-    add(fmt::format("mode1_resonances_N{}", n), "paper.ini",
-        {"--branch", "mode1", "--shooting_elements", n, "--detect_branch_points", "true", "--ds",
-         "0.05", "--ds_max", "0.05", "--energy_max", "3e-5", "--follow", "all",
-         "--follow_max_points", std::string(n) == "70" ? "30" : "8"});
-  add("mode1_resonances_N70_dt_half", "paper.ini",
-      {"--branch", "mode1", "--shooting_elements", "70", "--steps_per_period", "80",
-       "--detect_branch_points", "true", "--ds", "0.05", "--ds_max", "0.05", "--energy_max", "3e-5",
-       "--follow", "all", "--follow_max_points", "30"});
+  for (const auto& [run, n, per_period, points] :
+       {std::array<std::string, 4>{"N70", "70", "40", "30"},
+        {"N140", "140", "40", "8"},
+        {"N70_dt_half", "70", "80", "30"}})
+    add("mode1_resonances_" + run, "paper.ini",
+        {"--branch", "mode1", "--shooting_elements", n, "--steps_per_period", per_period,
+         "--detect_branch_points", "true", "--ds", "0.05", "--ds_max", "0.05", "--energy_max",
+         "3e-5", "--follow", "all", "--follow_max_points", points});
   for (const char* mode : {"mode1", "mode2"})
     add(fmt::format("clearance_{}", mode), "clearance.ini", {"--branch", mode});
   // The projected grid, its tolerances at the size of its projection's error.

@@ -195,13 +195,12 @@ po::options_description trace_keys() {
       ("stability_tdbem_check", po::value<bool>()->default_value(false),
        "with stability_representation fronts: K also by central differences of the TD-BEM's "
        "own march (shooting_solver tdbem, contact event), two simulations of a period per front "
-       "and point (steps 10 and 100 times smaller near a grazing); fronts.csv gains tdbem_ok (1: "
-       "the TD-BEM's K was computed; no tolerance), tdbem_kink (largest difference of the two "
-       "one-sided "
-       "differences: of order 1 on a grazing, infinite where one side fails), tdbem_k_difference "
-       "(largest |K_tdbem - K|, the "
-       "nearest of the central and one-sided K_tdbem) and tdbem_multiplier_difference "
-       "(problems/contact_bar/orbits/README.md, 'Stability')")  //
+       "and point (steps 10 and 100 times smaller near a grazing); fronts.csv gains tdbem_ok "
+       "(1: the TD-BEM's K was computed; no tolerance), tdbem_kink (largest difference of the "
+       "two one-sided differences: of order 1 on a grazing, infinite where one side fails), "
+       "tdbem_k_difference (largest |K_tdbem - K|, the nearest of the central and one-sided "
+       "K_tdbem) and tdbem_multiplier_difference (problems/contact_bar/orbits/README.md, "
+       "'Stability')")  //
       ("floquet_tolerance", po::value<double>()->default_value(1e-4),
        "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1). 1e-4 for the fronts: a "
        "Jordan block of size 2 (modes J >= 2) turns K's error e, the traced orbit's 1e-10, "
