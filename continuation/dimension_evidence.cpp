@@ -49,7 +49,7 @@ DimensionEvidence dimension_evidence(const core::Problem& problem, const core::V
   core::Matrix J;
   if (scaled.jacobian(z, J) != core::EvalStatus::ok) return e;
   e.report = core::rank_report(J, rank);
-  auto verifier = core::make_verifier(verify);
+  auto verifier = core::make_verifier(verify, rank);
   core::verify_null_directions(scaled, z, *verifier, verify, e.report);
   if (neighbour.size() == x.size()) {
     core::RankReport beside =

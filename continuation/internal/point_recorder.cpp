@@ -15,7 +15,7 @@ PointRecorder::PointRecorder(const core::Problem& problem, const ContinuationOpt
                              const core::Problem* counted)
     : problem_(problem), counted_(counted ? *counted : problem), options_(options) {
   if (options.rank_check_every > 0 && options.verify)
-    verifier_ = core::make_verifier(options.verification);
+    verifier_ = core::make_verifier(options.verification, options.rank);
 }
 
 void PointRecorder::begin() {

@@ -42,9 +42,12 @@ NewtonOptions VerifyOptions::corrector_options() const {
   return newton;
 }
 
-std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options) {
+std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options, const RankOptions& rank) {
   options.validate();
-  return make_corrector("eigen", options.corrector_options());
+  rank.validate();
+  NewtonOptions newton = options.corrector_options();
+  newton.rank_cutoff = rank.relative_threshold;
+  return make_corrector("eigen", newton);
 }
 
 namespace {

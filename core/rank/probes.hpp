@@ -11,7 +11,7 @@
 //
 //   RankReport rep = rank_report(J, RankOptions{});
 //   const VerifyOptions verify;
-//   auto verifier = make_verifier(verify);        // eigen, least squares, verify's tolerances
+//   auto verifier = make_verifier(verify, RankOptions{});  // eigen, least squares, cut-off
 //   verify_null_directions(problem, x, *verifier, verify, rep);
 //   fmt::print("nullity {} verified {}\n", rep.nullity, rep.verified_dimension);
 #pragma once
@@ -25,7 +25,8 @@
 
 namespace backbone::core {
 
-struct RankReport;  // rank_report.hpp
+struct RankReport;   // rank_report.hpp
+struct RankOptions;  // rank_report.hpp
 
 struct VerifyOptions {
   // Step length along each null direction (scaled units). 1e-4: a family that is piecewise
@@ -50,8 +51,13 @@ struct VerifyOptions {
 };
 
 // The corrector verify_null_directions is meant to run with: eigen (each probe has m + 1
-// equations in n unknowns, solved in the least-squares sense) with options.corrector_options().
-std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options);
+// equations in n unknowns, solved in the least-squares sense) with options.corrector_options(),
+// its singular values below rank.relative_threshold * sigma_max treated as zero
+// (NewtonOptions::rank_cutoff), as the report they verify treated them. A probe borders J with
+// one row, so its system keeps the family's other null directions; a cut-off below theirs
+// inverts them, and their singular values (round-off of an exact Jacobian, 1e-8 of
+// differences) then decide where the probe lands (core/README.md, 'Rank reports').
+std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options, const RankOptions& rank);
 
 // Fills verified_dimension and direction_verified. Evaluates the problem; never throws on
 // numerical failure (a direction that fails to re-correct is simply not verified).

@@ -13,7 +13,7 @@
 //   Matrix J; problem.jacobian(x, J);
 //   RankReport rep = rank_report(J, RankOptions{});
 //   const VerifyOptions verify;
-//   auto verifier = make_verifier(verify);        // eigen, least squares, verify's tolerances
+//   auto verifier = make_verifier(verify, RankOptions{});  // eigen, least squares, cut-off
 //   verify_null_directions(problem, x, *verifier, verify, rep);
 //   fmt::print("nullity {} verified {}\n", rep.nullity, rep.verified_dimension);
 #pragma once

@@ -49,6 +49,27 @@ backbone::core::Table trace_mode1_on_the_closed_form(const std::string& name,
   return check;
 }
 
+// The subharmonic backbone lies in a continuum of two dimensions (energy and shape; the closed
+// form of problems/contact_bar/orbits/README.md, 'Subharmonic continuum'), which the verified
+// rank report of F alone must find at every point with either Jacobian. The exact one's two
+// null singular values sit at round-off, so the probes' corrector must cut them like the report
+// does (core::make_verifier): with a cut-off of 1e-12 its probes drifted off at 11 of these points
+// (energies 2.3e-4 to 1.1e-3 J) and the dimension read 1 there.
+TEST(TraceCli, TheSubharmonicContinuumIsTwoDimensionalWithEitherJacobian) {
+  for (const std::string jacobian : {"differences", "exact"}) {
+    const fs::path out = cli::scratch("trace_cli", "subharmonic_" + jacobian);
+    const cli::Run r = cli::run(
+        "trace", paper + " --branch subharmonic --energy_max 1.2e-3 --jacobian " + jacobian, out);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto dimensions =
+        backbone::core::Table::read_csv(out / "subharmonic_check.csv").column("dimension_F");
+    EXPECT_GE(dimensions.size(), 20u);
+    for (std::size_t i = 0; i < dimensions.size(); ++i)
+      EXPECT_EQ(dimensions[i], 2) << jacobian << " point " << i;
+    fs::remove_all(out);
+  }
+}
+
 TEST(TraceCli, BadInputExitsTwoAndWritesNothing) {
   expect_bad_input(paper + " --branch mode3x", "branch");
   expect_bad_input(paper + " --ds 0", "ds");

@@ -140,14 +140,15 @@ RankColumns rank_columns(const core::PeriodicOrbitProblem& problem, const core::
   c.period_column_forward = forward.col(period).lpNorm<Eigen::Infinity>();
   c.period_column_central = central.col(period).lpNorm<Eigen::Infinity>();
   c.uncertainty = Eigen::JacobiSVD<core::Matrix>(forward - central).singularValues()[0];
-  // The continuation's verifier (continuation/internal/point_recorder.cpp): default VerifyOptions.
+  // The continuation's verifier (continuation/internal/point_recorder.cpp): default VerifyOptions,
+  // its cut-off the rank threshold.
   const core::VerifyOptions verify;
-  const auto verifier = core::make_verifier(verify);
   core::RankOptions absolute;
   absolute.absolute_threshold = c.uncertainty;
   core::RankOptions relative;
   relative.relative_threshold = formulation_rank_threshold;
   absolute.relative_threshold = formulation_rank_threshold;
+  const auto verifier = core::make_verifier(verify, relative);
   c.relative = core::rank_report(forward, relative);
   c.absolute = core::rank_report(forward, absolute);
   c.central = core::rank_report(central, relative);

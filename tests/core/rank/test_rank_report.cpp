@@ -167,7 +167,7 @@ TEST(RankReport, OptionsValidationNamesTheField) {
   }
   v = {};
   v.corrector_tolerance_ratio = 0;
-  EXPECT_THROW(make_verifier(v), InputError);
+  EXPECT_THROW(make_verifier(v, RankOptions{}), InputError);
 }
 
 // The verifier's corrector follows VerifyOptions: its tolerance is ratio * residual_tolerance
@@ -182,7 +182,7 @@ TEST(VerifyNullDirections, VerifierSettingsComeFromVerifyOptions) {
   v.max_iterations = 7;
   EXPECT_DOUBLE_EQ(v.corrector_options().residual_tolerance, 5e-7);
   EXPECT_EQ(v.corrector_options().max_iterations, 7);
-  EXPECT_EQ(make_verifier(v)->name(), "eigen");
+  EXPECT_EQ(make_verifier(v, RankOptions{})->name(), "eigen");
 }
 
 // Rank report + verification at a solution point x of `problem`.
@@ -299,7 +299,7 @@ TEST(VerifyNullDirections, ProbesStopStartingOnAJacobianAtXThatNeverServes) {
   ASSERT_EQ(sphere.jacobian(x, exact), EvalStatus::ok);
   const Matrix wrong = -exact;
   const auto verify = [&](const Matrix* at_x, long& residuals, long& jacobians) {
-    const auto verifier = make_verifier(VerifyOptions{});
+    const auto verifier = make_verifier(VerifyOptions{}, RankOptions{});
     RankReport r = rank_report(exact, RankOptions{});
     const long r0 = sphere.counters().residuals, j0 = sphere.counters().jacobians;
     verify_null_directions(sphere, x, *verifier, VerifyOptions{}, r, at_x);
@@ -376,7 +376,7 @@ TEST(VerifyNullDirections, DoubleRootNeedsTheVerifiersIterationBudget) {
     VerifyOptions v;
     v.max_iterations = cap;
     RankReport r = rank_report(J, RankOptions{});
-    verify_null_directions(p, x, *make_verifier(v), v, r);
+    verify_null_directions(p, x, *make_verifier(v, RankOptions{}), v, r);
     EXPECT_EQ(r.verified_dimension, cap == 60 ? 1 : 0) << cap << ": " << r.summary();
   }
 }
@@ -406,7 +406,7 @@ RankReport verified_from_origin(const Problem& p) {
   RankReport r;
   r.null_directions = Matrix::Identity(p.num_unknowns(), p.num_unknowns());
   const VerifyOptions v;
-  verify_null_directions(p, Vector::Zero(p.num_unknowns()), *make_verifier(v), v, r);
+  verify_null_directions(p, Vector::Zero(p.num_unknowns()), *make_verifier(v, RankOptions{}), v, r);
   return r;
 }
 
@@ -454,11 +454,11 @@ TEST(VerifyNullDirections, BoundaryOfAHalfPlaneIsASurface) {
   VerifyOptions v;
   RankReport outward;
   outward.null_directions = Vector::Unit(2, 0);
-  verify_null_directions(p, x, *make_verifier(v), v, outward);
+  verify_null_directions(p, x, *make_verifier(v, RankOptions{}), v, outward);
   EXPECT_EQ(outward.verified_dimension, 1) << outward.summary();
   RankReport both;
   both.null_directions = Matrix::Identity(2, 2);
-  verify_null_directions(p, x, *make_verifier(v), v, both);
+  verify_null_directions(p, x, *make_verifier(v, RankOptions{}), v, both);
   EXPECT_EQ(both.verified_dimension, 2) << both.summary();
 }
 
@@ -475,7 +475,7 @@ TEST(RankReportBeside, KinkOnTheBoundaryHidesADirectionThatTheInteriorShows) {
   EXPECT_EQ(at.nullity, 1);
   RankReport beside = rank_report_beside(p, x, -Vector::Unit(2, 0), v.step, RankOptions{});
   EXPECT_EQ(beside.nullity, 2);
-  verify_null_directions(p, x, *make_verifier(v), v, beside);
+  verify_null_directions(p, x, *make_verifier(v, RankOptions{}), v, beside);
   EXPECT_EQ(beside.verified_dimension, 2) << beside.summary();
   // A direction along which nothing is known gives nothing.
   EXPECT_EQ(rank_report_beside(p, x, Vector::Zero(2), v.step, RankOptions{}).nullity, 0);

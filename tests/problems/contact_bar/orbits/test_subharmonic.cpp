@@ -265,7 +265,7 @@ TEST(SubharmonicRepresentation, VerifiedDimensionIsTwo) {
       rank.relative_threshold = 1e-5;  // the trace default (plugin.cpp, rank_threshold)
       core::RankReport report = core::rank_report(J, rank);
       const core::VerifyOptions verify;
-      auto verifier = core::make_verifier(verify);
+      auto verifier = core::make_verifier(verify, rank);
       core::verify_null_directions(scaled, z, *verifier, verify, report);
       EXPECT_EQ(report.nullity, 2) << n << " " << shape << " " << report.summary();
       EXPECT_EQ(report.verified_dimension, 2) << n << " " << shape << " " << report.summary();
