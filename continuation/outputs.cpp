@@ -351,7 +351,7 @@ Branch whole_branch(const std::filesystem::path& dir, const core::Problem& probl
     const auto columns = read_columns(dir / "unknowns.csv", {"point", "index", "value"}, "resume");
     std::map<int, std::vector<double>> saved;  // point -> values in file order (index order)
     for (std::size_t i = 0; i < columns[0].size(); ++i)
-      if (columns[0][i] >= 0 && columns[0][i] < first)
+      if (columns[0][i] >= 0 && columns[0][i] <= first)
         saved[static_cast<int>(columns[0][i])].push_back(columns[2][i]);
     for (const auto& [index, values] : saved) {
       BranchPoint p;
@@ -363,7 +363,8 @@ Branch whole_branch(const std::filesystem::path& dir, const core::Problem& probl
       whole.points.push_back(std::move(p));
     }
   }
-  whole.points.insert(whole.points.end(), resumed.points.begin(), resumed.points.end());
+  for (const BranchPoint& p : resumed.points)
+    if (whole.points.empty() || p.index > whole.points.back().index) whole.points.push_back(p);
   whole.branch_points = resumed.branch_points;
   whole.reason = resumed.reason;
   whole.message = resumed.message;

@@ -109,9 +109,10 @@ void forget_saved_states(const std::filesystem::path& out);
 // when the file cannot be read or has no such point.
 core::Vector read_unknowns(const std::filesystem::path& path, int point, const std::string& key);
 
-// The saved points before resumed's first (dir/unknowns.csv, their observables recomputed, and
-// their multipliers with floquet non-null), then resumed's own: the whole branch as the files
-// of a resumed run hold it.
+// The saved points up to resumed's first (dir/unknowns.csv, their observables recomputed, and
+// their multipliers with floquet non-null), then resumed's later ones: the whole branch as the
+// files of a resumed run hold it. The restart point is the saved one: a restart without a saved
+// loop state corrects it again, to other round-off, and branch.csv keeps the saved row.
 Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
                     const Branch& resumed, const core::FloquetOptions* floquet);
 

@@ -87,6 +87,9 @@ FollowedBranch follow_attached(const core::Problem& problem, const BranchPointRe
   ContinuationOptions o = options;
   o.method = Method::arclength;
   o.branch_points.detect = false;
+  // The followed family's first tangent comes from the Jacobian at its start (nearest the probe's
+  // secant), whatever the traced branch's own first step did.
+  o.start_along_direction = false;
   if (o.branch_points.max_turn_degrees > 0)
     o.branch_points.max_turn_degrees =
         std::max(o.branch_points.max_turn_degrees, follow_max_turn_degrees);

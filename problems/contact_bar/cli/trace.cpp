@@ -174,11 +174,11 @@ po::options_description trace_keys() {
       ("max_memory", po::value<double>()->default_value(0),
        "refuse a trace whose dense Jacobian and its factorizations would need more than this "
        "many GB (>= 0; 0: half of this machine's memory)")  //
-      ("jacobian", po::value<std::string>()->default_value("differences"),
-       "the shooting Jacobian: differences (finite differences, compressed by its pattern) or "
-       "exact (from the exact solution's tangent: problems/contact_bar/orbits/README.md, "
-       "section 'Exact Jacobian'; the regular formulation with the exact solver or the TD-BEM's "
-       "event march, without path rows; else differences)")  //
+      ("jacobian", po::value<std::string>()->default_value("exact"),
+       "the shooting Jacobian: exact (from the exact solution's tangent: "
+       "problems/contact_bar/orbits/README.md, section 'Exact Jacobian'; the regular formulation "
+       "with the exact solver or the TD-BEM's event march, without path rows; else differences) "
+       "or differences (finite differences, compressed by its pattern)")  //
       ("max_dense_work", po::value<double>()->default_value(2e10),
        "refuse a trace whose dense factorizations (the rank report's SVD of the m x n "
        "Jacobian, m n^2 operations) cost more than this (> 0; 2e10: about 2000 intervals, "
@@ -615,9 +615,17 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
     };
   s.guess = problem->contact_family_guess(mode, ratio);
   check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
-  // Energy grows along the family: the direction of the contact family's own tangent.
+  // Energy grows along the family: the direction of the contact family's own tangent, which the
+  // first step follows (start_along_direction). The first orbit may sit on a branch point (end
+  // amplitude 1.25 g0 is T = 3.8 L/c), where the exact Jacobian is one-sided and its null
+  // vector points 48 degrees off the mode, towards the attached family.
   s.direction = problem->contact_family_guess(mode, ratio * 1.01) -
                 problem->contact_family_guess(mode, ratio);
+  s.branch_options = [given = s.branch_options](continuation::ContinuationOptions& o,
+                                                core::NewtonOptions& newton) {
+    if (given) given(o, newton);
+    o.start_along_direction = true;
+  };
   // Exact oracle sampled on 4x as many intervals as unknowns (finer than the default test
   // grid): a spurious root of the projected equations is not a root of these.
   s.reject_point = mode_check(scene, problem.get(), 4 * problem->state_size());
