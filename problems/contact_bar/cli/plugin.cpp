@@ -30,9 +30,9 @@ namespace {
 //     160 intervals, at 40 with the shooting's time step halved and with the orbits traced by
 //     the exact solver, of the subharmonic backbone
 //     (20 to 160 intervals, and 20 with the time step halved) and its continuum at 1e-3 J (20 to
-//     80), of the families attached to mode 1 at 70 and 140
-//     intervals and at 70 with the time step halved (T = 3.6, 3.5, 24/7, 3.2 and 22/7 L/c), and
-//     of the clearance modes 1 and 2;
+//     80), of the families attached to mode 1 at 40, 80 and 160 intervals (T = 3.6, 3.5, 3.25,
+//     3.2 and more), at 70 and 140 and at 70 with the time step halved (T = 3.6, 3.5, 24/7, 3.2
+//     and 22/7 L/c), and of the clearance modes 1 and 2;
 //   - the projected grid's (grid_<name>), modes 1 and 2 at 40 and 80, at 40 with c dt / dx
 //     halved and by the exact solver, and mode 2 at 160, for the comparison.
 std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
@@ -72,10 +72,13 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
     add(fmt::format("subharmonic_continuum_N{}", n), "paper.ini",
         {"--branch", "subharmonic_continuum", "--energy", "1e-3", "--shooting_elements", n});
   // Every family the grid finds attached to mode 1 up to 3e-5 J, followed with its multipliers
-  // (the steps of mode1_resonance_twelve: 0.05 of the amplitude); at 140 intervals 8 points of
-  // each (the seven families' rank reports there take minutes per 30 points).
+  // (the steps of mode1_resonance_twelve: 0.05 of the amplitude); at 140 and 160 intervals 8
+  // points of each (the seven families' rank reports there take minutes per 30 points).
   for (const auto& [run, n, per_period, points] :
-       {std::array<std::string, 4>{"N70", "70", "40", "30"},
+       {std::array<std::string, 4>{"N40", "40", "40", "30"},
+        {"N80", "80", "40", "30"},
+        {"N160", "160", "40", "8"},
+        {"N70", "70", "40", "30"},
         {"N140", "140", "40", "8"},
         {"N70_dt_half", "70", "80", "30"}})
     add("mode1_resonances_" + run, "paper.ini",

@@ -135,13 +135,19 @@ void plot_multipliers(const fs::path& folder) {
 // What a run's numbers say (orbits/README.md, 'Stability'): the fronts' K decides; the
 // projected grid's counts are its own and no verdict on the bar.
 // kinks: points where the TD-BEM's one-sided differences of K disagree (a grazing within the
-// step): the map has no derivative there, and K is one side's.
-std::string verdict(const std::string& representation, int unstable, int undecided,
-                    double defect_min, double defect_max, double kinks) {
+// step): the map has no derivative there, and K is one side's, so a multiplier off the circle
+// there (unstable_on_kinks of the unstable points) decides nothing.
+std::string verdict(const std::string& representation, int unstable, int unstable_on_kinks,
+                    int undecided, double defect_min, double defect_max, double kinks) {
   if (representation == "grid") return "projected grid: no verdict (see the fronts' runs)";
   std::string text;
-  if (unstable > 0)
-    text = fmt::format("unstable at {} points", unstable);
+  if (unstable > unstable_on_kinks)
+    text = fmt::format("unstable at {} points", unstable - unstable_on_kinks);
+  else if (unstable > 0)
+    text = fmt::format(
+        "no multiplier off the unit circle off the kinks; at {} {} on a kink one side's K has "
+        "one: not resolved there",
+        unstable, unstable == 1 ? "point" : "points");
   else if (defect_max > 0)
     text = fmt::format(
         "no multiplier off the unit circle; Jordan defect {}{}: perturbations along it grow "
@@ -151,8 +157,8 @@ std::string verdict(const std::string& representation, int unstable, int undecid
     text = "neutral: every multiplier on the unit circle, with its eigenvectors";
   if (undecided > 0) text += fmt::format(" ({} points undecided)", undecided);
   if (kinks > 0)
-    text += fmt::format(" ({:g} points on a kink of the period map, a grazing: one-sided there)",
-                        kinks);
+    text += fmt::format(" ({:g} {} on a kink of the period map, a grazing: one-sided there)", kinks,
+                        kinks == 1 ? "point" : "points");
   return text;
 }
 
@@ -206,8 +212,8 @@ int write_stability_summary(const fs::path& out) {
   for (const fs::path& run : runs) {
     const core::Table branch = core::Table::read_csv(run / "branch.csv");
     const core::Table multipliers = core::Table::read_csv(run / "multipliers.csv");
-    const std::vector<double> stable = branch.column("stable");
-    int unstable = 0, undecided = 0;
+    const std::vector<double> stable = branch.column("stable"), point = branch.column("point");
+    int unstable = 0, undecided = 0, unstable_on_kinks = 0;
     for (double s : stable) {
       unstable += s == 0 ? 1 : 0;
       undecided += s < 0 ? 1 : 0;
@@ -251,13 +257,15 @@ int write_stability_summary(const fs::path& out) {
         tdbem_points = 0;
         tdbem_kinks = 0;
         const std::vector<double> ok = f.column("tdbem_ok"), kink = f.column("tdbem_kink"),
-                                  dk = f.column("tdbem_k_difference"),
+                                  at = f.column("point"), dk = f.column("tdbem_k_difference"),
                                   dmu = f.column("tdbem_multiplier_difference");
         std::vector<double> smooth_k, smooth_mu;
         for (std::size_t i = 0; i < ok.size(); ++i) {
           tdbem_points += ok[i];
           if (kink[i] > 1e-3) {
             tdbem_kinks += 1;
+            for (std::size_t j = 0; j < point.size(); ++j)
+              if (point[j] == at[i] && stable[j] == 0) ++unstable_on_kinks;
             continue;
           }
           smooth_k.push_back(dk[i]);
@@ -294,7 +302,8 @@ int write_stability_summary(const fs::path& out) {
          tdbem_kinks,
          tdbem_k,
          tdbem_mu,
-         verdict(representation, unstable, undecided, defect_min, defect_max, tdbem_kinks)});
+         verdict(representation, unstable, unstable_on_kinks, undecided, defect_min, defect_max,
+                 tdbem_kinks)});
     if (representation == "grid")
       curves += fmt::format(
           "{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",
