@@ -132,17 +132,21 @@ void plot_multipliers(const fs::path& folder) {
   if (!r.ok) fmt::print("[figures] multipliers.png skipped: {}\n", r.message);
 }
 
+}  // namespace
+
 // What a run's numbers say (orbits/README.md, 'Stability'): the fronts' K decides; the
 // projected grid's counts are its own and no verdict on the bar.
 // kinks: points where the TD-BEM's one-sided differences of K disagree (a grazing within the
 // step): the map has no derivative there, and K is one side's, so a multiplier off the circle
 // there (unstable_on_kinks of the unstable points) decides nothing.
-std::string verdict(const std::string& representation, int unstable, int unstable_on_kinks,
-                    int undecided, double defect_min, double defect_max, double kinks) {
+std::string stability_verdict(const std::string& representation, int unstable,
+                              int unstable_on_kinks, int undecided, double defect_min,
+                              double defect_max, double kinks) {
   if (representation == "grid") return "projected grid: no verdict (see the fronts' runs)";
   std::string text;
   if (unstable > unstable_on_kinks)
-    text = fmt::format("unstable at {} points", unstable - unstable_on_kinks);
+    text = fmt::format("unstable at {} {}", unstable - unstable_on_kinks,
+                       unstable - unstable_on_kinks == 1 ? "point" : "points");
   else if (unstable > 0)
     text = fmt::format(
         "no multiplier off the unit circle off the kinks; at {} {} on a kink one side's K has "
@@ -161,8 +165,6 @@ std::string verdict(const std::string& representation, int unstable, int unstabl
                         kinks == 1 ? "point" : "points");
   return text;
 }
-
-}  // namespace
 
 int write_stability_summary(const fs::path& out) {
   const fs::path folder = out / "stability";
@@ -302,8 +304,8 @@ int write_stability_summary(const fs::path& out) {
          tdbem_kinks,
          tdbem_k,
          tdbem_mu,
-         verdict(representation, unstable, unstable_on_kinks, undecided, defect_min, defect_max,
-                 tdbem_kinks)});
+         stability_verdict(representation, unstable, unstable_on_kinks, undecided, defect_min,
+                           defect_max, tdbem_kinks)});
     if (representation == "grid")
       curves += fmt::format(
           "{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "continuation/cli/plugin.hpp"
@@ -26,6 +27,14 @@
 namespace backbone::contact_bar {
 
 std::vector<cli::ProblemJob> stability_figure_jobs();
+
+// summary.csv's verdict of one run: the fronts' K decides; the projected grid's ("grid") gives
+// none. unstable (of them unstable_on_kinks) and undecided count points; kinks: points where
+// the TD-BEM's one-sided differences of K disagree, where a multiplier off the circle is one
+// side's and decides nothing; defect_min/max: the fronts' Jordan defects.
+std::string stability_verdict(const std::string& representation, int unstable,
+                              int unstable_on_kinks, int undecided, double defect_min,
+                              double defect_max, double kinks);
 
 // 0 when written, or skipped with a line when OUT/stability holds no run.
 int write_stability_summary(const std::filesystem::path& out);

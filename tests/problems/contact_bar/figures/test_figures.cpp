@@ -11,6 +11,7 @@
 
 #include "core/io/table.hpp"
 #include "problems/contact_bar/figures/modes.hpp"
+#include "problems/contact_bar/figures/stability.hpp"
 
 namespace {
 
@@ -86,6 +87,24 @@ TEST(ContactBarFigures, ClosedFormSummaryHasOneRowPerCheckedBranch) {
       EXPECT_EQ(std::stod(cells[k + 1]), expected[k]) << name << " column " << k + 1;
   }
   EXPECT_FALSE(std::getline(in, line));
+}
+
+// The verdict follows the fronts' K only where the period map has a derivative: multipliers off
+// the circle at points on a kink (one side's K) make no "unstable", they are said unresolved;
+// one such point off the kinks does. The grid gives no verdict.
+TEST(ContactBarFigures, TheStabilityVerdictLeavesTheKinksUnresolved) {
+  using backbone::contact_bar::stability_verdict;
+  const std::string on_kinks = stability_verdict("fronts", 2, 2, 0, 0, 1, 7);
+  EXPECT_EQ(on_kinks.find("unstable at"), std::string::npos) << on_kinks;
+  EXPECT_NE(on_kinks.find("at 2 points on a kink one side's K has one: not resolved"),
+            std::string::npos)
+      << on_kinks;
+  EXPECT_NE(on_kinks.find("(7 points on a kink of the period map"), std::string::npos);
+  const std::string off = stability_verdict("fronts", 3, 2, 0, 0, 1, 7);
+  EXPECT_EQ(off.find("unstable at 1 point "), 0u) << off;
+  EXPECT_EQ(stability_verdict("fronts", 0, 0, 0, 1, 1, 0).find("Jordan defect 1:"),
+            std::string("no multiplier off the unit circle; ").size());
+  EXPECT_EQ(stability_verdict("grid", 5, 0, 0, 0, 0, 0).find("projected grid: no verdict"), 0u);
 }
 
 }  // namespace
