@@ -892,11 +892,15 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
       const double nan = std::numeric_limits<double>::quiet_NaN();
       double excess = nan, det = nan, defect = nan;
       if (m.ok) {
-        excess = -1;
-        const Eigen::VectorXcd mu = Eigen::EigenSolver<Eigen::MatrixXd>(m.K, false).eigenvalues();
-        for (const auto& z : mu) excess = std::max(excess, std::abs(z) - 1);
+        const Eigen::EigenSolver<Eigen::MatrixXd> solver(m.K, false);
+        if (solver.info() == Eigen::Success) {
+          excess = -1;
+          for (const auto& z : solver.eigenvalues()) excess = std::max(excess, std::abs(z) - 1);
+          defect = jordan_defect(m.K);
+        } else {
+          fmt::print("  fronts.csv: point {}: K's eigenvalues did not converge\n", point.index);
+        }
         det = m.K.determinant();
-        defect = jordan_defect(m.K);
       }
       std::vector<double> row{static_cast<double>(point.index),
                               point.observable("energy"),

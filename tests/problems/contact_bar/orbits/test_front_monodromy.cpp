@@ -301,6 +301,23 @@ TEST(TdbemFronts, TheTdbemsKMatchesTheExactSolversTangent) {
 // of the period map: a front moved one way makes the grazing a contact, the other way not, and
 // the one-sided differences of the TD-BEM's K disagree by order 1 (1.0 measured). An interior
 // member's map is affine around it: the two agree to round-off over the step.
+// The multipliers' distance pairs the eigenvalues one to one at the smallest largest gap: for
+// {0.5, 0} against {0.4, 1} that is 0.5 (0.5 with 1, 0 with 0.4), where taking each nearest
+// in turn leaves 0 with 1. Exact in binary: diagonal matrices, eigenvalues their entries.
+TEST(TdbemFronts, TheMultipliersDistanceIsTheBottleneckPairing) {
+  Eigen::MatrixXd a = Eigen::Vector2d(0.5, 0.0).asDiagonal();
+  Eigen::MatrixXd b = Eigen::Vector2d(0.4, 1.0).asDiagonal();
+  EXPECT_DOUBLE_EQ(contact_bar::multiplier_distance(a, b), 0.5);
+  EXPECT_DOUBLE_EQ(contact_bar::multiplier_distance(b, a), 0.5);
+  // A rotation by 90 degrees (eigenvalues +-i) twice against the identity twice: sqrt 2.
+  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(4, 4);
+  r(0, 1) = -1, r(1, 0) = 1, r(2, 2) = 1, r(3, 3) = 1;
+  EXPECT_NEAR(contact_bar::multiplier_distance(r, Eigen::MatrixXd::Identity(4, 4)), std::sqrt(2.0),
+              1e-15);
+  EXPECT_EQ(contact_bar::multiplier_distance(a, a), 0);
+  EXPECT_TRUE(std::isinf(contact_bar::multiplier_distance(a, r)));
+}
+
 TEST(TdbemFronts, TheOneSidedDifferencesFindTheContinuumsGrazingKink) {
   const bar::BarSetup s = contact_bar_setup();
   const contact_bar::ContactFamily mode2(s.material, 1e-3, 2);
