@@ -264,10 +264,9 @@ bool perfect_matching(const std::vector<std::vector<int>>& adjacent, std::size_t
   return true;
 }
 
-// K's eigenvalues. A K near a permutation (fronts that return in another order, slightly moved)
-// can stall the shifted QR iteration (one point in 30 of a family attached to mode 1 at 80
-// intervals): it is retried once on Q K Q, Q a fixed Householder reflection, the same
-// eigenvalues in another Hessenberg form.
+// K's eigenvalues. The shifted QR iteration can stall on a K of the TD-BEM (one point of 30 on
+// the family attached to mode 1 at T = 3.5, 80 intervals): it is retried once on Q K Q, Q a
+// fixed Householder reflection, the same eigenvalues in another Hessenberg form.
 bool eigenvalues_of(const Eigen::MatrixXd& K, Eigen::VectorXcd& mu) {
   const Eigen::EigenSolver<Eigen::MatrixXd> first(K, false);
   if (first.info() == Eigen::Success) {
