@@ -61,7 +61,9 @@ double number_or_nan(const std::string& text) {
 
 // The frequency-energy figure of the fronts' runs: every point coloured by the Jordan defect
 // of its K (0: every multiplier on the circle with its eigenvectors; 1, 2: linear growth along
-// as many chains), an unstable point (none so far) circled.
+// as many chains), an unstable point circled, one with a multiplier off the circle on a kink of
+// the period map (the TD-BEM's one-sided K apart by over 1e-3: one side's K, not resolved) in a
+// square.
 void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path>& runs) {
   std::string curves;
   for (const fs::path& run : runs) {
@@ -76,9 +78,24 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
     const std::string branch = core::gnuplot_quote(run / "branch.csv");
     curves += fmt::format(
         "{}{} using 'energy':(2*pi/column('period')):(column('jordan_defect')+1) with "
-        "linespoints lc variable pt 7 ps 0.6 notitle, {} using 'energy':(column('stable')==0 ? "
-        "column('frequency') : NaN) with points pt 6 ps 2 lc 'black' notitle",
-        curves.empty() ? "plot " : ", ", fronts, branch);
+        "linespoints lc variable pt 7 ps 0.6 notitle",
+        curves.empty() ? "plot " : ", ", fronts);
+    const auto& columns = core::Table::read_csv(run / "fronts.csv").columns();
+    if (std::find(columns.begin(), columns.end(), "tdbem_kink") == columns.end()) {
+      curves += fmt::format(
+          ", {} using 'energy':(column('stable')==0 ? column('frequency') : NaN) with points pt 6 "
+          "ps 2 lc 'black' notitle",
+          branch);
+    } else {
+      const double tolerance =
+          number_or_nan(scene_value(scene_dir / "scene.ini", "floquet_tolerance"));
+      for (const auto& [test, style] :
+           {std::pair{"<=", "pt 6 ps 2 lc 'black'"}, std::pair{">", "pt 4 ps 1.6 lc 'gray40'"}})
+        curves += fmt::format(
+            ", {} using 'energy':(column('max_modulus_minus_one') > {:.17g} && "
+            "column('tdbem_kink') {} 1e-3 ? 2*pi/column('period') : NaN) with points {} notitle",
+            fronts, std::isfinite(tolerance) ? tolerance : 1e-4, test, style);
+    }
     // The first point of each run named, but the families attached to mode 1 (on top of it).
     if (name.find("resonances") == std::string::npos)
       curves += fmt::format(
@@ -90,14 +107,15 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
   curves +=
       ", NaN with points pt 7 lc 1 title 'Jordan defect 0 (neutral)', NaN with points pt 7 lc 2 "
       "title 'defect 1 (linear growth)', NaN with points pt 7 lc 3 title 'defect 2', NaN with "
-      "points pt 6 ps 2 lc 'black' title 'unstable (|mu| > 1 + tol)'";
+      "points pt 6 ps 2 lc 'black' title 'unstable (|mu| > 1 + tol)', NaN with points pt 4 ps 1.6 "
+      "lc 'gray40' title 'the same on a kink (not resolved)'";
   const core::PlotResult r = core::render_png(
       folder / "stability_backbones.png",
       "set datafile separator ','\nset key noenhanced\nset grid\nset logscale x\nset format x "
       "'%.0e'\nset xrange [1e-7:2e-2]\nset xlabel 'energy [J]'\nset ylabel 'frequency "
       "[rad/s]'\nset key outside right\n"
-      "set title 'Multipliers from the fronts: colour, the Jordan defect of K; circled, "
-      "unstable points'\n" +
+      "set title 'K of the fronts: colour, its Jordan defect; circle, unstable; square, on a "
+      "kink'\n" +
           curves + "\n");
   if (!r.ok) fmt::print("[figures] stability_backbones.png skipped: {}\n", r.message);
 }
