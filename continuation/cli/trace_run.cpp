@@ -277,11 +277,10 @@ void TraceReport::on_point(const continuation::BranchPoint& p) {
   if (p.dimension_flag != continuation::DimensionFlag::as_verified)
     fmt::print(stderr, "backbone trace: point {}: {}\n", p.index,
                continuation::dimension_warning(p));
-  dimension_flags_[static_cast<int>(p.dimension_flag)] += 1;
   // A verified dimension above the expected one is a finding, not noise: other families pass
-  // through the point (continuation/README.md, 'What a branch records'). Said where it changes.
+  // through the point (continuation/README.md, 'What a branch records'). Said where it changes;
+  // summary.txt counts such points (count_dimensions).
   if (p.dimension > t_.expected_dimension) {
-    ++dimension_above_;
     if (p.dimension != last_dimension_)
       fmt::print(stderr,
                  "backbone trace: point {}: verified dimension {} where the branch expects {} "
@@ -358,7 +357,7 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
   if (branch.points.empty()) return followed_complete;
   const core::Table table = core::Table::read_csv(t.out / "branch.csv");
   report.points_in_files = table.rows();
-  report.count_dimensions(table);
+  report.count_dimensions(table);  // the whole branch, a resumed run's saved points included
   if (t.setup.covered_dimension == 0)
     continuation::plot_branch(
         t.out, table,

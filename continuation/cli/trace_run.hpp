@@ -95,7 +95,7 @@ class TraceReport {
   TraceRun& t_;
   continuation::BranchWriter writer_;
   ProgressLine progress_;
-  long dimension_flags_[3] = {0, 0, 0};  // points per DimensionFlag (branch.hpp)
+  long dimension_flags_[3] = {0, 0, 0};  // branch.csv points per DimensionFlag (branch.hpp)
   long dimension_above_ = 0;             // points verified above the expected dimension
   int last_dimension_ = -1;              // the last point's verified dimension (-1: none yet)
 };

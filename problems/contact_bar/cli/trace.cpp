@@ -892,11 +892,11 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
       const double nan = std::numeric_limits<double>::quiet_NaN();
       double excess = nan, det = nan, defect = nan;
       if (m.ok) {
-        const Eigen::EigenSolver<Eigen::MatrixXd> solver(m.K, false);
-        if (solver.info() == Eigen::Success) {
+        Eigen::VectorXcd mu;
+        if (front_eigenvalues(m.K, mu)) {
           excess = -1;
-          for (const auto& z : solver.eigenvalues()) excess = std::max(excess, std::abs(z) - 1);
-          defect = jordan_defect(m.K);
+          for (const auto& z : mu) excess = std::max(excess, std::abs(z) - 1);
+          defect = jordan_defect(m.K, mu);
         } else {
           fmt::print("  fronts.csv: point {}: K's eigenvalues did not converge\n", point.index);
         }

@@ -84,11 +84,13 @@ TdbemFronts orbit_tdbem_front_monodromy(const ContactBarOrbitProblem& problem,
 }
 
 int jordan_defect(const Eigen::MatrixXd& K) {
+  Eigen::VectorXcd mu;
+  return front_eigenvalues(K, mu) ? jordan_defect(K, mu) : -1;
+}
+
+int jordan_defect(const Eigen::MatrixXd& K, const Eigen::VectorXcd& mu) {
   const auto n = K.rows();
   if (n == 0) return 0;
-  const Eigen::EigenSolver<Eigen::MatrixXd> solver(K, false);
-  if (solver.info() != Eigen::Success) return -1;
-  const Eigen::VectorXcd mu = solver.eigenvalues();
   const double scale = std::max(1.0, K.cwiseAbs().maxCoeff());
   std::vector<bool> done(static_cast<std::size_t>(n), false);
   int defect = 0;

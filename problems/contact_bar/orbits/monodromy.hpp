@@ -101,8 +101,9 @@ TdbemFronts orbit_tdbem_front_monodromy(const ContactBarOrbitProblem& problem,
 // eigenvectors (singular values of K - mu I under 1e-8 |K|, mu the cluster's mean), summed: a
 // positive defect is a Jordan block, along which a perturbation grows linearly in the number of
 // periods. The widths: K carries the traced orbit's error e (1e-10), which splits a Jordan
-// block of size 2 by sqrt(e) and leaves K - mu I a singular value of about e. -1 when the QR
-// iteration for K's eigenvalues does not converge.
+// block of size 2 by sqrt(e) and leaves K - mu I a singular value of about e. mu: K's
+// eigenvalues (front_eigenvalues); without them, -1 when they do not converge.
+int jordan_defect(const Eigen::MatrixXd& K, const Eigen::VectorXcd& mu);
 int jordan_defect(const Eigen::MatrixXd& K);
 
 // The check that needs no representation: the orbit's state plus a random perturbation (u and

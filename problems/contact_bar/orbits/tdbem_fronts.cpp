@@ -264,10 +264,9 @@ bool perfect_matching(const std::vector<std::vector<int>>& adjacent, std::size_t
   return true;
 }
 
-// K's eigenvalues. The shifted QR iteration can stall on a K of the TD-BEM (one point of 30 on
-// the family attached to mode 1 at T = 3.5, 80 intervals): it is retried once on Q K Q, Q a
-// fixed Householder reflection, the same eigenvalues in another Hessenberg form.
-bool eigenvalues_of(const Eigen::MatrixXd& K, Eigen::VectorXcd& mu) {
+}  // namespace
+
+bool front_eigenvalues(const Eigen::MatrixXd& K, Eigen::VectorXcd& mu) {
   const Eigen::EigenSolver<Eigen::MatrixXd> first(K, false);
   if (first.info() == Eigen::Success) {
     mu = first.eigenvalues();
@@ -284,12 +283,10 @@ bool eigenvalues_of(const Eigen::MatrixXd& K, Eigen::VectorXcd& mu) {
   return true;
 }
 
-}  // namespace
-
 double multiplier_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   if (a.rows() != b.rows()) return std::numeric_limits<double>::infinity();
   Eigen::VectorXcd x, y;
-  if (!eigenvalues_of(a, x) || !eigenvalues_of(b, y))
+  if (!front_eigenvalues(a, x) || !front_eigenvalues(b, y))
     return std::numeric_limits<double>::quiet_NaN();
   const std::size_t n = static_cast<std::size_t>(x.size());
   if (n == 0) return 0;

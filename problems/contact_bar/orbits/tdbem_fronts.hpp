@@ -55,6 +55,12 @@ struct TdbemFronts {
 TdbemFronts tdbem_front_monodromy(const bar::BarSetup& setup, double t0, double period, double dt,
                                   double relative_step = 1e-6);
 
+// The eigenvalues of a fronts' return map K (false when they do not converge). The shifted QR
+// iteration can stall on such a K (one point of 30 on the family attached to mode 1 at T = 3.5,
+// 80 intervals, by the TD-BEM): it is retried once on Q K Q, Q a fixed Householder reflection,
+// the same eigenvalues in another Hessenberg form.
+bool front_eigenvalues(const Eigen::MatrixXd& K, Eigen::VectorXcd& mu);
+
 // The bottleneck distance between the eigenvalues of `a` and of `b`: the smallest d such that
 // they pair off one to one within d (multiplicities count); infinity when the sizes differ, NaN
 // when the QR iteration for either's eigenvalues does not converge, even after a similarity.
