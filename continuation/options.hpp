@@ -50,6 +50,7 @@ struct Bound {
   std::string observable;
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
+  bool keyed = false;  // from the scene keys <observable>_min and _max, not a `bound` spec
 };
 
 // Branch points (branch_points.hpp, continuation/README.md, section 'Branch points').

@@ -137,7 +137,7 @@ void read_bounds(const core::Scene& scene, ContinuationOptions& o) {
     }
     const double lo = scene.values()[std::string(name) + "_min"].as<double>();
     const double hi = scene.values()[std::string(name) + "_max"].as<double>();
-    if (std::isfinite(lo) || std::isfinite(hi)) o.bounds.push_back({name, lo, hi});
+    if (std::isfinite(lo) || std::isfinite(hi)) o.bounds.push_back({name, lo, hi, true});
   }
   if (!scene.has("bound")) return;
   for (const std::string& spec : scene.values()["bound"].as<std::vector<std::string>>()) {

@@ -22,12 +22,10 @@ namespace backbone::cli {
 
 namespace {
 
-// The scene key a bound came from: OBSERVABLE_min / _max when the scene gives that key, else
+// The scene key a bound came from: OBSERVABLE_min / _max (given or at their default), else
 // `bound` (the NAME:MIN:MAX key).
-std::string bound_key(const core::Scene& scene, const std::string& observable, const char* side) {
-  const std::string key = observable + side;
-  const auto& values = scene.values();
-  return values.count(key) && !values[key].defaulted() ? key : "bound";
+std::string bound_key(const continuation::Bound& b, const char* side) {
+  return b.keyed ? b.observable + side : "bound";
 }
 
 // The value of observable `name` at the start; InputError naming `key` when the problem has no
@@ -45,11 +43,12 @@ double observable_at_start(const core::Observables& at_start, const std::string&
 
 // Every bound names an observable of the problem, and a fresh start lies inside every bound: a
 // start outside would end the branch at its first point.
-void check_bounds(const core::Scene& scene, const core::Problem& problem,
+void check_bounds(const core::Problem& problem,
                   const core::Observables& at_start,
                   const continuation::ContinuationOptions& options, bool restarting) {
   for (const continuation::Bound& b : options.bounds) {
-    const double start = observable_at_start(at_start, b.observable, "bound", problem);
+    const double start = observable_at_start(
+        at_start, b.observable, bound_key(b, std::isfinite(b.max) ? "_max" : "_min"), problem);
     if (restarting || !std::isfinite(start)) continue;
     // A start on a bound (within rounding of the guess) is a branch's own end, as at a grazing
     // limit; one beyond it by more is outside the window.
@@ -59,7 +58,7 @@ void check_bounds(const core::Scene& scene, const core::Problem& problem,
     if (beyond(b.min, -1) || beyond(b.max, 1)) {
       const bool below = beyond(b.min, -1);
       throw core::InputError(
-          bound_key(scene, b.observable, below ? "_min" : "_max"),
+          bound_key(b, below ? "_min" : "_max"),
           fmt::format("the starting orbit's {} {:.6g} lies {} {:g}: the branch would end at its "
                       "first point",
                       b.observable, start, below ? "below" : "above", below ? b.min : b.max));
@@ -168,7 +167,7 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
                                                  "residual has {} equations for {} unknowns "
                                                  "(use newton = eigen, least squares)",
                                                  entry.name, m, n));
-  check_bounds(scene, problem, at_start, options, t.restart.has_value());
+  check_bounds(problem, at_start, options, t.restart.has_value());
   check_natural_parameter(t.run, problem, at_start, t.periodic != nullptr);
   if (t.restart && !t.resume.empty() && !t.restart->note.empty()) {
     // The saved states belong to another run's loop: the folder keeps none of them.
