@@ -43,8 +43,7 @@ double observable_at_start(const core::Observables& at_start, const std::string&
 
 // Every bound names an observable of the problem, and a fresh start lies inside every bound: a
 // start outside would end the branch at its first point.
-void check_bounds(const core::Problem& problem,
-                  const core::Observables& at_start,
+void check_bounds(const core::Problem& problem, const core::Observables& at_start,
                   const continuation::ContinuationOptions& options, bool restarting) {
   for (const continuation::Bound& b : options.bounds) {
     const double start = observable_at_start(
@@ -196,10 +195,11 @@ void print_trace_header(TraceRun& t) {
                  ? " (covered by the problem's own outputs from the corrected start below)"
                  : "");
   const auto& restart = t.restart;
-  fmt::print("  {} continuation, {} predictor, newton {}, {}{}{}\n",
+  fmt::print("  {} continuation, {} predictor, newton {}, {}{}{}{}\n",
              continuation::to_string(options.method), continuation::to_string(options.predictor),
              t.corrector->name(),
              t.periodic ? fmt::format("formulation {}, ", core::scene_name(t.run.formulation)) : "",
+             t.setup.jacobian ? "jacobian " + t.setup.jacobian() + ", " : "",
              fmt::format("ds {:g} in [{:g}, {:g}], at most {} points", options.ds, options.ds_min,
                          options.ds_max, options.max_points),
              restart ? fmt::format(", restarting from point {} ({})", restart->index,
@@ -248,14 +248,15 @@ std::string TraceReport::summary(const std::string& status, const continuation::
   const core::Problem& problem = t_.problem();
   return fmt::format(
       "problem {}\nbranch {}\nstatus {}\nequations {}\nunknowns {}\nexpected_dimension {}\n"
-      "method {}\nnewton {}\nformulation {}\npoints {}\nrejected_corrections {}\n"
+      "method {}\nnewton {}\nformulation {}\njacobian {}\npoints {}\nrejected_corrections {}\n"
       "switch_index {}\nstop_reason {}\nmessage {}\ndimension_rechecked {}\n"
       "dimension_unconfirmed {}\ndimension_above_expected {}\n",
       t_.entry->name, t_.branch_name, status, problem.num_equations(), problem.num_unknowns(),
       t_.expected_dimension, continuation::to_string(t_.run.options.method), t_.corrector->name(),
-      t_.periodic ? core::scene_name(t_.run.formulation) : "-", points_in_files, rejected,
-      switch_index, branch ? continuation::to_string(branch->reason) : "-",
-      branch ? branch->message : "-", dimension_flags_[1], dimension_flags_[2], dimension_above_);
+      t_.periodic ? core::scene_name(t_.run.formulation) : "-",
+      t_.setup.jacobian ? t_.setup.jacobian() : "-", points_in_files, rejected, switch_index,
+      branch ? continuation::to_string(branch->reason) : "-", branch ? branch->message : "-",
+      dimension_flags_[1], dimension_flags_[2], dimension_above_);
 }
 
 void TraceReport::count_dimensions(const core::Table& branch_csv) {

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "core/io/scene_ini.hpp"
 #include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
@@ -66,6 +67,11 @@ TEST(TraceCli, TheSubharmonicContinuumIsTwoDimensionalWithEitherJacobian) {
     EXPECT_GE(dimensions.size(), 20u);
     for (std::size_t i = 0; i < dimensions.size(); ++i)
       EXPECT_EQ(dimensions[i], 2) << jacobian << " point " << i;
+    // The traced curve has path rows: its corrections take differences whatever was asked, and
+    // summary.txt says so (scene.ini keeps the key as given).
+    EXPECT_EQ(
+        backbone::core::read_text_value(out / "summary.txt", "jacobian"),
+        jacobian == "exact" ? "differences (exact applies without path rows)" : "differences");
     fs::remove_all(out);
   }
 }

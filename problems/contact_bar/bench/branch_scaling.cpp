@@ -94,9 +94,9 @@ std::string Mode1BranchSettings::label() const {
   if (study == "grid_unchecked") return fmt::format("N = {}, no rank checks", elements);
   if (study == "grid_stability") return fmt::format("N = {}, with multipliers", elements);
   if (study.starts_with("grid_exact"))
-    return fmt::format("N = {}, {} Jacobian{}", elements, jacobian,
-                       start_offset == 0.25 ? std::string()
-                                            : fmt::format(", from {} g0", 1 + start_offset));
+    return fmt::format(
+        "N = {}, {} Jacobian{}", elements, jacobian,
+        start_offset == 0.25 ? std::string() : fmt::format(", from {} g0", 1 + start_offset));
   std::string text = fmt::format("N = {}", elements);
   if (steps_per_period != 40) text += fmt::format(", steps_per_period = {}", steps_per_period);
   if (formulation != "regular") text += fmt::format(", {} formulation", formulation);
@@ -307,8 +307,8 @@ void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
   // these grids holds).
   for (int n : grids)
     for (const double start_offset : {0.25, 0.05})
-      for (const auto& [study, jacobian] : {std::pair{"grid_exact", "exact"},
-                                            std::pair{"grid_exact_differences", "differences"}}) {
+      for (const auto& [study, jacobian] :
+           {std::pair{"grid_exact", "exact"}, std::pair{"grid_exact_differences", "differences"}}) {
         Mode1BranchSettings s;
         s.study = study;
         s.elements = n;
@@ -499,14 +499,14 @@ std::string exact_verdict(const ScalingRuns& r) {
       if (e.settings.jacobian == "exact" && d.settings.jacobian == "differences" &&
           d.settings.elements == e.settings.elements &&
           d.settings.start_offset == e.settings.start_offset)
-        rows += fmt::format(
-            "{}N = {}{}: {} against {} ms per point, sigma_zero at most {} against {}",
-            rows.empty() ? "" : "; ", e.settings.elements,
-            e.settings.start_offset == 0.25
-                ? std::string()
-                : fmt::format(" from {} g0", 1 + e.settings.start_offset),
-            significant(e.ms_per_point()), significant(d.ms_per_point()),
-            error_text(e.sigma_zero), error_text(d.sigma_zero));
+        rows +=
+            fmt::format("{}N = {}{}: {} against {} ms per point, sigma_zero at most {} against {}",
+                        rows.empty() ? "" : "; ", e.settings.elements,
+                        e.settings.start_offset == 0.25
+                            ? std::string()
+                            : fmt::format(" from {} g0", 1 + e.settings.start_offset),
+                        significant(e.ms_per_point()), significant(d.ms_per_point()),
+                        error_text(e.sigma_zero), error_text(d.sigma_zero));
   return rows.empty() ? std::string()
                       : " With the exact Jacobian (`--jacobian exact`): " + rows + ".";
 }

@@ -582,6 +582,16 @@ bool ContactBarOrbitProblem::exact_jacobian_applies() const {
   return tdbem && tdbem->method() == ContactMethod::event;
 }
 
+std::string ContactBarOrbitProblem::jacobian_description() const {
+  if (exact_jacobian_applies()) return "exact";
+  if (!options_.exact_jacobian) return "differences";
+  if (formulation() != core::ShootingFormulation::half_period_velocity)
+    return "differences (exact applies to the regular formulation)";
+  if (path_rows_enabled_ && options_.path_rows() > 0)
+    return "differences (exact applies without path rows)";
+  return "differences (exact applies with the exact solver or the TD-BEM's event march)";
+}
+
 // The regular residual r_i = (L/c) / u_s int v(x, T/2) psi_i dx / m_i differentiated through
 // the exact solution (exact_bar, 'Tangent'): the unknowns move u0's knots (the free knots map
 // the grid) and values, and T moves the instant T/2.

@@ -168,6 +168,9 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // the exact solution's tangent; else finite differences (core::Problem).
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
   bool exact_jacobian_applies() const;
+  // Where the Jacobian comes from, for the trace's header and summary.txt: "exact",
+  // "differences", or "differences (...)" saying why the exact one does not apply.
+  std::string jacobian_description() const;
   // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
   double displacement_scale() const;
 
