@@ -118,8 +118,7 @@ ManifoldRun cover_subharmonic_manifold(const ContactBarOrbitProblem& problem,
                                        double energy_max, double shape_margin,
                                        const core::NewtonOptions& newton, double return_tolerance) {
   // F alone: the periodicity residual whose solutions form the 2D manifold.
-  ContactBarOrbitProblem f(problem.setup_template(), problem.solver(), problem.options());
-  f.set_path_rows(false);
+  const ContactBarOrbitProblem f = problem.without_path_rows();
   auto inside = [&](const core::Vector& x) {
     const core::Observables o = f.observables(x);
     const double e = observable(o, "energy"), shape = observable(o, "shape");

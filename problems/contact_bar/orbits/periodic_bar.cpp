@@ -577,6 +577,10 @@ bool ContactBarOrbitProblem::exact_jacobian_applies() const {
   if (!options_.exact_jacobian) return false;
   if (formulation() != core::ShootingFormulation::half_period_velocity) return false;
   if (path_rows_enabled_ && options_.path_rows() > 0) return false;
+  return exact_jacobian_applies_to_solver();
+}
+
+bool ContactBarOrbitProblem::exact_jacobian_applies_to_solver() const {
   if (solver_.name() == "exact") return true;
   const auto* tdbem = dynamic_cast<const TdbemSolver*>(&solver_);
   return tdbem && tdbem->method() == ContactMethod::event;
@@ -585,11 +589,20 @@ bool ContactBarOrbitProblem::exact_jacobian_applies() const {
 std::string ContactBarOrbitProblem::jacobian_description() const {
   if (exact_jacobian_applies()) return "exact";
   if (!options_.exact_jacobian) return "differences";
+  std::vector<std::string> reasons;
   if (formulation() != core::ShootingFormulation::half_period_velocity)
-    return "differences (exact applies to the regular formulation)";
-  if (path_rows_enabled_ && options_.path_rows() > 0)
-    return "differences (exact applies without path rows)";
-  return "differences (exact applies with the exact solver or the TD-BEM's event march)";
+    reasons.emplace_back("exact applies to the regular formulation");
+  if (!exact_jacobian_applies_to_solver())
+    reasons.emplace_back("exact applies with the exact solver or the TD-BEM's event march");
+  if (!reasons.empty()) return fmt::format("differences ({})", fmt::join(reasons, "; "));
+  // Only the path rows stand in the way: F alone (without_path_rows) takes the exact one.
+  return "differences for the curve (path rows); exact for F alone (rank reports, atlas)";
+}
+
+ContactBarOrbitProblem ContactBarOrbitProblem::without_path_rows() const {
+  ContactBarOrbitProblem alone = *this;
+  alone.set_path_rows(false);
+  return alone;
 }
 
 // The regular residual r_i = (L/c) / u_s int v(x, T/2) psi_i dx / m_i differentiated through

@@ -115,6 +115,8 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   }
   // Path rows on (default) or off: off, the residual is the periodicity residual F alone.
   void set_path_rows(bool enabled) { path_rows_enabled_ = enabled; }
+  // A copy (same solver, options and formulation) with path rows off: F alone.
+  ContactBarOrbitProblem without_path_rows() const;
   bool path_rows_enabled() const { return path_rows_enabled_; }
   // The subharmonic shape of x from the knots of its last two kinks (README.md, 'Subharmonic
   // continuum of mode J'): (1 - k_J) J / (2 - (2J - 1) (k_J - k_J-1)) with lengths in units of
@@ -169,7 +171,8 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
   bool exact_jacobian_applies() const;
   // Where the Jacobian comes from, for the trace's header and summary.txt: "exact",
-  // "differences", or "differences (...)" saying why the exact one does not apply.
+  // "differences", "differences (...)" saying why the exact one does not apply, or, when only
+  // the path rows stand in the way, that F alone (rank reports, the atlas) takes the exact one.
   std::string jacobian_description() const;
   // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
   double displacement_scale() const;
@@ -237,6 +240,8 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
 
  private:
   double gap() const;
+  // The solver has the exact tangent: the exact one, or the TD-BEM's event march.
+  bool exact_jacobian_applies_to_solver() const;
   core::Vector mode_guess(int mode, double ratio, core::Vector x) const;
   std::shared_ptr<const bar::BarSolver> owned_solver_;  // empty unless shared
   bar::BarSetup setup_;

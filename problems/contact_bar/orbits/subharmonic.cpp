@@ -99,9 +99,7 @@ void write_subharmonic_outputs(const ContactBarOrbitProblem& problem, const Cont
                                const continuation::Branch& branch, const std::filesystem::path& out,
                                double rank_threshold) {
   // The periodicity residual F without path rows.
-  ContactBarOrbitProblem alone(problem.setup_template(), problem.solver(), problem.options());
-  alone.set_path_rows(false);
-  alone.set_formulation(problem.formulation());
+  const ContactBarOrbitProblem alone = problem.without_path_rows();
   const exact_bar::ExactBarSolver oracle;
   core::RankOptions rank;
   const bool check = std::isfinite(rank_threshold);

@@ -315,5 +315,32 @@ TEST(SubharmonicRepresentation, PathRowsPickTheMember) {
   EXPECT_LT(r.lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
+// F alone keeps the formulation the curve was traced with: the atlas and the rank reports of F
+// alone (without_path_rows) solve that residual. Off the continuum (one value moved), the paper
+// and the regular residuals differ, so the rows must match the formulation's, to round-off.
+TEST(SubharmonicRepresentation, FAloneKeepsTheFormulation) {
+  const TdbemSolver tdbem(ContactMethod::event);
+  OrbitOptions o = on_wall(20, 2);
+  o.fixed_energy = 1.25e-5;
+  ContactBarOrbitProblem p(paper_setup({}), tdbem, o);
+  core::Vector x = p.subharmonic_guess(1.25e-5, 0.3);
+  x[3] *= 1.1;
+  core::Vector previous;
+  for (const auto f : {core::ShootingFormulation::displacement_periodicity,
+                       core::ShootingFormulation::half_period_velocity}) {
+    p.set_formulation(f);
+    const ContactBarOrbitProblem alone = p.without_path_rows();
+    EXPECT_EQ(alone.formulation(), f);
+    EXPECT_EQ(alone.num_equations(), p.num_equations() - 1);
+    core::Vector full, r;
+    ASSERT_EQ(p.residual(x, full), core::EvalStatus::ok);
+    ASSERT_EQ(alone.residual(x, r), core::EvalStatus::ok);
+    EXPECT_GT(r.lpNorm<Eigen::Infinity>(), 1e-3);
+    EXPECT_EQ(r, full.head(r.size()));
+    if (previous.size() == r.size()) EXPECT_GT((r - previous).lpNorm<Eigen::Infinity>(), 1e-3);
+    previous = r;
+  }
+}
+
 }  // namespace
 }  // namespace backbone::contact_bar
