@@ -50,7 +50,10 @@ struct Bound {
   std::string observable;
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
-  bool keyed = false;  // from the scene keys <observable>_min and _max, not a `bound` spec
+  // The scene keys the sides come from, for a start outside the bound: <observable>_min and
+  // _max, `bound` (a NAME:MIN:MAX spec), a problem's own (the impact oscillator's wall_min and
+  // wall_max); empty for a side a problem derives (the observable's name is said instead).
+  std::string min_key = {}, max_key = {};
 };
 
 // Branch points (branch_points.hpp, continuation/README.md, section 'Branch points').

@@ -137,7 +137,8 @@ void read_bounds(const core::Scene& scene, ContinuationOptions& o) {
     }
     const double lo = scene.values()[std::string(name) + "_min"].as<double>();
     const double hi = scene.values()[std::string(name) + "_max"].as<double>();
-    if (std::isfinite(lo) || std::isfinite(hi)) o.bounds.push_back({name, lo, hi, true});
+    if (std::isfinite(lo) || std::isfinite(hi))
+      o.bounds.push_back({name, lo, hi, std::string(name) + "_min", std::string(name) + "_max"});
   }
   if (!scene.has("bound")) return;
   for (const std::string& spec : scene.values()["bound"].as<std::vector<std::string>>()) {
@@ -148,6 +149,7 @@ void read_bounds(const core::Scene& scene, ContinuationOptions& o) {
       throw core::InputError("bound", fmt::format("'{}' is not NAME:MIN:MAX", spec));
     Bound b;
     b.observable = spec.substr(0, first);
+    b.min_key = b.max_key = "bound";
     b.min = bound_value(spec.substr(first + 1, second - first - 1),
                         -std::numeric_limits<double>::infinity(), spec);
     b.max = bound_value(spec.substr(second + 1), std::numeric_limits<double>::infinity(), spec);

@@ -22,10 +22,10 @@ namespace backbone::cli {
 
 namespace {
 
-// The scene key a bound came from: OBSERVABLE_min / _max (given or at their default), else
-// `bound` (the NAME:MIN:MAX key).
-std::string bound_key(const continuation::Bound& b, const char* side) {
-  return b.keyed ? b.observable + side : "bound";
+// The scene key a side of a bound came from (continuation::Bound), else its observable's name.
+std::string bound_key(const continuation::Bound& b, bool max_side) {
+  const std::string& key = max_side ? b.max_key : b.min_key;
+  return key.empty() ? b.observable : key;
 }
 
 // The value of observable `name` at the start; InputError naming `key` when the problem has no
@@ -46,8 +46,8 @@ double observable_at_start(const core::Observables& at_start, const std::string&
 void check_bounds(const core::Problem& problem, const core::Observables& at_start,
                   const continuation::ContinuationOptions& options, bool restarting) {
   for (const continuation::Bound& b : options.bounds) {
-    const double start = observable_at_start(
-        at_start, b.observable, bound_key(b, std::isfinite(b.max) ? "_max" : "_min"), problem);
+    const double start =
+        observable_at_start(at_start, b.observable, bound_key(b, std::isfinite(b.max)), problem);
     if (restarting || !std::isfinite(start)) continue;
     // A start on a bound (within rounding of the guess) is a branch's own end, as at a grazing
     // limit; one beyond it by more is outside the window.
@@ -57,7 +57,7 @@ void check_bounds(const core::Problem& problem, const core::Observables& at_star
     if (beyond(b.min, -1) || beyond(b.max, 1)) {
       const bool below = beyond(b.min, -1);
       throw core::InputError(
-          bound_key(b, below ? "_min" : "_max"),
+          bound_key(b, !below),
           fmt::format("the starting orbit's {} {:.6g} lies {} {:g}: the branch would end at its "
                       "first point",
                       b.observable, start, below ? "below" : "above", below ? b.min : b.max));

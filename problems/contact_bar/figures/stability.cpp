@@ -80,7 +80,8 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
         "{}{} using 'energy':(2*pi/column('period')):(column('jordan_defect')+1) with "
         "linespoints lc variable pt 7 ps 0.6 notitle",
         curves.empty() ? "plot " : ", ", fronts);
-    const auto& columns = core::Table::read_csv(run / "fronts.csv").columns();
+    const core::Table table = core::Table::read_csv(run / "fronts.csv");
+    const auto& columns = table.columns();
     if (std::find(columns.begin(), columns.end(), "tdbem_kink") == columns.end()) {
       curves += fmt::format(
           ", {} using 'energy':(column('stable')==0 ? column('frequency') : NaN) with points pt 6 "

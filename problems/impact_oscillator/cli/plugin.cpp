@@ -63,7 +63,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
   s.direction = core::Vector::Unit(3, 2);  // the free parameter grows
   s.branch_options = [wall_min, wall_max, free, grazing_velocity, grazing_gap](
                          cli::ContinuationOptions& continuation, core::NewtonOptions&) {
-    if (free == "wall") continuation.bounds.push_back({"wall", wall_min, wall_max});
+    if (free == "wall")
+      continuation.bounds.push_back({"wall", wall_min, wall_max, "wall_min", "wall_max"});
     const double inf = std::numeric_limits<double>::infinity();
     continuation.bounds.push_back({"impact_velocity", grazing_velocity, inf});
     continuation.bounds.push_back({"wall_gap", grazing_gap, inf});
