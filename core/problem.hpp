@@ -128,6 +128,10 @@ class Problem {
     return std::nullopt;
   }
 
+  // Where compute_jacobian's matrix comes from, for the reports (the trace's header and
+  // summary.txt's `jacobian`): "differences" (the default's), or the override's own words.
+  virtual std::string jacobian_description() const { return "differences"; }
+
   const EvaluationCounters& counters() const { return counters_; }
   void reset_counters() const { counters_.reset(); }
 

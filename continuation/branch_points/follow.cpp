@@ -176,9 +176,11 @@ std::vector<FollowedBranch> follow_branch_points(
     core::write_text_atomically(
         dir / "summary.txt",
         fmt::format(
-            "branch_point {}\npoints {}\nstart_probe {}\nattempts {}\nstop_reason {}\nmessage {}\n",
+            "branch_point {}\npoints {}\nstart_probe {}\nattempts {}\nstop_reason {}\nmessage "
+            "{}\njacobian {}\n",
             k, f.branch.points.size(), f.start ? f.start->probe : -1, f.attempts,
-            f.branch.points.empty() ? "-" : to_string(f.branch.reason), f.message));
+            f.branch.points.empty() ? "-" : to_string(f.branch.reason), f.message,
+            problem.jacobian_description()));
     followed.push_back(std::move(f));
   }
   return followed;

@@ -79,10 +79,6 @@ struct TraceSetup {
   // state it, and the traced branch, only the corrected start the covering grows from, gets no
   // branch.png. 0: the dimension the sizes give.
   int covered_dimension = 0;
-  // Optional: where the problem's Jacobian comes from (e.g. "exact", or "differences" and why),
-  // asked once the run's settings are applied to the problem (its formulation); said on the
-  // header's settings line and as summary.txt's `jacobian` ("-" without it).
-  std::function<std::string()> jacobian;
   // Applies branch_options (when set) to the settings a run read from its scene and checks
   // them: what every runner of a trace (trace, the benchmarks) does before making its corrector.
   void apply_branch_options(ContinuationOptions& options, core::NewtonOptions& newton) const;

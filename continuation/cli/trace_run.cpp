@@ -199,7 +199,7 @@ void print_trace_header(TraceRun& t) {
              continuation::to_string(options.method), continuation::to_string(options.predictor),
              t.corrector->name(),
              t.periodic ? fmt::format("formulation {}, ", core::scene_name(t.run.formulation)) : "",
-             t.setup.jacobian ? "jacobian " + t.setup.jacobian() + ", " : "",
+             "jacobian " + t.problem().jacobian_description() + ", ",
              fmt::format("ds {:g} in [{:g}, {:g}], at most {} points", options.ds, options.ds_min,
                          options.ds_max, options.max_points),
              restart ? fmt::format(", restarting from point {} ({})", restart->index,
@@ -253,8 +253,8 @@ std::string TraceReport::summary(const std::string& status, const continuation::
       "dimension_unconfirmed {}\ndimension_above_expected {}\n",
       t_.entry->name, t_.branch_name, status, problem.num_equations(), problem.num_unknowns(),
       t_.expected_dimension, continuation::to_string(t_.run.options.method), t_.corrector->name(),
-      t_.periodic ? core::scene_name(t_.run.formulation) : "-",
-      t_.setup.jacobian ? t_.setup.jacobian() : "-", points_in_files, rejected, switch_index,
+      t_.periodic ? core::scene_name(t_.run.formulation) : "-", problem.jacobian_description(),
+      points_in_files, rejected, switch_index,
       branch ? continuation::to_string(branch->reason) : "-", branch ? branch->message : "-",
       dimension_flags_[1], dimension_flags_[2], dimension_above_);
 }

@@ -187,6 +187,9 @@ class HybridOrbitProblem : public Problem, public FloquetProblem {
   HybridOrbitProblem(const HybridOrbitProblem& other);
   EvalStatus compute_residual(const Vector& x, Vector& r) const override;
   EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override;
+  std::string jacobian_description() const override {
+    return "variational (the monodromy with saltation); the phase row by central differences";
+  }
   // A subclass that changes the system after construction calls this (the cache is stale).
   void forget_last_shot() const;
 

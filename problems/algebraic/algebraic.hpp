@@ -41,6 +41,7 @@ class FoldCurve : public core::Problem {
  protected:
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
+  std::string jacobian_description() const override { return "analytic"; }
 };
 
 // |x|^2 - radius^2 = 0 in R^dimension (dimension 2: circle, 3: sphere).
@@ -56,6 +57,7 @@ class QuadricSurface : public core::Problem {
  protected:
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
+  std::string jacobian_description() const override { return "analytic"; }
 
  private:
   int ambient_dimension_;
@@ -83,6 +85,7 @@ class RepeatedRows : public core::Problem {
  protected:
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
+  std::string jacobian_description() const override { return "analytic"; }
   // The `rows` equations and their Jacobian once.
   virtual void rows(const core::Vector& x, core::Vector& r) const = 0;
   virtual void rows_jacobian(const core::Vector& x, core::Matrix& J) const = 0;

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/io/scene_ini.hpp"
 #include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
@@ -241,6 +242,8 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   const fs::path dir = out / ("branch_point_" + std::to_string(row + 1));
   for (const char* file : {"branch.csv", "orbits.csv", "unknowns.csv", "summary.txt"})
     EXPECT_TRUE(fs::exists(dir / file)) << file;
+  // The followed family is corrected with the trace's Jacobian (the scene's default, exact).
+  EXPECT_EQ(backbone::core::read_text_value(dir / "summary.txt", "jacobian"), "exact");
   const Table b = Table::read_csv(dir / "branch.csv");
   ASSERT_GE(b.rows(), 5u);
   const auto period = b.column("period"), energy = b.column("energy");

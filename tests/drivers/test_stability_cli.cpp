@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <string>
 
+#include "core/io/scene_ini.hpp"
 #include "core/io/table.hpp"
 #include "tests/drivers/cli_run.hpp"
 
@@ -72,6 +73,10 @@ TEST(StabilityFiles, ImpactOscillatorBranchWritesItsMultipliersAndBifurcations) 
   ASSERT_EQ(found.rows(), 1u);
   EXPECT_EQ(found.text_column("type")[0], "grazing");
   EXPECT_TRUE(fs::exists(out / "branch.png"));
+  // The hybrid orbit's Jacobian is its own (HybridOrbitProblem::compute_jacobian), not the
+  // default differences, and summary.txt says so.
+  EXPECT_TRUE(
+      backbone::core::read_text_value(out / "summary.txt", "jacobian").starts_with("variational"));
 }
 
 // Stability off: the same branch without the files or columns.
@@ -82,6 +87,8 @@ TEST(StabilityFiles, StabilityOffWritesNoMultipliers) {
   EXPECT_FALSE(fs::exists(out / "multipliers.csv"));
   const backbone::core::Table branch = backbone::core::Table::read_csv(out / "branch.csv");
   EXPECT_EQ(std::count(branch.columns().begin(), branch.columns().end(), "stable"), 0);
+  // Duffing's shooting Jacobian is the default finite differences.
+  EXPECT_EQ(backbone::core::read_text_value(out / "summary.txt", "jacobian"), "differences");
 }
 
 // The bar's mode 2 with K also by the TD-BEM's own march: every point has both, and they agree

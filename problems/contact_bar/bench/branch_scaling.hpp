@@ -1,10 +1,11 @@
 // What a whole mode-1 branch costs against the error it reaches (bench case mode1_scaling,
 // bench.hpp): the mode-1 trace of the paper scene (scenes/paper.ini, `--branch mode1
-// --start_offset 0.25 --energy_max 5e-3 --shooting_elements N`, T 3.8 -> 3.01), run in-process
-// as `backbone trace` runs it, once per setting (grid N, steps per period, formulation, corrector,
-// threads). Each run is timed (process CPU and wall seconds), counted (points, Jacobians) and
-// checked against ContactFamily's closed form at every point's own energy, as the trace's
-// describe_point does. Beside it: the finite-difference Jacobian alone with 1 and 2 threads.
+// --start_offset 0.25 --energy_max 5e-3 --shooting_elements N`, T 3.8 -> 3.01; the exact-Jacobian
+// study also from --start_offset 0.05, T 83/21 -> 3.01), run in-process as `backbone trace` runs
+// it, once per setting (grid N, steps per period, formulation, corrector, threads, start). Each run
+// is timed (process CPU and wall seconds), counted (points, Jacobians) and checked against
+// ContactFamily's closed form at every point's own energy, as the trace's describe_point does.
+// Beside it: the finite-difference Jacobian alone with 1 and 2 threads.
 //
 //   Mode1BranchSettings s;  s.elements = 40;  s.steps_per_period = 80;
 //   const Mode1BranchCost c = trace_mode1_cost(s);    // c.points, c.cpu_seconds, c.worst_error
@@ -65,10 +66,10 @@ Mode1BranchCost trace_mode1_cost(const Mode1BranchSettings& settings);
 // True when both branches have the same points, every unknown equal bit for bit.
 bool same_branch(const Mode1BranchCost& a, const Mode1BranchCost& b);
 
-// The rows of mode1_scaling.csv: study, setting, N, steps_per_period, formulation, newton,
-// test_elements, threads, points,
-// jacobians_per_point, ms_per_point (CPU), total_seconds (CPU), wall_seconds,
-// worst_closed_form_error, median_closed_form_error, energy_reached, complete (1 or 0).
+// The rows of mode1_scaling.csv: study, setting, start_offset, N, steps_per_period, formulation,
+// newton, test_elements, threads, points, jacobians_per_point, ms_per_point (CPU), total_seconds
+// (CPU), wall_seconds, worst_closed_form_error, median_closed_form_error, energy_reached,
+// complete (1 or 0), jacobian, sigma_zero_max.
 core::Table branch_cost_table(const std::vector<Mode1BranchCost>& runs);
 
 // Least-squares exponent p of ms_per_point ~ C N^p over the runs with N >= min_elements

@@ -956,8 +956,6 @@ cli::TraceSetup setup_trace_with_reports(const core::Scene& scene, const std::st
           fmt::format("needs {} (the TD-BEM's own K from the orbit's fronts)", missing));
   }
   cli::TraceSetup s = setup_trace(scene, branch);
-  if (const auto* p = dynamic_cast<const ContactBarOrbitProblem*>(s.problem.get()))
-    s.jacobian = [p] { return p->jacobian_description(); };
   if (scene.flag("stability")) add_front_report(s, tdbem_check);
   return s;
 }

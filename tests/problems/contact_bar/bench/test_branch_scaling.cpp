@@ -70,15 +70,31 @@ TEST(ContactBarBranchScaling, TinyBranchesGiveTheTableColumnsAndTheClosedForm) {
   EXPECT_FALSE(contact_bar::same_branch(runs[0], runs[1]));  // other grid, other unknowns
 
   const core::Table t = contact_bar::branch_cost_table(runs);
-  EXPECT_EQ(t.columns(), (std::vector<std::string>{
-                             "study", "setting", "N", "steps_per_period", "formulation", "newton",
-                             "test_elements", "threads", "points", "jacobians_per_point",
-                             "ms_per_point", "total_seconds", "wall_seconds",
-                             "worst_closed_form_error", "median_closed_form_error",
-                             "energy_reached", "complete", "jacobian", "sigma_zero_max"}));
+  EXPECT_EQ(t.columns(), (std::vector<std::string>{"study",
+                                                   "setting",
+                                                   "start_offset",
+                                                   "N",
+                                                   "steps_per_period",
+                                                   "formulation",
+                                                   "newton",
+                                                   "test_elements",
+                                                   "threads",
+                                                   "points",
+                                                   "jacobians_per_point",
+                                                   "ms_per_point",
+                                                   "total_seconds",
+                                                   "wall_seconds",
+                                                   "worst_closed_form_error",
+                                                   "median_closed_form_error",
+                                                   "energy_reached",
+                                                   "complete",
+                                                   "jacobian",
+                                                   "sigma_zero_max"}));
   ASSERT_EQ(t.rows(), 2u);
   EXPECT_EQ(t.text_column("setting"), (std::vector<std::string>{"N = 10", "N = 20"}));
   EXPECT_EQ(t.column("N"), (std::vector<double>{10, 20}));
+  EXPECT_EQ(t.column("start_offset"),
+            (std::vector<double>{runs[0].settings.start_offset, runs[1].settings.start_offset}));
   EXPECT_EQ(t.column("points")[1], runs[1].points);
   EXPECT_DOUBLE_EQ(t.column("ms_per_point")[1], 1e3 * runs[1].cpu_seconds / runs[1].points);
   EXPECT_EQ(t.column("complete"), (std::vector<double>{1, 1}));

@@ -337,7 +337,9 @@ TEST(SubharmonicRepresentation, FAloneKeepsTheFormulation) {
     ASSERT_EQ(alone.residual(x, r), core::EvalStatus::ok);
     EXPECT_GT(r.lpNorm<Eigen::Infinity>(), 1e-3);
     EXPECT_EQ(r, full.head(r.size()));
-    if (previous.size() == r.size()) EXPECT_GT((r - previous).lpNorm<Eigen::Infinity>(), 1e-3);
+    if (previous.size() == r.size()) {
+      EXPECT_GT((r - previous).lpNorm<Eigen::Infinity>(), 1e-3);
+    }
     previous = r;
   }
 }
