@@ -107,6 +107,32 @@ TEST(StabilityFiles, BarModeTwoWritesTheTdbemsKBesideTheExactOne) {
   for (const double ok : fronts.column("tdbem_ok")) EXPECT_EQ(ok, 1.0);
   for (const double d : fronts.column("tdbem_k_difference")) EXPECT_LT(d, 1e-6);
   for (const double n : fronts.column("fronts")) EXPECT_EQ(n, 3.0);
+  for (const double g : fronts.column("grazing_instants")) EXPECT_EQ(g, 0.0);
+}
+
+// The subharmonic continuum at one energy starts on a grazing limit (shape 1: the end touches
+// the wall once without a phase): fronts.csv's grazing_instants, by the exact solver, says 1
+// there and 0 inside, where the TD-BEM's one-sided differences agree (tdbem_kink of order 1 on
+// the grazing, round-off inside: below 1e-3, the threshold the verdict takes).
+TEST(StabilityFiles, TheContinuumsGrazingLimitIsFlaggedWithoutTheTdbem) {
+  const fs::path out = cli::scratch("stability_cli", "continuum_grazing");
+  const cli::Run r = cli::run("trace",
+                              paper +
+                                  " --branch subharmonic_continuum --energy 1e-3 "
+                                  "--shooting_elements 20 --stability true "
+                                  "--stability_tdbem_check true",
+                              out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const backbone::core::Table fronts = backbone::core::Table::read_csv(out / "fronts.csv");
+  ASSERT_GT(fronts.rows(), 10u);
+  const auto grazing = fronts.column("grazing_instants"), kink = fronts.column("tdbem_kink");
+  EXPECT_EQ(grazing[0], 1.0);
+  EXPECT_GT(kink[0], 0.1);
+  for (std::size_t i = 1; i < grazing.size(); ++i) {
+    EXPECT_EQ(grazing[i], 0.0) << i;
+    EXPECT_LT(kink[i], 1e-3) << i;
+  }
+  fs::remove_all(out);
 }
 
 TEST(StabilityInput, TdbemCheckNeedsTheTdbemAndTheFronts) {

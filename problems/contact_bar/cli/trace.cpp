@@ -868,6 +868,14 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
 
 }  // namespace
 
+// The instants per period where the orbit's end reaches the wall and leaves it without a contact
+// phase (contact_structure, by the exact solver): a kink of the period map, where K is one
+// side's. NaN where the exact simulation fails.
+double grazing_instants(const ContactBarOrbitProblem& p, const core::Vector& x) {
+  const ContactStructure c = contact_structure(p.setup_at(x), p.period(x));
+  return c.ok ? c.grazing_instants : std::numeric_limits<double>::quiet_NaN();
+}
+
 // With the fronts representation, fronts.csv beside the branch: per point the isolated
 // multipliers' matrix K's checks and its Jordan defect (monodromy.hpp; README.md of orbits/,
 // 'Stability').
@@ -878,10 +886,19 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
   s.write_extra_outputs = [p, tdbem_check, inner = std::move(s.write_extra_outputs)](
                               const std::filesystem::path& out, const continuation::Branch& b) {
     if (inner) inner(out, b);
-    std::vector<std::string> columns{"point",       "energy",         "period",
-                                     "ok",          "fronts",         "max_modulus_minus_one",
-                                     "determinant", "jordan_defect",  "time_shift_error",
-                                     "value_leak",  "isometry_error", "return_error"};
+    std::vector<std::string> columns{"point",
+                                     "energy",
+                                     "period",
+                                     "ok",
+                                     "fronts",
+                                     "max_modulus_minus_one",
+                                     "determinant",
+                                     "jordan_defect",
+                                     "time_shift_error",
+                                     "value_leak",
+                                     "isometry_error",
+                                     "return_error",
+                                     "grazing_instants"};
     if (tdbem_check)
       columns.insert(columns.end(), {"tdbem_ok", "tdbem_kink", "tdbem_k_difference",
                                      "tdbem_multiplier_difference"});
@@ -913,7 +930,8 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
                               m.ok ? m.time_shift_error : nan,
                               m.ok ? m.value_leak : nan,
                               m.ok ? m.isometry_error : nan,
-                              m.ok ? m.return_error : nan};
+                              m.ok ? m.return_error : nan,
+                              grazing_instants(*p, point.x)};
       if (tdbem_check) {
         const TdbemFronts t = orbit_tdbem_front_monodromy(*p, point.x);
         const bool both = m.ok && t.ok && t.K.rows() == m.K.rows();
