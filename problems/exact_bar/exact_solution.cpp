@@ -283,6 +283,9 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
           continue;
         }
         if (sc >= len - tol) {
+          // The end reaches its wall at the segment's end (a front arrives there): a kink.
+          if (sc <= len + tol && global_time(k, s.r1) <= t_end_ + tol)
+            closings_on_fronts_.push_back(global_time(k, s.r1));
           emit_to(s.r1, nullptr, false, false);
           break;
         }

@@ -128,6 +128,10 @@ class ExactBarSolution {
 
   // Closed-contact episodes starting before t_end, in time order (empty for non-contact ends).
   std::vector<ContactInterval> contact_intervals() const;
+  // The instants in [0, t_end] where an open end reaches a wall exactly (to the march's snap,
+  // 64 eps tau) as a front arrives: it closes there, or grazes it and leaves. They are the
+  // kinks of the solution map; a tangent through one is the side the march resolved.
+  const std::vector<double>& closings_on_fronts() const { return closings_on_fronts_; }
   std::vector<ContactInterval> contact_intervals(Side side) const;
 
   // The field on the uniform grid of request.elements intervals at time t; every projection
@@ -235,6 +239,7 @@ class ExactBarSolution {
   Chunked<EndSegment> left_, right_;
   bool ok_ = true;
   std::string message_;
+  std::vector<double> closings_on_fronts_;  // global times, per end in march order
   // Tangent: its seed, its size n (0: none), the segments' derivatives beside a_ and b_sig_.
   InitialTangent seed_;
   int tangent_size_ = 0;

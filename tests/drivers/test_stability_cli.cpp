@@ -108,12 +108,14 @@ TEST(StabilityFiles, BarModeTwoWritesTheTdbemsKBesideTheExactOne) {
   for (const double d : fronts.column("tdbem_k_difference")) EXPECT_LT(d, 1e-6);
   for (const double n : fronts.column("fronts")) EXPECT_EQ(n, 3.0);
   for (const double g : fronts.column("grazing_instants")) EXPECT_EQ(g, 0.0);
+  for (const double g : fronts.column("closings_on_fronts")) EXPECT_EQ(g, 0.0);
 }
 
 // The subharmonic continuum at one energy starts on a grazing limit (shape 1: the end touches
-// the wall once without a phase): fronts.csv's grazing_instants, by the exact solver, says 1
-// there and 0 inside, where the TD-BEM's one-sided differences agree (tdbem_kink of order 1 on
-// the grazing, round-off inside: below 1e-3, the threshold the verdict takes).
+// the wall once without a phase, as a front arrives): fronts.csv's grazing_instants and
+// closings_on_fronts, by the exact solver, say 1 there and 0 inside, where the TD-BEM's one-sided
+// differences agree (tdbem_kink of order 1 on the grazing, round-off inside: below 1e-3, the
+// threshold the verdict takes).
 TEST(StabilityFiles, TheContinuumsGrazingLimitIsFlaggedWithoutTheTdbem) {
   const fs::path out = cli::scratch("stability_cli", "continuum_grazing");
   const cli::Run r = cli::run("trace",
@@ -126,10 +128,13 @@ TEST(StabilityFiles, TheContinuumsGrazingLimitIsFlaggedWithoutTheTdbem) {
   const backbone::core::Table fronts = backbone::core::Table::read_csv(out / "fronts.csv");
   ASSERT_GT(fronts.rows(), 10u);
   const auto grazing = fronts.column("grazing_instants"), kink = fronts.column("tdbem_kink");
+  const auto on_fronts = fronts.column("closings_on_fronts");
   EXPECT_EQ(grazing[0], 1.0);
+  EXPECT_EQ(on_fronts[0], 1.0);
   EXPECT_GT(kink[0], 0.1);
   for (std::size_t i = 1; i < grazing.size(); ++i) {
     EXPECT_EQ(grazing[i], 0.0) << i;
+    EXPECT_EQ(on_fronts[i], 0.0) << i;
     EXPECT_LT(kink[i], 1e-3) << i;
   }
   fs::remove_all(out);

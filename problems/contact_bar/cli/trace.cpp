@@ -868,14 +868,6 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
 
 }  // namespace
 
-// The instants per period where the orbit's end reaches the wall and leaves it without a contact
-// phase (contact_structure, by the exact solver): a kink of the period map, where K is one
-// side's. NaN where the exact simulation fails.
-double grazing_instants(const ContactBarOrbitProblem& p, const core::Vector& x) {
-  const ContactStructure c = contact_structure(p.setup_at(x), p.period(x));
-  return c.ok ? c.grazing_instants : std::numeric_limits<double>::quiet_NaN();
-}
-
 // With the fronts representation, fronts.csv beside the branch: per point the isolated
 // multipliers' matrix K's checks and its Jordan defect (monodromy.hpp; README.md of orbits/,
 // 'Stability').
@@ -898,13 +890,19 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
                                      "value_leak",
                                      "isometry_error",
                                      "return_error",
-                                     "grazing_instants"};
+                                     "grazing_instants",
+                                     "closings_on_fronts"};
     if (tdbem_check)
       columns.insert(columns.end(), {"tdbem_ok", "tdbem_kink", "tdbem_k_difference",
                                      "tdbem_multiplier_difference"});
     core::Table table(columns);
     for (const auto& point : b.points) {
       const exact_bar::FrontMonodromy m = orbit_front_monodromy(*p, point.x);
+      // Grazings and closings on fronts, by the exact solver (kinks, where K is one side's).
+      const bar::BarSetup setup = p->setup_at(point.x);
+      const ContactStructure structure = setup.right.has_wall() && setup.right.gap > 0
+                                             ? contact_structure(setup, p->period(point.x))
+                                             : ContactStructure{};
       if (!m.ok) fmt::print("  fronts.csv: point {} has no K: {}\n", point.index, m.message);
       const double nan = std::numeric_limits<double>::quiet_NaN();
       double excess = nan, det = nan, defect = nan;
@@ -931,7 +929,8 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
                               m.ok ? m.value_leak : nan,
                               m.ok ? m.isometry_error : nan,
                               m.ok ? m.return_error : nan,
-                              grazing_instants(*p, point.x)};
+                              structure.ok ? structure.grazing_instants : nan,
+                              structure.ok ? structure.closings_on_fronts : nan};
       if (tdbem_check) {
         const TdbemFronts t = orbit_tdbem_front_monodromy(*p, point.x);
         const bool both = m.ok && t.ok && t.K.rows() == m.K.rows();

@@ -25,6 +25,7 @@ ContactStructure contact_structure(const bar::BarSetup& setup, double period) {
   const exact_bar::ExactBarSolution sol(setup, period);
   if (!sol.ok()) return result;
   result.ok = true;
+  result.closings_on_fronts = static_cast<int>(sol.closings_on_fronts().size());
   const double g0 = setup.right.gap, tol = 1e-9 * period;
   const auto intervals = sol.contact_intervals(exact_bar::Side::right);
   // The phases on one wall; a phase through t = 0 = T appears as [0, a) and [T - a', T): one
