@@ -69,6 +69,7 @@ class ScaledProblem : public core::Problem {
   int num_unknowns() const override { return base_.num_unknowns(); }
   int num_equations() const override { return base_.num_equations(); }
   std::string name() const override { return base_.name(); }
+  std::string jacobian_description() const override { return base_.jacobian_description(); }
   core::Observables observables(const core::Vector& z) const override {
     return base_.observables(to_unknowns(z));
   }

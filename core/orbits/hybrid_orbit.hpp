@@ -187,8 +187,12 @@ class HybridOrbitProblem : public Problem, public FloquetProblem {
   HybridOrbitProblem(const HybridOrbitProblem& other);
   EvalStatus compute_residual(const Vector& x, Vector& r) const override;
   EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override;
+  // The monodromy with saltation (variational); a forced system's dT/dp, or an autonomous one's
+  // phase row, by central differences.
   std::string jacobian_description() const override {
-    return "variational (the monodromy with saltation); the phase row by central differences";
+    return forced() ? "variational (the monodromy with saltation); dT/dp by central differences"
+                    : "variational (the monodromy with saltation); the phase row by central "
+                      "differences";
   }
   // A subclass that changes the system after construction calls this (the cache is stale).
   void forget_last_shot() const;

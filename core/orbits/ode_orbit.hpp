@@ -90,6 +90,9 @@ class OdeOrbitProblem : public PeriodicOrbitProblem, public FloquetProblem {
   // at d = 4, where a residual is a bare flow again).
   EvalStatus compute_residual(const Vector& x, Vector& r) const override;
   EvalStatus compute_jacobian(const Vector& x, Matrix& J) const override;
+  std::string jacobian_description() const override {
+    return "analytic (the variational equations)";
+  }
   // A subclass whose vector field or energy can change after construction (a parameter setter)
   // calls this when it does: the kept Jacobian belongs to the old field.
   void forget_last_shot() const;

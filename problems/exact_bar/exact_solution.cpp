@@ -195,6 +195,30 @@ void ExactBarSolution::march_windows(EndState& left_state, EndState& right_state
       return;
     }
   }
+  keep_closings_on_fronts();
+}
+
+// A candidate is a boundary between incoming segments b and b + 1 at which an open end reached
+// its wall. It is a kink only where a front arrives there: the incoming value or slope jumps
+// (a window's end, or a release at the other end, splits a signal without a jump).
+void ExactBarSolution::keep_closings_on_fronts() {
+  const double tol = snap_tolerance(tau_);
+  for (const auto& [side, b] : front_closing_candidates_) {
+    const auto& incoming = side == Side::right ? a_ : b_sig_;
+    if (b + 1 >= incoming.segments.size()) continue;
+    const Segment& s = incoming.segments[b];
+    const Segment& next = incoming.segments[b + 1];
+    const double before = s.at(s.r1), after = next.at(next.r0);
+    const bool jump =
+        std::abs(after - before) > 8 * epsilon * (std::abs(before) + std::abs(after)) ||
+        std::abs(next.slope - s.slope) > 8 * epsilon * (std::abs(s.slope) + std::abs(next.slope));
+    const double t = global_time(s.k, s.r1);
+    if (jump && t <= t_end_ + tol) closings_on_fronts_.push_back(t);
+  }
+  std::sort(closings_on_fronts_.begin(), closings_on_fronts_.end());
+  closings_on_fronts_.erase(std::unique(closings_on_fronts_.begin(), closings_on_fronts_.end()),
+                            closings_on_fronts_.end());
+  front_closing_candidates_.clear();
 }
 
 void ExactBarSolution::march_end(Side side, long k, EndState& state) {
@@ -222,6 +246,7 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
     // end velocity when free (v = in); toward a wall whose outward normal is m (the end's n for
     // the front wall, -n for a clearance end's back wall) the incoming velocity is q = m * in.
     double rc = s.r0;
+    const bool open_at_start = !state.closed;
     double yc = s.y0;
     // Tangent: the derivatives of rc and of the value yc there (README.md, 'Tangent').
     SegmentTangent piece;
@@ -275,6 +300,12 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
         }
         const double wall_u = wall > 0 ? n * model.gap : -n * model.gap_back;
         if (sc <= tol) {
+          // Reached at this segment's start from an open end: the previous segment's end, which
+          // its own check missed by more than the snap (a duplicate of it is dropped).
+          if (events == 0 && i > 0 && open_at_start &&
+              (front_closing_candidates_.empty() ||
+               front_closing_candidates_.back() != std::pair{side, i - 1}))
+            front_closing_candidates_.emplace_back(side, i - 1);
           state.closed = true;
           state.side = wall;
           state.u = wall_u;
@@ -283,9 +314,9 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
           continue;
         }
         if (sc >= len - tol) {
-          // The end reaches its wall at the segment's end (a front arrives there): a kink.
-          if (sc <= len + tol && global_time(k, s.r1) <= t_end_ + tol)
-            closings_on_fronts_.push_back(global_time(k, s.r1));
+          // The end reaches its wall at the segment's end: a kink where a front arrives there
+          // (keep_closings_on_fronts).
+          if (sc <= len + tol) front_closing_candidates_.emplace_back(side, i);
           emit_to(s.r1, nullptr, false, false);
           break;
         }

@@ -26,6 +26,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "problems/bar/bar.hpp"
@@ -128,11 +129,13 @@ class ExactBarSolution {
 
   // Closed-contact episodes starting before t_end, in time order (empty for non-contact ends).
   std::vector<ContactInterval> contact_intervals() const;
-  // The instants in [0, t_end] where an open end reaches a wall exactly (to the march's snap,
-  // 64 eps tau) as a front arrives: it closes there, or grazes it and leaves. They are the
+  std::vector<ContactInterval> contact_intervals(Side side) const;
+
+  // The instants in (0, t_end], in time order, where an open end reaches a wall (the front or a
+  // clearance end's back wall) exactly, to the march's snap (64 eps tau), as a front arrives
+  // (the incoming signal jumps): it closes there, or grazes the wall and leaves. They are the
   // kinks of the solution map; a tangent through one is the side the march resolved.
   const std::vector<double>& closings_on_fronts() const { return closings_on_fronts_; }
-  std::vector<ContactInterval> contact_intervals(Side side) const;
 
   // The field on the uniform grid of request.elements intervals at time t; every projection
   // int f psi_i dx is exact (Simpson on each polynomial piece). request.dt is ignored.
@@ -239,7 +242,11 @@ class ExactBarSolution {
   Chunked<EndSegment> left_, right_;
   bool ok_ = true;
   std::string message_;
-  std::vector<double> closings_on_fronts_;  // global times, per end in march order
+  std::vector<double> closings_on_fronts_;  // global times, sorted
+  // Boundaries (side, b) between incoming segments b and b + 1 where an open end reached its
+  // wall, during the march; keep_closings_on_fronts keeps those where a front arrives.
+  std::vector<std::pair<Side, std::size_t>> front_closing_candidates_;
+  void keep_closings_on_fronts();
   // Tangent: its seed, its size n (0: none), the segments' derivatives beside a_ and b_sig_.
   InitialTangent seed_;
   int tangent_size_ = 0;

@@ -46,6 +46,9 @@ TEST(StabilityInput, WallBeyondTheGrazingHasNoOrbit) {
 TEST(StabilityInput, WindowAroundTheStartIsChecked) {
   cli::expect_bad_input("trace", impact + " --wall_min 0.1", "wall_min", "stability_cli");
   cli::expect_bad_input("trace", impact + " --wall_max -0.1", "wall_max", "stability_cli");
+  // The start's impact velocity (0.34) below the grazing bound: the key that sets it is named.
+  cli::expect_bad_input("trace", impact + " --grazing_velocity 100", "grazing_velocity",
+                        "stability_cli");
   cli::expect_bad_input("trace", impact + " --continuation_parameter mass",
                         "continuation_parameter", "stability_cli");
 }
@@ -87,8 +90,9 @@ TEST(StabilityFiles, StabilityOffWritesNoMultipliers) {
   EXPECT_FALSE(fs::exists(out / "multipliers.csv"));
   const backbone::core::Table branch = backbone::core::Table::read_csv(out / "branch.csv");
   EXPECT_EQ(std::count(branch.columns().begin(), branch.columns().end(), "stable"), 0);
-  // Duffing's shooting Jacobian is the default finite differences.
-  EXPECT_EQ(backbone::core::read_text_value(out / "summary.txt", "jacobian"), "differences");
+  // Duffing's shooting Jacobian is OdeOrbitProblem's, from the variational equations.
+  EXPECT_EQ(backbone::core::read_text_value(out / "summary.txt", "jacobian"),
+            "analytic (the variational equations)");
 }
 
 // The bar's mode 2 with K also by the TD-BEM's own march: every point has both, and they agree

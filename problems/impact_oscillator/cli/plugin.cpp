@@ -66,8 +66,9 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string&) {
     if (free == "wall")
       continuation.bounds.push_back({"wall", wall_min, wall_max, "wall_min", "wall_max"});
     const double inf = std::numeric_limits<double>::infinity();
-    continuation.bounds.push_back({"impact_velocity", grazing_velocity, inf});
-    continuation.bounds.push_back({"wall_gap", grazing_gap, inf});
+    continuation.bounds.push_back(
+        {"impact_velocity", grazing_velocity, inf, "grazing_velocity", "impact_velocity"});
+    continuation.bounds.push_back({"wall_gap", grazing_gap, inf, "grazing_gap", "wall_gap"});
   };
   s.describe_point = [](const cli::BranchPoint& point) {
     const auto oracle = period_one_orbit(point.observable("frequency"),

@@ -320,7 +320,7 @@ TEST(SubharmonicRepresentation, PathRowsPickTheMember) {
 
 // F alone keeps the formulation the curve was traced with: the atlas and the rank reports of F
 // alone (without_path_rows) solve that residual. Off the continuum (one value moved), the paper
-// and the regular residuals differ, so the rows must match the formulation's, to round-off.
+// and the regular residuals differ, so the rows must match the formulation's, bit for bit.
 TEST(SubharmonicRepresentation, FAloneKeepsTheFormulation) {
   const TdbemSolver tdbem(ContactMethod::event);
   OrbitOptions o = on_wall(20, 2);
