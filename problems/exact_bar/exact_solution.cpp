@@ -25,6 +25,11 @@ double snap_tolerance(double tau) {
   return 64 * epsilon * tau;
 }
 
+// Two values (or slopes) equal to a few ulps: a signal continuous across a breakpoint.
+bool same_to_ulps(double a, double b) {
+  return std::abs(a - b) <= 8 * epsilon * (std::abs(a) + std::abs(b));
+}
+
 // Cap on stored segments: a runaway event cascade is reported as a failure, not a hang.
 constexpr std::size_t max_segments = 20'000'000;
 
@@ -209,9 +214,7 @@ void ExactBarSolution::keep_closings_on_fronts() {
     const Segment& s = incoming.segments[b];
     const Segment& next = incoming.segments[b + 1];
     const double before = s.at(s.r1), after = next.at(next.r0);
-    const bool jump =
-        std::abs(after - before) > 8 * epsilon * (std::abs(before) + std::abs(after)) ||
-        std::abs(next.slope - s.slope) > 8 * epsilon * (std::abs(s.slope) + std::abs(next.slope));
+    const bool jump = !same_to_ulps(before, after) || !same_to_ulps(s.slope, next.slope);
     const double t = global_time(s.k, s.r1);
     if (jump && t <= t_end_ + tol) closings_on_fronts_.push_back(t);
   }
@@ -382,11 +385,8 @@ void ExactBarSolution::emit(Side side, long k, double r0, double r1, double in0,
   if (tangent_size_ == 0 && other.segments.size() > other.first.back()) {
     Segment& last = other.segments.back();
     const double left_value = last.at(r0);
-    if (last.r1 == r0 &&
-        std::abs(left_value - next.y0) <=
-            8 * epsilon * (std::abs(left_value) + std::abs(next.y0)) &&
-        std::abs(last.slope - next.slope) <=
-            8 * epsilon * (std::abs(last.slope) + std::abs(next.slope))) {
+    if (last.r1 == r0 && same_to_ulps(left_value, next.y0) &&
+        same_to_ulps(last.slope, next.slope)) {
       last.r1 = r1;
       return;
     }
