@@ -201,6 +201,12 @@ c("stability_representation_typo", "trace",
 c("stability_tdbem_check_on_exact_solver", "trace",
   ["{S}", "--branch", "mode1", "--stability", "true", "--stability_tdbem_check", "true",
    "--shooting_solver", "exact"], "stability_tdbem_check")
+c("stability_growth_periods_negative", "trace",
+  ["{S}", "--branch", "mode1", "--stability", "true", "--stability_growth_periods", "-5"],
+  "stability_growth_periods")
+c("stability_growth_periods_huge", "trace",
+  ["{S}", "--branch", "mode1", "--stability", "true", "--stability_growth_periods", "1e9"],
+  "stability_growth_periods")
 c("floquet_tolerance_zero", "trace", ["{I}", "--floquet_tolerance", "0"], "floquet_tolerance")
 c("floquet_tolerance_huge", "trace", ["{D}", "--floquet_tolerance", "5"], "floquet_tolerance")
 c("floquet_trivial_tolerance_nan", "trace", ["{D}", "--floquet_trivial_tolerance", "nan"],

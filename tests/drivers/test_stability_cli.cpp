@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "core/io/scene_ini.hpp"
@@ -59,6 +60,10 @@ TEST(StabilityInput, FloquetTolerancesAreChecked) {
   cli::expect_bad_input("trace", duffing + " --floquet_trivial_tolerance 2",
                         "floquet_trivial_tolerance", "stability_cli");
   cli::expect_bad_input("trace", impact + " --follow doubles", "follow", "stability_cli");
+  cli::expect_bad_input("trace", paper + " --branch mode1 --stability_growth_periods -1",
+                        "stability_growth_periods", "stability_cli");
+  cli::expect_bad_input("trace", paper + " --branch mode1 --stability_growth_periods 100001",
+                        "stability_growth_periods", "stability_cli");
 }
 
 // A branch with multipliers writes them, with the stability columns, and its bifurcations.
@@ -113,6 +118,29 @@ TEST(StabilityFiles, BarModeTwoWritesTheTdbemsKBesideTheExactOne) {
   for (const double n : fronts.column("fronts")) EXPECT_EQ(n, 3.0);
   for (const double g : fronts.column("grazing_instants")) EXPECT_EQ(g, 0.0);
   for (const double g : fronts.column("closings_on_fronts")) EXPECT_EQ(g, 0.0);
+  // The perturbed orbits over 1000 periods follow K's Jordan block at -1 (defect 1, from the
+  // closed form's fronts): a drift at most linear in k (power <= 1.5; exponential growth with
+  // |mu| = 1.005 would read 3), that does grow (the drift: measured 67 to 111-fold; bounded
+  // motion stays under 5, as on mode 1 below).
+  const auto largest = fronts.column("growth_largest"), power = fronts.column("growth_power");
+  for (std::size_t i = 0; i < largest.size(); ++i) {
+    EXPECT_GT(largest[i], 5.0) << i;
+    EXPECT_LT(power[i], 1.5) << i;
+  }
+}
+
+// Mode 1's K is [1], with its eigenvector: a perturbed orbit stays within a few times its size
+// (measured at most 1.2 over 1000 periods on the closed forms, test_monodromy.cpp).
+TEST(StabilityFiles, PerturbedModeOneOrbitsStayNear) {
+  const fs::path out = cli::scratch("stability_cli", "bar_mode1_growth");
+  const cli::Run r = cli::run(
+      "trace", paper + " --branch mode1 --shooting_elements 20 --max_points 6 --stability true",
+      out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const backbone::core::Table fronts = backbone::core::Table::read_csv(out / "fronts.csv");
+  ASSERT_GT(fronts.rows(), 0u);
+  for (const double g : fronts.column("growth_largest")) EXPECT_LT(g, 5.0);
+  fs::remove_all(out);
 }
 
 // The subharmonic continuum at one energy starts on a grazing limit (shape 1: the end touches
@@ -140,6 +168,16 @@ TEST(StabilityFiles, TheContinuumsGrazingLimitIsFlaggedWithoutTheTdbem) {
     EXPECT_EQ(grazing[i], 0.0) << i;
     EXPECT_EQ(on_fronts[i], 0.0) << i;
     EXPECT_LT(kink[i], 1e-3) << i;
+  }
+  // The perturbed orbits, the check where K is one side's: the grazing orbit's end starts on
+  // the wall, and the draw that would push it through is projected onto the wall, so every
+  // point has the check. Off the kink K has Jordan defect 1: at most linear (power <= 1.5).
+  const auto largest = fronts.column("growth_largest"), power = fronts.column("growth_power");
+  for (std::size_t i = 0; i < largest.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(largest[i]) && std::isfinite(power[i])) << i;
+    if (i > 0) {
+      EXPECT_LT(power[i], 1.5) << i;
+    }
   }
   fs::remove_all(out);
 }

@@ -201,6 +201,15 @@ po::options_description trace_keys() {
        "tdbem_k_difference (largest |K_tdbem - K|, the nearest of the central and one-sided "
        "K_tdbem) and tdbem_multiplier_difference (problems/contact_bar/orbits/README.md, "
        "'Stability')")  //
+      ("stability_growth_periods", po::value<long>()->default_value(1000),
+       "with stability_representation fronts, at every point: the orbit plus a random "
+       "perturbation of 1e-6 of its amplitude, and its opposite, marched by the exact solver "
+       "over this many periods, in [0, 100000] (0: none): the check on a kink of the period "
+       "map, where K is one side's. fronts.csv gains growth_largest (the largest distance to "
+       "the orbit over the initial one), growth_modulus (its periods-th root, a bound on "
+       "every excited |mu|) and growth_power (the power of k the distance follows over the "
+       "second half: 0 bounded, 1 a linear drift, k ln|mu| an exponential growth) "
+       "(problems/contact_bar/orbits/README.md, 'Stability')")  //
       ("floquet_tolerance", po::value<double>()->default_value(1e-4),
        "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1). 1e-4 for the fronts: a "
        "Jordan block of size 2 (modes J >= 2) turns K's error e, the traced orbit's 1e-10, "
@@ -871,11 +880,12 @@ cli::TraceSetup setup_subharmonic(const core::Scene& scene, const std::string& b
 // With the fronts representation, fronts.csv beside the branch: per point the isolated
 // multipliers' matrix K's checks and its Jordan defect (monodromy.hpp; README.md of orbits/,
 // 'Stability').
-void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
+void add_front_report(cli::TraceSetup& s, bool tdbem_check, int growth_periods) {
   const auto* p = dynamic_cast<const ContactBarOrbitProblem*>(s.problem.get());
   if (!p || p->monodromy_options().representation != MonodromyOptions::Representation::fronts)
     return;
-  s.write_extra_outputs = [p, tdbem_check, inner = std::move(s.write_extra_outputs)](
+  s.write_extra_outputs = [p, tdbem_check, growth_periods,
+                           inner = std::move(s.write_extra_outputs)](
                               const std::filesystem::path& out, const continuation::Branch& b) {
     if (inner) inner(out, b);
     std::vector<std::string> columns{"point",
@@ -895,6 +905,8 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
     if (tdbem_check)
       columns.insert(columns.end(), {"tdbem_ok", "tdbem_kink", "tdbem_k_difference",
                                      "tdbem_multiplier_difference"});
+    if (growth_periods > 0)
+      columns.insert(columns.end(), {"growth_largest", "growth_modulus", "growth_power"});
     core::Table table(columns);
     for (const auto& point : b.points) {
       const exact_bar::FrontMonodromy m = orbit_front_monodromy(*p, point.x);
@@ -931,8 +943,10 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
                               m.ok ? m.return_error : nan,
                               structure.ok ? structure.grazing_instants : nan,
                               structure.ok ? structure.closings_on_fronts : nan};
+      bool on_kink = structure.ok && structure.grazing_instants > 0;
       if (tdbem_check) {
         const TdbemFronts t = orbit_tdbem_front_monodromy(*p, point.x);
+        on_kink = on_kink || (t.ok && t.kink > 1e-3);
         const bool both = m.ok && t.ok && t.K.rows() == m.K.rows();
         if (!t.ok)
           fmt::print("  fronts.csv: point {} has no TD-BEM K: {}\n", point.index, t.message);
@@ -946,6 +960,39 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check) {
         row.insert(row.end(), {t.ok ? 1.0 : 0.0, t.ok ? t.kink : nan,
                                both ? (*nearest - m.K).cwiseAbs().maxCoeff() : nan,
                                both ? multiplier_distance(*nearest, m.K) : nan});
+      }
+      if (growth_periods > 0) {
+        // The perturbed orbit itself, no linearization (monodromy.hpp, perturbation_growth: the
+        // paper scene's 40 intervals, seed 7): the one check of a point on a kink, where K is
+        // one side's. The draw and its opposite, one on each side of a grazing.
+        // Of the draw that grows more: its largest distance, and the power of k that takes the
+        // largest distance up to k_h (the last sample at k <= periods / 2) to the largest of
+        // all: 0 bounded, 1 a linear drift (a Jordan block), (periods - k_h) ln|mu| / ln(periods
+        // / k_h) for an exponential one (3 for |mu| = 1.005 over 1000 periods).
+        const double T = p->period(point.x);
+        double largest = 0, power = nan;
+        for (double size : {1e-6, -1e-6}) {
+          const PerturbationGrowth g = perturbation_growth(setup, T, growth_periods, size, 40, 7);
+          if (!g.ok) {
+            largest = nan;
+            break;
+          }
+          if (g.largest < largest) continue;
+          int half = 1;           // the last sample at k <= periods / 2
+          double first_half = 1;  // the largest distance up to it (1 at k = 0)
+          for (const auto& [k, d] : g.history)
+            if (2 * k <= growth_periods) half = k, first_half = std::max(first_half, d);
+          largest = g.largest;
+          power = half < growth_periods ? std::log(g.largest / first_half) /
+                                              std::log(static_cast<double>(growth_periods) / half)
+                                        : nan;
+        }
+        if (on_kink)
+          fmt::print(
+              "  fronts.csv: point {} on a kink: a perturbation grows at most {:.3g}-fold "
+              "over {} periods, like k^{:.2f} at the end\n",
+              point.index, largest, growth_periods, power);
+        row.insert(row.end(), {largest, std::pow(largest, 1.0 / growth_periods), power});
       }
       table.add_row(row);
     }
@@ -973,7 +1020,8 @@ cli::TraceSetup setup_trace_with_reports(const core::Scene& scene, const std::st
           fmt::format("needs {} (the TD-BEM's own K from the orbit's fronts)", missing));
   }
   cli::TraceSetup s = setup_trace(scene, branch);
-  if (scene.flag("stability")) add_front_report(s, tdbem_check);
+  const int growth_periods = static_cast<int>(scene.integer("stability_growth_periods", 0, 100000));
+  if (scene.flag("stability")) add_front_report(s, tdbem_check, growth_periods);
   return s;
 }
 

@@ -62,8 +62,8 @@ double number_or_nan(const std::string& text) {
 // The frequency-energy figure of the fronts' runs: every point coloured by the Jordan defect
 // of its K (0: every multiplier on the circle with its eigenvectors; 1, 2: linear growth along
 // as many chains), an unstable point circled, one with a multiplier off the circle on a kink of
-// the period map (the TD-BEM's one-sided K apart by over 1e-3: one side's K, not resolved) in a
-// square.
+// the period map (the TD-BEM's one-sided K apart by over 1e-3: one side's K, which decides
+// nothing; the perturbed orbits of fronts.csv's growth_* do) in a square.
 void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path>& runs) {
   std::string curves;
   for (const fs::path& run : runs) {
@@ -109,7 +109,7 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
       ", NaN with points pt 7 lc 1 title 'Jordan defect 0 (neutral)', NaN with points pt 7 lc 2 "
       "title 'defect 1 (linear growth)', NaN with points pt 7 lc 3 title 'defect 2', NaN with "
       "points pt 6 ps 2 lc 'black' title 'unstable (|mu| > 1 + tol)', NaN with points pt 4 ps 1.6 "
-      "lc 'gray40' title 'the same on a kink (not resolved)'";
+      "lc 'gray40' title 'the same on a kink: K of one side (the perturbed orbits decide)'";
   const core::PlotResult r = core::render_png(
       folder / "stability_backbones.png",
       "set datafile separator ','\nset key noenhanced\nset grid\nset logscale x\nset format x "
@@ -160,17 +160,27 @@ void plot_multipliers(const fs::path& folder) {
 // there (unstable_on_kinks of the unstable points) decides nothing.
 std::string stability_verdict(const std::string& representation, int unstable,
                               int unstable_on_kinks, int undecided, double defect_min,
-                              double defect_max, double kinks) {
+                              double defect_max, double kinks, const KinkGrowth& growth) {
   if (representation == "grid") return "projected grid: no verdict (see the fronts' runs)";
   std::string text;
   if (unstable > unstable_on_kinks)
     text = fmt::format("unstable at {} {}", unstable - unstable_on_kinks,
                        unstable - unstable_on_kinks == 1 ? "point" : "points");
+  else if (unstable > 0 && growth.power <= 1.5)
+    text = fmt::format(
+        "no multiplier off the unit circle off the kinks; at {} {} on a kink one side's K has "
+        "one (|mu| up to {:.3g}), but a perturbed orbit there drifts at most linearly (like "
+        "k^{:.2f}, at most {:.3g}-fold over {:g} periods): no exponential growth",
+        unstable, unstable == 1 ? "point" : "points", growth.modulus, growth.power, growth.largest,
+        growth.periods);
   else if (unstable > 0)
     text = fmt::format(
         "no multiplier off the unit circle off the kinks; at {} {} on a kink one side's K has "
-        "one: not resolved there",
-        unstable, unstable == 1 ? "point" : "points");
+        "one{}: not resolved there",
+        unstable, unstable == 1 ? "point" : "points",
+        std::isnan(growth.power)
+            ? std::string()
+            : fmt::format(" and a perturbed orbit grows like k^{:.2f}", growth.power));
   else if (defect_max > 0)
     text = fmt::format(
         "no multiplier off the unit circle; Jordan defect {}{}: perturbations along it grow "
@@ -228,6 +238,8 @@ int write_stability_summary(const fs::path& out) {
                        "tdbem_kink_points",
                        "tdbem_k_difference_worst",
                        "tdbem_multiplier_difference_worst",
+                       "growth_largest_worst",
+                       "growth_power_worst",
                        "verdict"});
   std::string curves;
   for (const fs::path& run : runs) {
@@ -264,6 +276,12 @@ int write_stability_summary(const fs::path& out) {
     // how many sit on a kink of the map (one-sided differences apart by over 1e-3; 1e-5 at most
     // elsewhere in the main job), and the worst differences off the kinks.
     double tdbem_points = nan, tdbem_kinks = nan, tdbem_k = nan, tdbem_mu = nan;
+    // The perturbed orbits' check (--stability_growth_periods): worst over the run, and the
+    // kink growth at the unstable points on a kink.
+    double growth_worst = nan, power_worst = nan;
+    KinkGrowth kink_growth;
+    bool growth_failed = false;  // a point on a kink whose check failed: no conclusion there
+    const std::vector<double> modulus_at = branch.column("max_multiplier_modulus");
     if (fs::exists(run / "fronts.csv")) {
       const core::Table f = core::Table::read_csv(run / "fronts.csv");
       fronts_min = smallest(f.column("fronts"));
@@ -274,6 +292,12 @@ int write_stability_summary(const fs::path& out) {
                             largest(f.column("isometry_error"))});
       returned = largest(f.column("return_error"));
       const auto& names = f.columns();
+      const bool growth = std::find(names.begin(), names.end(), "growth_power") != names.end();
+      if (growth) {
+        growth_worst = largest(f.column("growth_largest"));
+        power_worst = largest(f.column("growth_power"));
+        kink_growth.periods = number_or_nan(scene_value(scene, "stability_growth_periods"));
+      }
       if (std::find(names.begin(), names.end(), "tdbem_ok") != names.end()) {
         tdbem_points = 0;
         tdbem_kinks = 0;
@@ -285,8 +309,16 @@ int write_stability_summary(const fs::path& out) {
           tdbem_points += ok[i];
           if (kink[i] > 1e-3) {
             tdbem_kinks += 1;
-            for (std::size_t j = 0; j < point.size(); ++j)
-              if (point[j] == at[i] && stable[j] == 0) ++unstable_on_kinks;
+            for (std::size_t j = 0; j < point.size(); ++j) {
+              if (point[j] != at[i] || stable[j] != 0) continue;
+              ++unstable_on_kinks;
+              kink_growth.modulus = std::fmax(kink_growth.modulus, modulus_at[j]);
+              if (!growth) continue;
+              const double g = f.column("growth_largest")[i], q = f.column("growth_power")[i];
+              growth_failed = growth_failed || std::isnan(g) || std::isnan(q);
+              kink_growth.largest = std::fmax(kink_growth.largest, g);
+              kink_growth.power = std::fmax(kink_growth.power, q);
+            }
             continue;
           }
           smooth_k.push_back(dk[i]);
@@ -323,8 +355,10 @@ int write_stability_summary(const fs::path& out) {
          tdbem_kinks,
          tdbem_k,
          tdbem_mu,
+         growth_worst,
+         power_worst,
          stability_verdict(representation, unstable, unstable_on_kinks, undecided, defect_min,
-                           defect_max, tdbem_kinks)});
+                           defect_max, tdbem_kinks, growth_failed ? KinkGrowth{} : kink_growth)});
     if (representation == "grid")
       curves += fmt::format(
           "{}{} using 'energy':'max_multiplier_modulus' with linespoints title '{}'",

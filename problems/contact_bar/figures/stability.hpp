@@ -19,6 +19,7 @@
 #pragma once
 
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -32,9 +33,18 @@ std::vector<cli::ProblemJob> stability_figure_jobs();
 // none. unstable (of them unstable_on_kinks) and undecided count points; kinks: points where
 // the TD-BEM's one-sided differences of K disagree, where a multiplier off the circle is one
 // side's and decides nothing; defect_min/max: the fronts' Jordan defects.
+// kink_growth: at those unstable points on a kink, the perturbed orbits' check (fronts.csv,
+// growth_*; orbits/README.md, 'Stability'), the worst of each; NaN when not run. A power of k
+// up to 1.5 is a drift at most linear: one side's multiplier is not what the orbit does there.
+struct KinkGrowth {
+  double periods = std::numeric_limits<double>::quiet_NaN();
+  double largest = std::numeric_limits<double>::quiet_NaN();  // growth_largest
+  double power = std::numeric_limits<double>::quiet_NaN();    // growth_power
+  double modulus = std::numeric_limits<double>::quiet_NaN();  // one side's largest |mu|
+};
 std::string stability_verdict(const std::string& representation, int unstable,
                               int unstable_on_kinks, int undecided, double defect_min,
-                              double defect_max, double kinks);
+                              double defect_max, double kinks, const KinkGrowth& growth = {});
 
 // 0 when written, or skipped with a line when OUT/stability holds no run.
 int write_stability_summary(const std::filesystem::path& out);

@@ -282,7 +282,7 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
 PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period, int periods,
                                        double relative_size, int elements, unsigned seed) {
   PerturbationGrowth g;
-  if (!(period > 0) || periods < 1 || elements < 1) return g;
+  if (!(period > 0) || periods < 1 || elements < 1 || !(relative_size != 0)) return g;
   const double length = setup.material.length;
   std::vector<double> nodes(static_cast<std::size_t>(elements) + 1);
   for (int i = 0; i <= elements; ++i) nodes[static_cast<std::size_t>(i)] = length * i / elements;
@@ -296,44 +296,50 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
     state[i] = setup.u0(nodes[static_cast<std::size_t>(i) + 1]) + size * unit(random);
     state[elements + i] = setup.v0(nodes[static_cast<std::size_t>(i) + 1]) + size * unit(random);
   }
+  // An end on its wall (a grazing orbit) stays on the admissible side: the draw is projected.
+  double& end = state[elements - 1];
+  if (setup.right.has_wall()) end = std::min(end, setup.right.gap);
+  if (setup.right.has_back_wall()) end = std::max(end, -setup.right.gap_back);
   bar::BarSetup perturbed = setup;
   perturbed.u0 = nodal_function(nodes, state.data());
   perturbed.v0 = nodal_function(nodes, state.data() + elements);
   const exact_bar::ExactBarSolution solution(perturbed, periods * period);
   const exact_bar::ExactBarSolution orbit(setup, period);
   if (!solution.ok() || !orbit.ok()) return g;
-  const int samples = 4 * elements;
+  // u on 4 elements + 1 points, one profile of the solution per time.
+  bar::SnapshotRequest samples;
+  samples.elements = 4 * elements;
   // Distance of the perturbed state at t from the orbit's state at time tau (mod T).
-  const auto gap_at = [&](double t, double tau) {
+  const auto gap_at = [&](const std::vector<double>& u, double tau) {
     tau = std::fmod(tau, period);
     if (tau < 0) tau += period;
+    const std::vector<double> w = orbit.snapshot(tau, samples).u;
     double d = 0;
-    for (int j = 0; j <= samples; ++j) {
-      const double x = length * j / samples;
-      d = std::max(d, std::abs(solution.u(x, t) - orbit.u(x, tau)));
-    }
+    for (std::size_t j = 0; j < u.size(); ++j) d = std::max(d, std::abs(u[j] - w[j]));
     return d / amplitude;
   };
   // The nearest state of the orbit: a perturbation of the energy moves the period, so the
   // perturbed state drifts along the orbit (linearly in k: the trivial pair's Jordan block);
   // that drift is no growth. A scan of +-window around k T, then golden sections.
   const auto distance = [&](int k) {
-    const double t = k * period, window = std::min(0.25, 1e-2 + 10 * relative_size * k) * period;
-    double best = 0, best_d = gap_at(t, 0);
+    const double t = k * period,
+                 window = std::min(0.25, 1e-2 + 10 * std::abs(relative_size) * k) * period;
+    const std::vector<double> u = solution.snapshot(t, samples).u;
+    double best = 0, best_d = gap_at(u, 0);
     for (int i = -20; i <= 20; ++i) {
-      const double tau = window * i / 20, d = gap_at(t, tau);
+      const double tau = window * i / 20, d = gap_at(u, tau);
       if (d < best_d) best_d = d, best = tau;
     }
     double lo = best - window / 20, hi = best + window / 20;
     const double r = 0.5 * (std::sqrt(5.0) - 1);
     for (int it = 0; it < 40; ++it) {
       const double m1 = hi - r * (hi - lo), m2 = lo + r * (hi - lo);
-      if (gap_at(t, m1) < gap_at(t, m2))
+      if (gap_at(u, m1) < gap_at(u, m2))
         hi = m2;
       else
         lo = m1;
     }
-    return std::min(best_d, gap_at(t, 0.5 * (lo + hi)));
+    return std::min(best_d, gap_at(u, 0.5 * (lo + hi)));
   };
   g.initial = distance(0);
   if (!(g.initial > 0)) return g;

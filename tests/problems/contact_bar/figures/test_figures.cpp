@@ -107,4 +107,23 @@ TEST(ContactBarFigures, TheStabilityVerdictLeavesTheKinksUnresolved) {
   EXPECT_EQ(stability_verdict("grid", 5, 0, 0, 0, 0, 0).find("projected grid: no verdict"), 0u);
 }
 
+// On a kink the perturbed orbits decide what one side's K cannot: a drift at most linear
+// (power <= 1.5) is no exponential growth; a faster one leaves the point unresolved.
+TEST(ContactBarFigures, TheKinksVerdictFollowsThePerturbedOrbits) {
+  using backbone::contact_bar::KinkGrowth;
+  using backbone::contact_bar::stability_verdict;
+  const std::string linear =
+      stability_verdict("fronts", 2, 2, 0, 0, 1, 7, KinkGrowth{1000, 192, 0.99, 1.36});
+  EXPECT_NE(linear.find("(|mu| up to 1.36), but a perturbed orbit there drifts at most linearly "
+                        "(like k^0.99, at most 192-fold over 1000 periods): no exponential"),
+            std::string::npos)
+      << linear;
+  EXPECT_EQ(linear.find("unstable at"), std::string::npos) << linear;
+  const std::string faster =
+      stability_verdict("fronts", 2, 2, 0, 0, 1, 7, KinkGrowth{1000, 5e4, 3.1, 1.36});
+  EXPECT_NE(faster.find("and a perturbed orbit grows like k^3.10: not resolved there"),
+            std::string::npos)
+      << faster;
+}
+
 }  // namespace
