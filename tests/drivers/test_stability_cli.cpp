@@ -62,7 +62,7 @@ TEST(StabilityInput, FloquetTolerancesAreChecked) {
   cli::expect_bad_input("trace", impact + " --follow doubles", "follow", "stability_cli");
   cli::expect_bad_input("trace", paper + " --branch mode1 --stability_growth_periods -1",
                         "stability_growth_periods", "stability_cli");
-  cli::expect_bad_input("trace", paper + " --branch mode1 --stability_growth_periods 100001",
+  cli::expect_bad_input("trace", paper + " --branch mode1 --stability_growth_periods 10001",
                         "stability_growth_periods", "stability_cli");
 }
 

@@ -32,7 +32,8 @@ namespace {
 //     (20 to 160 intervals, and 20 with the time step halved) and its continuum at 1e-3 J (20 to
 //     80), of the families attached to mode 1 at 40, 80 and 160 intervals (T = 3.6, 3.5, 3.25,
 //     3.2 and more), at 70 and 140 and at 70 with the time step halved (T = 3.6, 3.5, 24/7, 3.2
-//     and 22/7 L/c), and of the clearance modes 1 and 2;
+//     and 22/7 L/c), the families at 40 again with their perturbed orbits over 3000 periods,
+//     and of the clearance modes 1 and 2;
 //   - the projected grid's (grid_<name>), modes 1 and 2 at 40 and 80, at 40 with c dt / dx
 //     halved and by the exact solver, and mode 2 at 160, for the comparison.
 std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
@@ -85,6 +86,29 @@ std::vector<cli::ReproduceStep> stability_steps(const std::string& scenes) {
         {"--branch", "mode1", "--shooting_elements", n, "--steps_per_period", per_period,
          "--detect_branch_points", "true", "--ds", "0.05", "--ds_max", "0.05", "--energy_max",
          "3e-5", "--follow", "all", "--follow_max_points", points});
+  // The perturbed orbits over 3 times the periods, on the families with grazing ends at 40
+  // intervals: a drift that stays linear (3 times the growth) is no slow exponential one.
+  add("mode1_resonances_N40_growth_3000", "paper.ini",
+      {"--branch",
+       "mode1",
+       "--shooting_elements",
+       "40",
+       "--steps_per_period",
+       "40",
+       "--detect_branch_points",
+       "true",
+       "--ds",
+       "0.05",
+       "--ds_max",
+       "0.05",
+       "--energy_max",
+       "3e-5",
+       "--follow",
+       "all",
+       "--follow_max_points",
+       "30",
+       "--stability_growth_periods",
+       "3000"});
   for (const char* mode : {"mode1", "mode2"})
     add(fmt::format("clearance_{}", mode), "clearance.ini", {"--branch", mode});
   // The projected grid, its tolerances at the size of its projection's error.
