@@ -118,13 +118,12 @@ TEST(StabilityFiles, BarModeTwoWritesTheTdbemsKBesideTheExactOne) {
   for (const double n : fronts.column("fronts")) EXPECT_EQ(n, 3.0);
   for (const double g : fronts.column("grazing_instants")) EXPECT_EQ(g, 0.0);
   for (const double g : fronts.column("closings_on_fronts")) EXPECT_EQ(g, 0.0);
-  // The perturbed orbits over 1000 periods follow K's Jordan block at -1 (defect 1, from the
-  // closed form's fronts): a drift at most linear in k (power <= 1.5; exponential growth with
-  // |mu| = 1.005 would read 3), that does grow (the drift: measured 67 to 111-fold; bounded
-  // motion stays under 5, as on mode 1 below).
+  // The perturbed orbits over 1000 periods: K's Jordan block at -1 (defect 1, from the closed
+  // form's fronts) allows a drift linear in k, no exponential growth: a power of k under 1.5
+  // (|mu| = 1.005 would read 3) and under 1e3-fold (|mu| = 1.007 would pass it).
   const auto largest = fronts.column("growth_largest"), power = fronts.column("growth_power");
   for (std::size_t i = 0; i < largest.size(); ++i) {
-    EXPECT_GT(largest[i], 5.0) << i;
+    EXPECT_LT(largest[i], 1e3) << i;
     EXPECT_LT(power[i], 1.5) << i;
   }
 }

@@ -291,18 +291,51 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
   std::mt19937 random(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const double size = relative_size * amplitude;
-  Vector state(2 * elements);
-  for (int i = 0; i < elements; ++i) {
-    state[i] = setup.u0(nodes[static_cast<std::size_t>(i) + 1]) + size * unit(random);
-    state[elements + i] = setup.v0(nodes[static_cast<std::size_t>(i) + 1]) + size * unit(random);
+  std::vector<double> du(nodes.size()), dv(nodes.size());  // 0 at x = 0
+  for (std::size_t i = 1; i < nodes.size(); ++i) {
+    du[i] = size * unit(random);
+    dv[i] = size * unit(random);
   }
+  // The orbit's own state plus the draw: piecewise linear on the union of their knots (a knot
+  // of the orbit off the uniform nodes is kept). The orbit's interior knots move too, each by
+  // up to relative_size L: the fronts' shifts, which the values excite only through the
+  // contact instants.
+  const auto plus = [&](const bar::PiecewiseLinear& orbit_state, const std::vector<double>& d) {
+    const bar::PiecewiseLinear draw(nodes, d);
+    std::vector<double> knots = orbit_state.knots();
+    for (std::size_t i = 1; i + 1 < knots.size(); ++i) {
+      // At most a quarter of either neighbouring interval: the knots keep their order.
+      const double room = 0.25 * std::min(knots[i] - knots[i - 1], knots[i + 1] - knots[i]) /
+                          (std::abs(relative_size) * length);
+      knots[i] += relative_size * length * std::clamp(unit(random), -room, room);
+    }
+    const bar::PiecewiseLinear f(knots, orbit_state.values());
+    std::vector<double> x = f.knots();
+    const double tol = 1e-12 * length;
+    for (double node : nodes)
+      if (std::none_of(f.knots().begin(), f.knots().end(),
+                       [&](double k) { return std::abs(k - node) <= tol; }))
+        x.push_back(node);
+    std::sort(x.begin(), x.end());
+    std::vector<double> y(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) y[i] = f(x[i]) + draw(x[i]);
+    return std::pair{x, y};
+  };
+  auto [ux, uy] = plus(setup.u0, du);
+  const auto [vx, vy] = plus(setup.v0, dv);
   // An end on its wall (a grazing orbit) stays on the admissible side: the draw is projected.
-  double& end = state[elements - 1];
-  if (setup.right.has_wall()) end = std::min(end, setup.right.gap);
-  if (setup.right.has_back_wall()) end = std::max(end, -setup.right.gap_back);
+  for (std::size_t i = 0; i < ux.size(); ++i) {
+    if (ux[i] < length * (1 - 1e-12)) continue;
+    if (setup.right.has_wall()) uy[i] = std::min(uy[i], setup.right.gap);
+    if (setup.right.has_back_wall()) uy[i] = std::max(uy[i], -setup.right.gap_back);
+  }
   bar::BarSetup perturbed = setup;
-  perturbed.u0 = nodal_function(nodes, state.data());
-  perturbed.v0 = nodal_function(nodes, state.data() + elements);
+  try {
+    perturbed.u0 = bar::PiecewiseLinear(ux, uy);
+    perturbed.v0 = bar::PiecewiseLinear(vx, vy);
+  } catch (const core::InputError&) {
+    return g;  // knots the union cannot hold (a velocity with jumps): no check
+  }
   const exact_bar::ExactBarSolution solution(perturbed, periods * period);
   const exact_bar::ExactBarSolution orbit(setup, period);
   if (!solution.ok() || !orbit.ok()) return g;
@@ -320,18 +353,18 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
   };
   // The nearest state of the orbit: a perturbation of the energy moves the period, so the
   // perturbed state drifts along the orbit (linearly in k: the trivial pair's Jordan block);
-  // that drift is no growth. A scan of +-window around k T, then golden sections.
-  const auto distance = [&](int k) {
-    const double t = k * period,
-                 window = std::min(0.25, 1e-2 + 10 * std::abs(relative_size) * k) * period;
-    const std::vector<double> u = solution.snapshot(t, samples).u;
+  // that drift is no growth. The distance is to the orbit as a set (orbital stability): the
+  // best of a scan of +-window around k T and of one over the whole period (a drift beyond the
+  // window: the clearance modes' period moves fast with the energy), each refined by golden
+  // sections around its best sample.
+  const double r = 0.5 * (std::sqrt(5.0) - 1);
+  const auto nearest = [&](const std::vector<double>& u, double width, int n) {
     double best = 0, best_d = gap_at(u, 0);
-    for (int i = -20; i <= 20; ++i) {
-      const double tau = window * i / 20, d = gap_at(u, tau);
+    for (int i = -n; i <= n; ++i) {
+      const double tau = width * i / n, d = gap_at(u, tau);
       if (d < best_d) best_d = d, best = tau;
     }
-    double lo = best - window / 20, hi = best + window / 20;
-    const double r = 0.5 * (std::sqrt(5.0) - 1);
+    double lo = best - width / n, hi = best + width / n;
     for (int it = 0; it < 40; ++it) {
       const double m1 = hi - r * (hi - lo), m2 = lo + r * (hi - lo);
       if (gap_at(u, m1) < gap_at(u, m2))
@@ -341,6 +374,13 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
     }
     return std::min(best_d, gap_at(u, 0.5 * (lo + hi)));
   };
+  const auto distance = [&](int k) {
+    const double t = k * period,
+                 window = std::min(0.25, 1e-2 + 10 * std::abs(relative_size) * k) * period;
+    const std::vector<double> u = solution.snapshot(t, samples).u;
+    return std::min(nearest(u, window, 20), nearest(u, 0.5 * period, 100));
+  };
+
   g.initial = distance(0);
   if (!(g.initial > 0)) return g;
   for (int k = 1; k <= periods; k = k < 10 ? k + 1 : (k * 3) / 2) {

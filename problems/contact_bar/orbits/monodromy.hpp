@@ -108,12 +108,13 @@ int jordan_defect(const Eigen::MatrixXd& K);
 
 // The check that needs no representation: the orbit's state plus a random perturbation (u and
 // v continuous and piecewise linear on `elements` uniform intervals, nodal values uniform in
-// [-1, 1] times relative_size times max|u0|, u = v = 0 at x = 0; u(L) kept off the walls),
-// simulated by the exact
-// characteristics solver for `periods` periods of T. At t = k T (k = 1..10, then growing by
-// half, and the last) the distance to the orbit is taken: min over tau of
-// max_x |u(x, k T) - u_orbit(x, tau)| (on 4 elements + 1 points), so that the drift along the
-// orbit of a perturbed energy (the trivial pair's Jordan block, linear in k) is not counted.
+// [-1, 1] times relative_size times max|u0|, u = v = 0 at x = 0; the orbit's interior knots
+// moved by up to relative_size L, its fronts' shifts; u(L) kept off the walls), simulated by
+// the exact characteristics solver for `periods` periods of T. At t = k T (k = 1..10, then
+// growing by half, and the last) the distance to the orbit as a set is taken: min over tau of
+// max_x |u(x, k T) - u_orbit(x, tau)| (on 4 elements + 1 points; a scan near tau = 0 and one
+// over the whole period), so that the drift along the orbit of a perturbed energy (the trivial
+// pair's Jordan block, linear in k) is not counted.
 // A multiplier of modulus 1 + d in a direction the perturbation excites grows it like
 // (1 + d)^k; without growth every excited multiplier has |mu| <= largest^(1 / periods)
 // (README.md, section 'Stability'). A negative relative_size draws the same perturbation with

@@ -185,10 +185,10 @@ TEST(ContactBarMonodromy, TheExactSolversMultipliersAgreeWithTheTdbems) {
 // perturbation of 1e-6 of the closed-form orbits (exact) of modes 1 and 2, simulated by the
 // exact solver for 1000 periods. Mode 1 stays within a few times its initial size (measured
 // at most 1.2; a multiplier of modulus 1.002 in an excited direction would reach 7.4). Mode 2
-// drifts about linearly in k (measured 99 at k = 823 at twice the grazing energy), not
-// exponentially: from k = 500 to 1000 the distance at most triples (linear: 2; |mu| = 1.003
-// in an excited direction: 4.5), and it stays far below the 1.09^1000 of the projected
-// monodromy's multiplier (README.md, 'Stability').
+// may drift linearly in k along its Jordan block at -1, not exponentially: from k = 500 to
+// 1000 the distance at most triples (linear: 2; |mu| = 1.003 in an excited direction: 4.5),
+// and it stays far below the 1.09^1000 of the projected monodromy's multiplier (README.md,
+// 'Stability').
 TEST(ContactBarMonodromy, PerturbationsOfModesOneAndTwoDoNotGrowExponentially) {
   bar::BarSetup setup = test_support::paper_setup();
   for (int mode : {1, 2}) {
