@@ -109,7 +109,7 @@ void plot_stability_backbones(const fs::path& folder, const std::vector<fs::path
       ", NaN with points pt 7 lc 1 title 'Jordan defect 0 (neutral)', NaN with points pt 7 lc 2 "
       "title 'defect 1 (linear growth)', NaN with points pt 7 lc 3 title 'defect 2', NaN with "
       "points pt 6 ps 2 lc 'black' title 'unstable (|mu| > 1 + tol)', NaN with points pt 4 ps 1.6 "
-      "lc 'gray40' title 'the same on a kink: K of one side (the perturbed orbits decide)'";
+      "lc 'gray40' title 'the same on a kink (one-sided K)'";
   const core::PlotResult r = core::render_png(
       folder / "stability_backbones.png",
       "set datafile separator ','\nset key noenhanced\nset grid\nset logscale x\nset format x "
