@@ -203,15 +203,15 @@ po::options_description trace_keys() {
        "'Stability')")  //
       ("stability_growth_periods", po::value<long>()->default_value(1000),
        "with stability_representation fronts, at every point: the orbit plus a random "
-       "perturbation of 1e-6 of its amplitude, and its opposite, marched by the exact solver "
-       "over this many periods, in [0, 10000] (0: none; the march is kept whole: 10000 took "
-       "1.1 GB and 20 s a draw on the families at 40 intervals, 1000 0.09 GB and 0.3 s): "
-       "the check on a kink of the period map, where K is one side's. fronts.csv gains "
-       "growth_largest (the largest distance to "
-       "the orbit over the initial one), growth_modulus (its periods-th root, a bound on "
-       "every excited |mu|) and growth_power (the power of k the distance follows over the "
-       "second half: 0 bounded, 1 a linear drift, k ln|mu| an exponential growth) "
-       "(problems/contact_bar/orbits/README.md, 'Stability')")  //
+       "perturbation (values 1e-6 of its amplitude, knots moved by up to 1e-6 L) and its "
+       "opposite, marched by the exact solver over this many periods, in [0, 10000] (0: none; "
+       "the march is kept whole: 10000 took 1.1 GB on the families at 40 intervals, 1000 "
+       "0.09 GB): the check on a kink of the period map, where K is one side's. fronts.csv "
+       "gains growth_largest (the largest distance to the orbit as a set over the initial "
+       "one), growth_modulus (its periods-th root, a bound on every excited |mu|) and "
+       "growth_power (the power of k that takes the largest distance up to the middle to the "
+       "largest of all: 0 bounded, 1 a linear drift, about 3 for |mu| = 1.005 over 1000 "
+       "periods) (problems/contact_bar/orbits/README.md, 'Stability')")  //
       ("floquet_tolerance", po::value<double>()->default_value(1e-4),
        "a multiplier with |mu| > 1 + this is unstable, in (0, 0.1). 1e-4 for the fronts: a "
        "Jordan block of size 2 (modes J >= 2) turns K's error e, the traced orbit's 1e-10, "
@@ -976,7 +976,7 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check, int growth_periods) 
         for (double size : {1e-6, -1e-6}) {
           const PerturbationGrowth g = perturbation_growth(setup, T, growth_periods, size, 40, 7);
           if (!g.ok) {
-            largest = nan;
+            largest = power = nan;
             break;
           }
           if (g.largest < largest) continue;

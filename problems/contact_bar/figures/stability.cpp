@@ -169,10 +169,10 @@ std::string stability_verdict(const std::string& representation, int unstable,
   else if (unstable > 0 && growth.power <= 1.5)
     text = fmt::format(
         "no multiplier off the unit circle off the kinks; at {} {} on a kink one side's K has "
-        "one (|mu| up to {:.3g}), but a perturbed orbit there drifts at most linearly (like "
-        "k^{:.2f}, at most {:.3g}-fold over {:g} periods): no exponential growth",
+        "one (|mu| up to {:.3g}), but a perturbed orbit there grows like k^{:.2f}, at most "
+        "{:.3g}-fold over {:g} periods: no excited |mu| above {:.4g}",
         unstable, unstable == 1 ? "point" : "points", growth.modulus, growth.power, growth.largest,
-        growth.periods);
+        growth.periods, std::pow(growth.largest, 1 / growth.periods));
   else if (unstable > 0)
     text = fmt::format(
         "no multiplier off the unit circle off the kinks; at {} {} on a kink one side's K has "

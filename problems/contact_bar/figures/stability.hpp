@@ -34,8 +34,10 @@ std::vector<cli::ProblemJob> stability_figure_jobs();
 // the TD-BEM's one-sided differences of K disagree, where a multiplier off the circle is one
 // side's and decides nothing; defect_min/max: the fronts' Jordan defects.
 // kink_growth: at those unstable points on a kink, the perturbed orbits' check (fronts.csv,
-// growth_*; orbits/README.md, 'Stability'), the worst of each; NaN when not run. A power of k
-// up to 1.5 is a drift at most linear: one side's multiplier is not what the orbit does there.
+// growth_*; orbits/README.md, 'Stability'), the worst of each; NaN when not run. With a power
+// of k up to 1.5 (a linear drift reads 0.95 to 1.05 on the kinks of the main job) the verdict
+// gives the bound the check proves, every excited |mu| <= largest^(1 / periods), against one
+// side's multiplier; a faster growth, or none measured, leaves the point unresolved.
 struct KinkGrowth {
   double periods = std::numeric_limits<double>::quiet_NaN();
   double largest = std::numeric_limits<double>::quiet_NaN();  // growth_largest

@@ -321,16 +321,16 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
     for (std::size_t i = 0; i < x.size(); ++i) y[i] = f(x[i]) + draw(x[i]);
     return std::pair{x, y};
   };
-  auto [ux, uy] = plus(setup.u0, du);
-  const auto [vx, vy] = plus(setup.v0, dv);
-  // An end on its wall (a grazing orbit) stays on the admissible side: the draw is projected.
-  for (std::size_t i = 0; i < ux.size(); ++i) {
-    if (ux[i] < length * (1 - 1e-12)) continue;
-    if (setup.right.has_wall()) uy[i] = std::min(uy[i], setup.right.gap);
-    if (setup.right.has_back_wall()) uy[i] = std::max(uy[i], -setup.right.gap_back);
-  }
   bar::BarSetup perturbed = setup;
   try {
+    auto [ux, uy] = plus(setup.u0, du);
+    const auto [vx, vy] = plus(setup.v0, dv);
+    // An end on its wall (a grazing orbit) stays on the admissible side: the draw is projected.
+    for (std::size_t i = 0; i < ux.size(); ++i) {
+      if (ux[i] < length * (1 - 1e-12)) continue;
+      if (setup.right.has_wall()) uy[i] = std::min(uy[i], setup.right.gap);
+      if (setup.right.has_back_wall()) uy[i] = std::max(uy[i], -setup.right.gap_back);
+    }
     perturbed.u0 = bar::PiecewiseLinear(ux, uy);
     perturbed.v0 = bar::PiecewiseLinear(vx, vy);
   } catch (const core::InputError&) {

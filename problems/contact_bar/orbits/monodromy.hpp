@@ -109,7 +109,8 @@ int jordan_defect(const Eigen::MatrixXd& K);
 // The check that needs no representation: the orbit's state plus a random perturbation (u and
 // v continuous and piecewise linear on `elements` uniform intervals, nodal values uniform in
 // [-1, 1] times relative_size times max|u0|, u = v = 0 at x = 0; the orbit's interior knots
-// moved by up to relative_size L, its fronts' shifts; u(L) kept off the walls), simulated by
+// moved by up to relative_size L, its fronts' shifts; u(L) put on a wall it would cross, so
+// that at a grazing one of the two signs keeps the end's value), simulated by
 // the exact characteristics solver for `periods` periods of T. At t = k T (k = 1..10, then
 // growing by half, and the last) the distance to the orbit as a set is taken: min over tau of
 // max_x |u(x, k T) - u_orbit(x, tau)| (on 4 elements + 1 points; a scan near tau = 0 and one
@@ -118,8 +119,9 @@ int jordan_defect(const Eigen::MatrixXd& K);
 // A multiplier of modulus 1 + d in a direction the perturbation excites grows it like
 // (1 + d)^k; without growth every excited multiplier has |mu| <= largest^(1 / periods)
 // (README.md, section 'Stability'). A negative relative_size draws the same perturbation with
-// the opposite sign: on a kink of the period map (a grazing) the two lie on its two sides, to
-// first order.
+// the opposite sign (but where two knots lie within 4 relative_size L of each other: a knot
+// moves by at most a quarter of its intervals, which its neighbour's move has changed): on a
+// kink of the period map (a grazing) the two lie on its two sides, to first order.
 struct PerturbationGrowth {
   double initial = 0;  // distance at t = 0 (relative to max|u0|)
   double largest = 0;  // largest distance over the sampled k, over the initial one
