@@ -342,15 +342,24 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
   // u on 4 elements + 1 points, one profile of the solution per time.
   bar::SnapshotRequest samples;
   samples.elements = 4 * elements;
-  // Distance of the perturbed state at t from the orbit's state at time tau (mod T).
-  const auto gap_at = [&](const std::vector<double>& u, double tau) {
+  // The orbit's u at time tau (mod T), and the distance of a perturbed u from one of them.
+  const auto orbit_u = [&](double tau) {
     tau = std::fmod(tau, period);
     if (tau < 0) tau += period;
-    const std::vector<double> w = orbit.snapshot(tau, samples).u;
+    return orbit.snapshot(tau, samples).u;
+  };
+  const auto gap = [&](const std::vector<double>& u, const std::vector<double>& w) {
     double d = 0;
     for (std::size_t j = 0; j < u.size(); ++j) d = std::max(d, std::abs(u[j] - w[j]));
     return d / amplitude;
   };
+  const auto gap_at = [&](const std::vector<double>& u, double tau) {
+    return gap(u, orbit_u(tau));
+  };
+  // The whole-period scan's samples are the same at every k: the orbit there, once.
+  constexpr int scan = 100;
+  std::vector<std::vector<double>> scanned(2 * scan + 1);
+  for (int i = -scan; i <= scan; ++i) scanned[i + scan] = orbit_u(0.5 * period * i / scan);
   // The nearest state of the orbit: a perturbation of the energy moves the period, so the
   // perturbed state drifts along the orbit (linearly in k: the trivial pair's Jordan block);
   // that drift is no growth. The distance is to the orbit as a set (orbital stability): the
@@ -358,10 +367,15 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
   // window: the clearance modes' period moves fast with the energy), each refined by golden
   // sections around its best sample.
   const double r = 0.5 * (std::sqrt(5.0) - 1);
-  const auto nearest = [&](const std::vector<double>& u, double width, int n) {
-    double best = 0, best_d = gap_at(u, 0);
+  // profiles: the orbit at the scan's samples (width * i / n), when they are the whole period's.
+  const auto nearest = [&](const std::vector<double>& u, double width, int n,
+                           const std::vector<std::vector<double>>* profiles) {
+    const auto sample = [&](int i) {
+      return profiles ? gap(u, (*profiles)[i + n]) : gap_at(u, width * i / n);
+    };
+    double best = 0, best_d = sample(0);
     for (int i = -n; i <= n; ++i) {
-      const double tau = width * i / n, d = gap_at(u, tau);
+      const double tau = width * i / n, d = sample(i);
       if (d < best_d) best_d = d, best = tau;
     }
     double lo = best - width / n, hi = best + width / n;
@@ -378,7 +392,7 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
     const double t = k * period,
                  window = std::min(0.25, 1e-2 + 10 * std::abs(relative_size) * k) * period;
     const std::vector<double> u = solution.snapshot(t, samples).u;
-    return std::min(nearest(u, window, 20), nearest(u, 0.5 * period, 100));
+    return std::min(nearest(u, window, 20, nullptr), nearest(u, 0.5 * period, scan, &scanned));
   };
 
   g.initial = distance(0);
