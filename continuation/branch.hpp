@@ -93,8 +93,9 @@ std::string dimension_warning(const BranchPoint& point);
 // the test function changed sign or dipped. verified() when the rank report and its probes found
 // more directions of solutions there than the traced tangent.
 struct BranchPointReport {
-  int after_point = 0;            // located between this point of the branch and the next one
-  core::Vector x;                 // located point, problem's unknowns
+  int after_point = 0;  // located between this point of the branch and the next one
+  int bracket = -1;     // which of the branch's brackets, from 0 (BranchPointDetector::brackets)
+  core::Vector x;       // located point, problem's unknowns
   core::Observables observables;  // problem.observables(x)
   double arclength = 0;           // along the branch, same units as BranchPoint::arclength
   double test_value = 0;          // signed test function at x (branch_points.hpp)

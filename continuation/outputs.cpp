@@ -254,7 +254,7 @@ void check_saved_files(const std::filesystem::path& dir, const std::string& key)
   }
 }
 
-int repair_branch_files(const std::filesystem::path& out, const std::string& key) {
+int repair_branch_files(const std::filesystem::path& out, const std::string& key, int up_to) {
   std::vector<std::filesystem::path> files{out / "branch.csv", out / "unknowns.csv"};
   for (const char* optional : {"orbits.csv", "multipliers.csv", "state.txt"})
     if (std::filesystem::exists(out / optional)) files.push_back(out / optional);
@@ -281,6 +281,7 @@ int repair_branch_files(const std::filesystem::path& out, const std::string& key
       cut = true;
   }
   if (cut) last -= 1;
+  last = std::min(last, static_cast<double>(up_to));
   if (!(last >= 0))
     throw core::InputError(key, fmt::format("'{}' holds no complete point", out.string()));
   for (std::size_t i = 0; i < files.size(); ++i) {

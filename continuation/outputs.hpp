@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -98,7 +99,9 @@ void check_saved_files(const std::filesystem::path& dir, const std::string& key)
 // every row of a point that is not complete in all of branch.csv, unknowns.csv (and orbits.csv
 // and state.txt when present). Returns the last complete point; InputError naming `key` when there
 // is none.
-int repair_branch_files(const std::filesystem::path& out, const std::string& key);
+// up_to: also drops the points after it (a resume that takes up an earlier point).
+int repair_branch_files(const std::filesystem::path& out, const std::string& key,
+                        int up_to = std::numeric_limits<int>::max());
 
 // Replaces the saved loop state of every point of out/state.txt by `-` (none), atomically: what
 // a resume does when the saved states do not fit its settings (restart.hpp, state_mismatch), so

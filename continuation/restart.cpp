@@ -90,11 +90,11 @@ std::string format_state(const LoopState& s) {
   std::string line = fmt::format(
       "method={} index={} arclength={} ds={} lambda={} previous_step={} switch_index={} "
       "jacobian_scale={} scale={} z={} tangent={} previous={} jacobian_point={} chord_misses={} "
-      "samples={}",
+      "brackets={} samples={}",
       to_string(s.method), s.index, number(s.arclength), number(s.ds), number(s.lambda),
       number(s.previous_step), s.switch_index, number(s.jacobian_scale), numbers(s.scale),
       numbers(s.z), numbers(s.tangent), numbers(s.previous), numbers(s.jacobian_point),
-      s.chord_misses, s.samples.size());
+      s.chord_misses, s.brackets, s.samples.size());
   for (std::size_t k = 0; k < s.samples.size(); ++k) {
     const TestFunctionSample& a = s.samples[k];
     line += fmt::format(
@@ -128,6 +128,7 @@ LoopState parse_state(const std::string& line, const std::string& key, const std
   // fresh Jacobian.
   if (in.has("jacobian_point")) s.jacobian_point = in.vector("jacobian_point");
   if (in.has("chord_misses")) s.chord_misses = in.whole("chord_misses");
+  if (in.has("brackets")) s.brackets = in.whole("brackets");
   const int samples = in.whole("samples");
   if (samples < 0 || samples > 3) in.fail(fmt::format("{} detector samples (at most 3)", samples));
   for (int k = 0; k < samples; ++k) {
@@ -293,6 +294,155 @@ void take_up(RestartPoint& restart, const std::string& key, int direction,
   // A state carries its own step (options.ds stays the first step of a later arclength part).
   if (restart.next_step > 0 && !restart.state)
     options.ds = std::clamp(restart.next_step, options.ds_min, options.ds_max);
+}
+
+namespace {
+
+const char* const saved_branch_points_header =
+    "branch points located so far (continuation/README.md, section 'Restart files')";
+
+std::string format_branch_point(const BranchPointReport& r) {
+  std::string line = fmt::format(
+      "bracket={} after_point={} arclength={} test_value={} sign_change={} location_steps={} "
+      "jacobian_evaluations={} residual_evaluations={} nullity={} attached_dimension={} "
+      "candidates={} probed={} verified_dimension={} tangent_angle={} x={} attached_point={} "
+      "attached_points={}",
+      r.bracket, r.after_point, number(r.arclength), number(r.test_value), r.sign_change ? 1 : 0,
+      r.location_steps, r.jacobian_evaluations, r.residual_evaluations, r.nullity,
+      r.attached_dimension, r.candidates, r.probed, r.verified_dimension, number(r.tangent_angle),
+      numbers(r.x), numbers(r.attached_point), r.attached_points.size());
+  for (std::size_t k = 0; k < r.attached_points.size(); ++k)
+    line += fmt::format(" attached{}={}", k, numbers(r.attached_points[k]));
+  line += fmt::format(" described={}", r.attached_description.size());
+  for (std::size_t k = 0; k < r.attached_description.size(); ++k)
+    line += fmt::format(" name{0}={1} value{0}={2}", k, r.attached_description[k].first,
+                        number(r.attached_description[k].second));
+  return line;
+}
+
+BranchPointReport parse_branch_point(const std::string& line, const core::Problem& problem,
+                                     const std::string& key, const std::string& where) {
+  const StateReader in(line, key, where);
+  BranchPointReport r;
+  r.bracket = in.whole("bracket");
+  r.after_point = in.whole("after_point");
+  r.arclength = in.value("arclength");
+  r.test_value = in.value("test_value");
+  r.sign_change = in.whole("sign_change") != 0;
+  r.location_steps = in.whole("location_steps");
+  r.jacobian_evaluations = static_cast<long>(in.value("jacobian_evaluations"));
+  r.residual_evaluations = static_cast<long>(in.value("residual_evaluations"));
+  r.nullity = in.whole("nullity");
+  r.attached_dimension = in.whole("attached_dimension");
+  r.candidates = in.whole("candidates");
+  r.probed = in.whole("probed");
+  r.verified_dimension = in.whole("verified_dimension");
+  r.tangent_angle = in.value("tangent_angle");
+  r.x = in.vector("x");
+  r.attached_point = in.vector("attached_point");
+  const int attached = in.whole("attached_points");
+  for (int k = 0; k < attached; ++k)
+    r.attached_points.push_back(in.vector(fmt::format("attached{}", k)));
+  const int described = in.whole("described");
+  for (int k = 0; k < described; ++k)
+    r.attached_description.emplace_back(in.text(fmt::format("name{}", k)),
+                                        in.value(fmt::format("value{}", k)));
+  const Eigen::Index n = problem.num_unknowns();
+  const bool sizes_agree = r.x.size() == n &&
+                           (r.attached_point.size() == 0 || r.attached_point.size() == n) &&
+                           std::all_of(r.attached_points.begin(), r.attached_points.end(),
+                                       [&](const core::Vector& y) { return y.size() == n; });
+  if (r.bracket < 0 || attached < 0 || described < 0 || !sizes_agree)
+    in.fail(fmt::format("not a located candidate of this problem's {} unknowns", n));
+  r.observables = problem.observables(r.x);
+  return r;
+}
+
+// The brackets each point's state had made (state.txt, in the order of the file): -1 for a
+// point without a state (`K -`), -2 for a state that does not count them.
+std::vector<std::pair<int, int>> saved_brackets(const std::filesystem::path& path) {
+  std::vector<std::pair<int, int>> out;
+  std::ifstream in(path);
+  std::string line;
+  for (bool header = true; std::getline(in, line); header = false) {
+    if (header) continue;
+    const int point = std::atoi(line.c_str());
+    const auto at = line.find(" brackets=");
+    const bool stateless = line.size() >= 2 && line.compare(line.size() - 2, 2, " -") == 0;
+    out.emplace_back(point, stateless                 ? -1
+                            : at == std::string::npos ? -2
+                                                      : std::atoi(line.c_str() + at + 10));
+  }
+  return out;
+}
+
+}  // namespace
+
+void SavedBranchPoints::write(const std::filesystem::path& out) const {
+  std::string text = fmt::format("{}\nsettled={}\n", saved_branch_points_header, settled);
+  for (const BranchPointReport& r : reports) text += format_branch_point(r) + "\n";
+  core::write_text_atomically(out / "branch_points.txt", text);
+}
+
+SavedBranchPoints read_saved_branch_points(const std::filesystem::path& dir,
+                                           const core::Problem& problem, const std::string& key) {
+  const std::filesystem::path path = dir / "branch_points.txt";
+  std::ifstream in(path);
+  if (!in) throw core::InputError(key, fmt::format("cannot read '{}'", path.string()));
+  SavedBranchPoints saved;
+  std::string line;
+  int number_of_line = 0;
+  while (std::getline(in, line)) {
+    ++number_of_line;
+    const std::string where = fmt::format("'{}', line {}", path.string(), number_of_line);
+    if (number_of_line == 1) {
+      if (line != saved_branch_points_header)
+        throw core::InputError(key, fmt::format("{}: not the header of a list of located "
+                                                "branch points",
+                                                where));
+      continue;
+    }
+    if (number_of_line == 2) {
+      const StateReader settled(line, key, where);
+      saved.settled = settled.whole("settled");
+      continue;
+    }
+    saved.reports.push_back(parse_branch_point(line, problem, key, where));
+    if (saved.reports.size() > 1 &&
+        saved.reports.back().bracket <= saved.reports[saved.reports.size() - 2].bracket)
+      throw core::InputError(key, fmt::format("{}: the brackets are not in order", where));
+  }
+  if (number_of_line < 2 || saved.settled < 0)
+    throw core::InputError(key,
+                           fmt::format("'{}' has no count of settled brackets", path.string()));
+  // A candidate is written before the count that settles its bracket.
+  if (!saved.reports.empty())
+    saved.settled = std::max(saved.settled, saved.reports.back().bracket + 1);
+  return saved;
+}
+
+std::optional<BranchPointResume> branch_point_resume(const std::filesystem::path& dir, int last,
+                                                     const core::Problem& problem,
+                                                     const std::string& key) {
+  if (!std::filesystem::exists(dir / "branch_points.txt")) return std::nullopt;
+  const std::vector<std::pair<int, int>> brackets = saved_brackets(dir / "state.txt");
+  BranchPointResume r;
+  r.saved = read_saved_branch_points(dir, problem, key);
+  int made = -1;
+  for (auto it = brackets.rbegin(); it != brackets.rend(); ++it) {
+    if (it->first > last) continue;
+    if (it->second == -2) return std::nullopt;  // states that do not count brackets
+    if (it->second < 0) continue;               // a point without a state
+    if (it->second <= r.saved.settled) {
+      r.point = it->first;
+      made = it->second;
+      break;
+    }
+  }
+  if (made < 0) return std::nullopt;
+  std::erase_if(r.saved.reports, [&](const BranchPointReport& b) { return b.bracket >= made; });
+  r.saved.settled = made;
+  return r;
 }
 
 }  // namespace backbone::continuation

@@ -19,6 +19,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -61,6 +62,10 @@ struct LoopState {
   int switch_index = -1;      // natural_then_arclength: first arclength point, -1 before
   double jacobian_scale = 0;  // branch-point detector: its Jacobian scale (0: unset)
   std::vector<TestFunctionSample> samples;  // the detector's samples before z was added
+  // Branch-point detector: the candidates it had bracketed before z was added (-1: not saved).
+  // A resume from this state brackets again from there on; the candidates located earlier must
+  // come from the saved list (outputs.hpp, SavedBranchPoints).
+  int brackets = -1;
 
   core::Vector unknowns() const { return z.cwiseProduct(scale); }
 };
@@ -114,5 +119,39 @@ std::string state_mismatch(const LoopState& state, const core::Problem& problem,
 void take_up(RestartPoint& restart, const std::string& key, int direction,
              const core::Problem& problem, ContinuationOptions& options, core::Vector& guess,
              core::Vector& hint);
+
+// The located candidates of a detecting run, kept while it runs so that an interrupted run
+// loses none: trace rewrites out/branch_points.txt (atomically) whenever a candidate is located
+// or a bracket settles (ContinuationHooks::on_branch_point, on_brackets_settled), while
+// branch_points.csv is written once the branch has ended. Format (continuation/README.md,
+// 'Restart files'): a header line, `settled=N`, then one line per candidate of `name=value`
+// tokens, every number in its shortest round-trip form. Repeated runs write it bit for bit: it
+// holds no wall time (BranchPointReport::seconds reads back as 0).
+struct SavedBranchPoints {
+  int settled = 0;  // brackets located or given up: the list is complete below this bracket
+  std::vector<BranchPointReport> reports;  // in bracket order (BranchPointReport::bracket)
+  // Writes out/branch_points.txt atomically; std::runtime_error when it cannot.
+  void write(const std::filesystem::path& out) const;
+};
+// Reads dir/branch_points.txt (the observables recomputed by problem.observables). InputError
+// naming `key` on any defect.
+SavedBranchPoints read_saved_branch_points(const std::filesystem::path& dir,
+                                           const core::Problem& problem, const std::string& key);
+
+// Where a resumed detecting run takes up its branch so that it loses no candidate. Location runs
+// behind the loop (branch_points.hpp), so when a run is killed the candidates bracketed by its
+// last points may still be being located: branch_points.txt then holds fewer brackets than the
+// last state had made. The resume starts from the last point `point` <= last whose state had
+// made at most the settled brackets (LoopState::brackets); the run from there is the
+// interrupted one's bit for bit and brackets the rest again. saved: the candidates bracketed
+// before that point. Empty when dir has no branch_points.txt or its states do not count brackets
+// (the rows of branch_points.csv are then merged as write_after_run says).
+struct BranchPointResume {
+  int point = 0;
+  SavedBranchPoints saved;
+};
+std::optional<BranchPointResume> branch_point_resume(const std::filesystem::path& dir, int last,
+                                                     const core::Problem& problem,
+                                                     const std::string& key);
 
 }  // namespace backbone::continuation

@@ -137,6 +137,7 @@ int run_trace(const std::vector<std::string>& args_in) {
   const int stop_signal = stop->signal();
   stop.reset();  // the default actions again
   report.progress().finish();
+  cli::add_saved_branch_points(t, result.branch);
   const cont::Branch& branch = result.branch;
   const bool complete = !branch.points.empty() && !branch.ended_early();
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);

@@ -98,26 +98,38 @@ double BranchPointDetector::last_value() const {
   return samples_.empty() ? std::numeric_limits<double>::quiet_NaN() : samples_.back().tau.value;
 }
 
-void BranchPointDetector::restore(std::vector<TestFunctionSample> samples, double jacobian_scale) {
+int BranchPointDetector::brackets() const {
+  wait_for_samples();
+  return brackets_;
+}
+
+void BranchPointDetector::restore(std::vector<TestFunctionSample> samples, double jacobian_scale,
+                                  int brackets) {
   wait_for_samples();
   samples_ = std::move(samples);
   jacobian_scale_ = jacobian_scale;
+  brackets_ = brackets;
+  {
+    const std::lock_guard<std::mutex> lock(found_mutex_);
+    settled_ = brackets;
+  }
   last_jacobian_.resize(0, 0);
 }
 
-std::vector<BranchPointReport> BranchPointDetector::take() {
+std::vector<BranchPointReport> BranchPointDetector::take(int* settled) {
   if (sampling_) sampling_->rethrow();
   if (locating_) locating_->rethrow();
   const std::lock_guard<std::mutex> lock(found_mutex_);
   std::vector<BranchPointReport> out = std::move(found_);
   found_.clear();
+  if (settled) *settled = settled_;
   return out;
 }
 
-std::vector<BranchPointReport> BranchPointDetector::finish() {
+std::vector<BranchPointReport> BranchPointDetector::finish(int* settled) {
   if (sampling_) sampling_->wait();  // its brackets are on the locating queue by then
   if (locating_) locating_->wait();
-  return take();
+  return take(settled);
 }
 
 void BranchPointDetector::submit(std::vector<Sample> polyline, bool sign_change,
@@ -129,11 +141,16 @@ void BranchPointDetector::submit(std::vector<Sample> polyline, bool sign_change,
   job.jacobian_scale = jacobian_scale_;
   job.scale = scale;
   job.residual_factor = residual_factor;
-  const auto run = [this](branch_point::Job& j) {
+  const int bracket = brackets_++;
+  const auto run = [this, bracket](branch_point::Job& j) {
     std::vector<BranchPointReport> out;
     locator_->run(std::move(j), out);
     const std::lock_guard<std::mutex> lock(found_mutex_);
-    for (BranchPointReport& r : out) found_.push_back(std::move(r));
+    for (BranchPointReport& r : out) {
+      r.bracket = bracket;
+      found_.push_back(std::move(r));
+    }
+    settled_ = bracket + 1;
   };
   if (!locating_) {
     run(job);

@@ -108,11 +108,13 @@ class BranchPointDetector {
   void add(int index, const core::Vector& z, const core::Vector& tangent, const core::Matrix& J,
            double arclength);
   // Located candidates so far (in the problem's own unknowns), in order; cleared. Does not wait
-  // for the worker's pending candidates.
-  std::vector<BranchPointReport> take();
+  // for the worker's pending candidates. settled, when given: how many brackets have been
+  // located or given up by then (BranchPointReport::bracket counts them from 0, in order), the
+  // returned reports included.
+  std::vector<BranchPointReport> take(int* settled = nullptr);
   // The rest: waits until every candidate handed to the worker is located and verified, then
   // take(). Rethrows what a location threw on the worker.
-  std::vector<BranchPointReport> finish();
+  std::vector<BranchPointReport> finish(int* settled = nullptr);
   // Test-function value at the last added point (NaN before the first).
   double last_value() const;
   // What add() remembers between points, for a restart that must continue bit for bit: the
@@ -120,9 +122,12 @@ class BranchPointDetector {
   // first point). restore() puts them back.
   // They wait for the sampling thread to take every point added (one step of the loop's is
   // ample time for it).
+  // brackets(): the candidates bracketed so far, located or not (the next one's
+  // BranchPointReport::bracket).
   const std::vector<TestFunctionSample>& samples() const;
   double jacobian_scale() const;
-  void restore(std::vector<TestFunctionSample> samples, double jacobian_scale);
+  int brackets() const;
+  void restore(std::vector<TestFunctionSample> samples, double jacobian_scale, int brackets);
 
  private:
   using Sample = TestFunctionSample;
@@ -142,8 +147,10 @@ class BranchPointDetector {
   std::vector<Sample> samples_;  // the last three points
   double jacobian_scale_ = 0;    // Frobenius norm of the first point's Jacobian (unit scale)
   core::Matrix last_jacobian_;   // the last sample's, unit scale (empty after restore())
+  int brackets_ = 0;             // candidates bracketed (submitted) so far
   std::mutex found_mutex_;
   std::vector<BranchPointReport> found_;  // located, not yet taken
+  int settled_ = 0;                       // brackets located or given up (under found_mutex_)
   // With a clone() of the problem (options.branch_points.background): the copy and its view,
   // which the locator corrects in, and the two threads. Declared in this order so that the
   // sampling thread, which pushes onto the locating one, stops first.

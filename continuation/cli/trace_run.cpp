@@ -138,8 +138,15 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
   if (!t.resume.empty()) {
     t.lock = std::make_unique<core::FolderLock>("resume", t.resume);
     continuation::check_saved_files(t.resume, "resume");
-    continuation::repair_branch_files(t.resume, "resume");
-    t.restart = continuation::restart_point(t.resume, -1, options, "resume");
+    const int last = continuation::repair_branch_files(t.resume, "resume");
+    int from = -1;
+    if (options.branch_points.detect)
+      if (auto r = continuation::branch_point_resume(t.resume, last, problem, "resume")) {
+        from = r->point;
+        t.saved_branch_points = std::move(r->saved);
+        if (from < last) t.resume_drops_after = last;
+      }
+    t.restart = continuation::restart_point(t.resume, from, options, "resume");
     t.restart->record_saved_point = false;  // it is in the files
   } else if (scene.has("start")) {
     const auto [dir, point] = continuation::parse_saved_point(scene.text("start"), "start");
@@ -208,6 +215,11 @@ void print_trace_header(TraceRun& t) {
                                                                                ? "no saved state"
                                                                                : restart->note))
                      : "");
+  if (t.resume_drops_after >= 0)
+    fmt::print(
+        "  points {} to {} are traced again: the branch points they bracketed were still "
+        "being located when the run stopped (branch_points.txt)\n",
+        restart->index + 1, t.resume_drops_after);
 }
 
 namespace {
@@ -215,12 +227,24 @@ TraceRun& locked(TraceRun& t) {
   if (!t.lock) t.lock = std::make_unique<core::FolderLock>("out", t.out);
   return t;
 }
+
+// The files of a resumed run cut after its restart point when it lies before their last point
+// (TraceRun::resume_drops_after), before the writer appends to them.
+TraceRun& cut(TraceRun& t) {
+  if (t.resume_drops_after >= 0)
+    continuation::repair_branch_files(t.resume, "resume", t.restart->index);
+  return t;
+}
 }  // namespace
 
 TraceReport::TraceReport(TraceRun& t)
-    : t_(locked(t)),
+    : t_(cut(locked(t))),
       writer_(t.out, t.periodic, t.restart.has_value() && !t.resume.empty()),
-      progress_(t.options()) {}
+      progress_(t.options()) {
+  if (!t.options().branch_points.detect) return;
+  if (t.saved_branch_points) located_ = *t.saved_branch_points;
+  located_.write(t.out);
+}
 
 continuation::ContinuationHooks TraceReport::hooks(const std::optional<StopSignals>& stop) {
   continuation::ContinuationHooks hooks;
@@ -231,9 +255,15 @@ continuation::ContinuationHooks TraceReport::hooks(const std::optional<StopSigna
   // Located candidates as they come (from the detector's thread, a few points after the bracket
   // that holds them; continuation/README.md, 'Branch points'), between the point lines.
   hooks.on_branch_point = [this](const continuation::BranchPointReport& r) {
+    located_.reports.push_back(r);
+    located_.write(t_.out);
     progress_.finish();
     fmt::print("  {}\n", branch_point_line(r));
     std::fflush(stdout);
+  };
+  hooks.on_brackets_settled = [this](int settled) {
+    located_.settled = settled;
+    located_.write(t_.out);
   };
   hooks.on_attempt = [this](const continuation::StepAttempt& a) {
     if (a.rejection.empty()) return;
@@ -334,6 +364,13 @@ bool follow_doublings(TraceRun& t, const std::vector<continuation::OrbitBifurcat
 
 }  // namespace
 
+void add_saved_branch_points(const TraceRun& t, continuation::Branch& branch) {
+  if (!t.saved_branch_points) return;
+  const auto& saved = t.saved_branch_points->reports;
+  branch.branch_points.insert(branch.branch_points.begin(), saved.begin(), saved.end());
+  branch.branch_points_from = 0;  // every candidate of the branch is in the list
+}
+
 bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
                               const continuation::ContinuationHooks& hooks) {
   bool followed_complete = true;
@@ -342,14 +379,14 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
     const auto verified =
         std::count_if(branch.branch_points.begin(), branch.branch_points.end(),
                       [](const continuation::BranchPointReport& r) { return r.verified(); });
-    fmt::print("branch points located by this run: {} ({} verified; branch_points.csv)\n",
+    fmt::print("branch points located on this branch: {} ({} verified; branch_points.csv)\n",
                branch.branch_points.size(), verified);
   }
   const continuation::FollowSelection& selection = t.run.follow.selection;
   if (selection.kind == continuation::FollowSelection::Kind::one &&
       selection.k > static_cast<int>(branch.branch_points.size())) {
     fmt::print(stderr,
-               "backbone trace: --follow {}: this run located {} branch points "
+               "backbone trace: --follow {}: the branch has {} located branch points "
                "(branch_points.csv), nothing to follow\n",
                selection.k, branch.branch_points.size());
     followed_complete = false;

@@ -47,6 +47,11 @@ struct TraceRun {
   core::PeriodicOrbitProblem* periodic = nullptr;  // setup.problem when it is one
   core::Vector direction;                          // the first tangent's hint
   std::optional<continuation::RestartPoint> restart;
+  // A resumed detecting run: the candidates located before its restart point (branch_points.txt,
+  // continuation::branch_point_resume), and the last complete point of the files when the
+  // restart point lies before it (the points after it are traced again), else -1.
+  std::optional<continuation::SavedBranchPoints> saved_branch_points;
+  int resume_drops_after = -1;
   int expected_dimension = 0;
   // One writer of `out` at a time: taken before a resume repairs the saved files, else by
   // TraceReport once every check has passed.
@@ -94,6 +99,9 @@ class TraceReport {
 
   TraceRun& t_;
   continuation::BranchWriter writer_;
+  // With detection: every candidate located so far (the saved ones of a resume first), kept in
+  // t.out/branch_points.txt as they come.
+  continuation::SavedBranchPoints located_;
   ProgressLine progress_;
   long dimension_flags_[3] = {0, 0, 0};  // branch.csv points per DimensionFlag (branch.hpp)
   long dimension_above_ = 0;             // points verified above the expected dimension
@@ -106,5 +114,10 @@ class TraceReport {
 // run did not locate).
 bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
                               const continuation::ContinuationHooks& hooks);
+
+// A resumed detecting run's branch holds the candidates it located; the saved ones located
+// before its restart point go in front, so that branch_points.csv, the rows K of --follow K and
+// the followed branches cover the whole branch.
+void add_saved_branch_points(const TraceRun& t, continuation::Branch& branch);
 
 }  // namespace backbone::cli

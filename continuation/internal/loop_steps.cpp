@@ -126,13 +126,22 @@ void LoopSteps::push(BranchPoint point) {
 Branch LoopSteps::take() {
   flush_first(nullptr);
   if (pending_branch_points_) {
-    for (BranchPointReport& report : pending_branch_points_()) add_branch_point(std::move(report));
+    int settled = 0;
+    for (BranchPointReport& report : pending_branch_points_(&settled))
+      add_branch_point(std::move(report));
+    brackets_settled(settled);
     pending_branch_points_ = nullptr;
   }
   for (std::size_t i = 0; i < branch_.points.size(); ++i)
     branch_.points[i].x = branch_.points[i].x.cwiseProduct(point_scales_[i]);
   point_scales_.clear();
   return std::move(branch_);
+}
+
+void LoopSteps::brackets_settled(int settled) {
+  if (settled == brackets_settled_) return;
+  brackets_settled_ = settled;
+  if (hooks_.on_brackets_settled) hooks_.on_brackets_settled(settled);
 }
 
 void LoopSteps::add_branch_point(BranchPointReport report) {

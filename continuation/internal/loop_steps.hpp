@@ -194,9 +194,12 @@ class LoopSteps {
   void add_branch_point(BranchPointReport report);
   // Candidates still being located when the branch ends (the detector's worker): take() adds
   // what this returns (it waits for them) before it hands the branch over.
-  void add_pending_branch_points(std::function<std::vector<BranchPointReport>()> pending) {
+  void add_pending_branch_points(std::function<std::vector<BranchPointReport>(int*)> pending) {
     pending_branch_points_ = std::move(pending);
   }
+  // The detector's count of brackets located or given up (hooks.on_brackets_settled when it
+  // grows).
+  void brackets_settled(int settled);
   // A resumed run locates again from this after_point on (Branch::branch_points_from).
   void branch_points_from(int after_point) { branch_.branch_points_from = after_point; }
 
@@ -261,7 +264,8 @@ class LoopSteps {
   bool defer_first_ = false, first_pending_ = false;
   std::size_t first_position_ = 0;
   core::Vector first_direction_;
-  std::function<std::vector<BranchPointReport>()> pending_branch_points_;
+  std::function<std::vector<BranchPointReport>(int*)> pending_branch_points_;
+  int brackets_settled_ = -1;
 };
 
 }  // namespace backbone::continuation

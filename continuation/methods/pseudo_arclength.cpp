@@ -170,7 +170,7 @@ ArclengthLoop::ArclengthLoop(ScaledProblem& problem, const BranchStart& start,
       steps_(problem, corrector, options, hooks, start) {
   if (options.branch_points.detect) {
     detector_.emplace(problem, options, hooks, corrector);
-    steps_.add_pending_branch_points([this] { return detector_->finish(); });
+    steps_.add_pending_branch_points([this](int* settled) { return detector_->finish(settled); });
   }
   s_.ds = options.ds;
   s_.factor = core::Vector::Ones(problem.num_unknowns());
@@ -226,7 +226,7 @@ std::optional<Branch> ArclengthLoop::begin_from_state(const LoopState& from, boo
   // the last two) and the point, so with after_point >= index - samples. Those rows of the
   // earlier run are replaced by these, the ones before stand (an interrupted run may have
   // stopped before writing them).
-  detector_->restore(from.samples, from.jacobian_scale);
+  detector_->restore(from.samples, from.jacobian_scale, std::max(from.brackets, 0));
   steps_.branch_points_from(from.index -
                             static_cast<int>(std::min<std::size_t>(from.samples.size(), 2)));
   if (problem_.jacobian(s_.x, s_.J) != core::EvalStatus::ok)
@@ -438,6 +438,7 @@ std::shared_ptr<LoopState> ArclengthLoop::state_after(const core::Vector& y,
   if (detector_) {
     state->samples = detector_->samples();
     state->jacobian_scale = detector_->jacobian_scale();
+    state->brackets = detector_->brackets();
   }
   return state;
 }
@@ -458,7 +459,10 @@ void ArclengthLoop::detect(int index, const core::Vector& z, const core::Vector&
                            double arclength) {
   if (!detector_) return;
   detector_->add(index, z, tangent, s_.J, arclength);
-  for (BranchPointReport& report : detector_->take()) steps_.add_branch_point(std::move(report));
+  int settled = 0;
+  for (BranchPointReport& report : detector_->take(&settled))
+    steps_.add_branch_point(std::move(report));
+  steps_.brackets_settled(settled);
 }
 
 Branch arclength_loop(ScaledProblem& problem, const core::Vector& guess, const core::Vector& hint,

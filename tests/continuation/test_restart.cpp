@@ -5,9 +5,12 @@
 // both runs is the same, so any difference is state the restart lost (the re-corrected point,
 // the re-derived tangent or step of the restart this replaced moved the branch by ~1e-14 and
 // then let it diverge at a retried step).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -25,8 +28,17 @@ using namespace backbone;
 using continuation::Branch;
 using continuation::LoopState;
 using continuation_tests::vec;
+namespace fs = std::filesystem;
 
 namespace {
+
+// An empty folder of this test's own under the system's temporary folder.
+fs::path scratch(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("backbone_test_restart_" + name);
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
 
 // x^2 + lambda = 1 with lambda in thousandths: typical scale (1, 1e-3), so the scaled unknowns
 // differ from the problem's and a restart from the unknowns alone would not be exact.
@@ -98,6 +110,7 @@ TEST(LoopState, TextFormReadsBackBitForBit) {
   s.tangent = vec(0.6, -0.8);
   s.jacobian_point = vec(-2.0 / 3.0, 1e300);
   s.chord_misses = 11;
+  s.brackets = 4;
   continuation::TestFunctionSample a;
   a.index = 16;
   a.s = 2.0 / 7.0;
@@ -123,6 +136,7 @@ TEST(LoopState, TextFormReadsBackBitForBit) {
   EXPECT_EQ(b.previous.size(), 0);
   EXPECT_TRUE(b.jacobian_point == s.jacobian_point);
   EXPECT_EQ(b.chord_misses, 11);
+  EXPECT_EQ(b.brackets, 4);
   ASSERT_EQ(b.samples.size(), 2u);
   EXPECT_EQ(b.samples[1].index, 16);
   EXPECT_EQ(b.samples[1].s, a.s);
@@ -174,6 +188,125 @@ TEST(LoopState, DefectsAreInputErrorsNamingTheKey) {
       EXPECT_EQ(e.key(), "resume") << bad;
     }
   }
+}
+
+// The located candidates an interrupted run keeps (branch_points.txt) read back bit for bit,
+// every field follow_attached and branch_points.csv use, the observables recomputed; the wall
+// time is not kept (repeated runs write the file bit for bit).
+TEST(SavedBranchPoints, TextFormReadsBackBitForBit) {
+  const fs::path dir = scratch("saved_branch_points");
+  continuation::SavedBranchPoints saved;
+  saved.settled = 3;
+  continuation::BranchPointReport r;
+  r.bracket = 2;
+  r.after_point = 40;
+  r.x = vec(1.0 / 3.0, -1e-310);
+  r.arclength = 2.0 / 7.0;
+  r.test_value = -0.0;
+  r.sign_change = true;
+  r.location_steps = 6;
+  r.jacobian_evaluations = 12345678901;
+  r.residual_evaluations = 7;
+  r.nullity = 3;
+  r.attached_dimension = 2;
+  r.candidates = 2;
+  r.probed = 2;
+  r.verified_dimension = 3;
+  r.tangent_angle = std::numeric_limits<double>::quiet_NaN();
+  r.seconds = 0.125;
+  r.attached_points = {vec(0.5, 1e300), vec(std::sqrt(2.0), 0.0)};
+  r.attached_point = r.attached_points[1];
+  r.attached_description = {{"frequency_ratio", 7.0 / 3.0}, {"resonance_order", 8}};
+  continuation::BranchPointReport unverified;
+  unverified.bracket = 0;
+  unverified.x = vec(0.25, 0.75);
+  saved.reports = {unverified, r};
+  saved.write(dir);
+  const ScaledFold problem;
+  const continuation::SavedBranchPoints b =
+      continuation::read_saved_branch_points(dir, problem, "resume");
+  EXPECT_EQ(b.settled, 3);
+  ASSERT_EQ(b.reports.size(), 2u);
+  const continuation::BranchPointReport& c = b.reports[1];
+  EXPECT_EQ(c.bracket, 2);
+  EXPECT_EQ(c.after_point, 40);
+  EXPECT_TRUE(c.x == r.x && c.attached_point == r.attached_point);
+  ASSERT_EQ(c.attached_points.size(), 2u);
+  EXPECT_TRUE(c.attached_points[0] == r.attached_points[0] &&
+              c.attached_points[1] == r.attached_points[1]);
+  EXPECT_EQ(c.arclength, r.arclength);
+  EXPECT_TRUE(std::signbit(c.test_value));
+  EXPECT_TRUE(c.sign_change);
+  EXPECT_EQ(c.location_steps, 6);
+  EXPECT_EQ(c.jacobian_evaluations, 12345678901);
+  EXPECT_EQ(c.residual_evaluations, 7);
+  EXPECT_EQ(c.nullity, 3);
+  EXPECT_EQ(c.attached_dimension, 2);
+  EXPECT_EQ(c.candidates, 2);
+  EXPECT_EQ(c.probed, 2);
+  EXPECT_EQ(c.verified_dimension, 3);
+  EXPECT_TRUE(std::isnan(c.tangent_angle));
+  EXPECT_EQ(c.seconds, 0);  // wall time is not kept
+  EXPECT_EQ(c.attached_description, r.attached_description);
+  EXPECT_EQ(c.observables, problem.observables(r.x));
+  EXPECT_EQ(b.reports[0].attached_points.size(), 0u);
+  EXPECT_EQ(b.reports[0].attached_point.size(), 0);
+}
+
+// A resume takes up the last point whose state had made no more brackets than the saved list
+// settled, and keeps the candidates bracketed before it: here 3 are settled, point 5 had made
+// 4 (one still being located when the run stopped), point 4 had made 3. Point 3 has no state
+// (`3 -`), which the search passes over. States that do not count brackets, or no saved list:
+// nothing to take up (the rows of branch_points.csv are merged instead).
+TEST(SavedBranchPoints, ResumeStartsWhereEveryBracketWasSettled) {
+  const fs::path dir = scratch("branch_point_resume");
+  const ScaledFold problem;
+  const auto state = [](int index, int brackets) {
+    LoopState s = minimal_state();
+    s.index = index;
+    s.brackets = brackets;
+    return fmt::format("{} {}\n", index, continuation::format_state(s));
+  };
+  const auto write = [&](const std::string& text) {
+    std::ofstream(dir / "state.txt") << "point state\n" << text;
+  };
+  write(state(0, 0) + state(1, 1) + state(2, 2) + "3 -\n" + state(4, 3) + state(5, 4));
+  EXPECT_FALSE(continuation::branch_point_resume(dir, 5, problem, "resume"));
+  continuation::SavedBranchPoints saved;
+  saved.settled = 3;
+  for (int bracket : {0, 2}) {
+    continuation::BranchPointReport r;
+    r.bracket = bracket;
+    r.x = vec(bracket, 1);
+    saved.reports.push_back(r);
+  }
+  saved.write(dir);
+  auto r = continuation::branch_point_resume(dir, 5, problem, "resume");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->point, 4);
+  EXPECT_EQ(r->saved.settled, 3);
+  EXPECT_EQ(r->saved.reports.size(), 2u);
+  // Point 2 had made 2 brackets: the candidate of bracket 2 is located again from there.
+  saved.settled = 2;
+  saved.reports.pop_back();
+  saved.write(dir);
+  r = continuation::branch_point_resume(dir, 5, problem, "resume");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->point, 2);
+  EXPECT_EQ(r->saved.reports.size(), 1u);
+  // A candidate written before the count that settles its bracket counts as settled.
+  saved.settled = 0;
+  saved.write(dir);
+  r = continuation::branch_point_resume(dir, 5, problem, "resume");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->point, 1);
+  write(state(0, 0) + "1 " +
+        continuation::format_state(minimal_state())
+            .replace(continuation::format_state(minimal_state()).find(" brackets=-1"), 12, "") +
+        "\n");
+  EXPECT_FALSE(continuation::branch_point_resume(dir, 1, problem, "resume"));
+  std::ofstream(dir / "branch_points.txt") << "not a list\n";
+  EXPECT_THROW(continuation::branch_point_resume(dir, 1, problem, "resume"), core::InputError);
 }
 
 // Pseudo-arclength round the fold of x^2 + 1000 lambda = 1 (tangent and secant predictors,

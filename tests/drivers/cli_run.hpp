@@ -34,6 +34,14 @@ inline fs::path scratch(const std::string& suite, const std::string& name) {
   return p;
 }
 
+// The whole file, byte for byte (empty when it cannot be read).
+inline std::string file_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
 // stderr goes to OUT.stderr, or to err_file when given (an OUT whose sibling cannot be written).
 inline Run run(const std::string& subcommand, const std::string& arguments, const fs::path& out,
                fs::path err_file = {}) {

@@ -223,6 +223,56 @@ TEST(BranchPointsCli, ResumedRunNeitherRepeatsNorDropsCandidates) {
   }
 }
 
+// What SIGKILL leaves when location runs behind the loop (branch_points.hpp): branch.csv holds
+// points whose brackets were still being located, branch_points.txt the candidates located so
+// far and how many brackets had settled, and no branch_points.csv (written when the branch
+// ends). Made exactly here: a run cut at 21 points, its branch_points.csv removed and its saved
+// list cut back to the first three brackets. The resume must take up the last point whose
+// state had made no more than three brackets (the points after it are traced again, bit for
+// bit: unknowns.csv equals the uninterrupted run's byte for byte), keep the three saved
+// candidates, locate the others again, and follow every verified one: the same rows, after the
+// same points, verified alike, with a branch_point_K/ for each verified K.
+TEST(BranchPointsCli, KilledRunLosesNoCandidateAndFollowsThemAll) {
+  const std::string scene = paper +
+                            " --branch mode1 --shooting_elements 100 --energy_max 1e-2 "
+                            "--detect_branch_points true --follow all --follow_max_points 3";
+  const fs::path full = cli::scratch("branch_points_cli", "full"),
+                 part = cli::scratch("branch_points_cli", "killed");
+  ASSERT_EQ(cli::run("trace", scene, full).code, 0);
+  ASSERT_EQ(cli::run("trace", scene + " --max_points 21", part).code, 0);
+  fs::remove(part / "branch_points.csv");
+  std::ifstream in(part / "branch_points.txt");
+  std::string text, line;
+  int kept = 0;
+  for (int n = 0; std::getline(in, line); ++n) {
+    if (n == 1) line = "settled=3";
+    if (n >= 2 && std::stoi(line.substr(line.find("bracket=") + 8)) >= 3) continue;
+    kept += n >= 2;
+    text += line + "\n";
+  }
+  in.close();
+  ASSERT_GE(kept, 2);  // candidates of the first three brackets (a bracket may locate none)
+  std::ofstream(part / "branch_points.txt") << text;
+  const std::string log = part.string() + ".log";
+  const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
+                             part.string() + "' --max_points 1000 > '" + log + "' 2>&1";
+  ASSERT_EQ(std::system(resume.c_str()), 0) << cli::file_text(log);
+  EXPECT_NE(cli::file_text(log).find("to 20 are traced again"), std::string::npos)
+      << cli::file_text(log);
+  EXPECT_EQ(cli::file_text(part / "unknowns.csv"), cli::file_text(full / "unknowns.csv"));
+  const Table a = Table::read_csv(full / "branch_points.csv");
+  const Table b = Table::read_csv(part / "branch_points.csv");
+  ASSERT_GE(a.rows(), 6u);
+  ASSERT_EQ(b.rows(), a.rows());
+  EXPECT_EQ(b.column("after_point"), a.column("after_point"));
+  EXPECT_EQ(b.column("verified"), a.column("verified"));
+  for (std::size_t k = 1; k <= a.rows(); ++k) {
+    const fs::path dir = "branch_point_" + std::to_string(k);
+    EXPECT_EQ(fs::exists(part / dir / "branch.csv"), fs::exists(full / dir / "branch.csv")) << k;
+    if (a.column("verified")[k - 1] == 1) EXPECT_TRUE(fs::exists(part / dir / "branch.csv")) << k;
+  }
+}
+
 }  // namespace
 
 // --follow all: the family attached at T = 3.2 is traced into branch_point_K/ (K: its row). It

@@ -165,12 +165,7 @@ void expect_same_rows(const backbone::core::Table& a, const backbone::core::Tabl
   }
 }
 
-std::string file_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using cli::file_text;
 
 // mode 1 on a coarse grid up to 2e-3 J: 88 cheap points (steps of 5 % of the amplitude above
 // the gap: amplitude_units, problems/contact_bar/orbits/README.md 'Amplitude units').
