@@ -8,6 +8,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -279,10 +280,9 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
   return M.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 
-PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period, int periods,
-                                       double relative_size, int elements, unsigned seed) {
-  PerturbationGrowth g;
-  if (!(period > 0) || periods < 1 || elements < 1 || !(relative_size != 0)) return g;
+std::optional<bar::BarSetup> perturbed_setup(const bar::BarSetup& setup, double relative_size,
+                                             int elements, unsigned seed) {
+  if (elements < 1 || !(relative_size != 0) || !std::isfinite(relative_size)) return std::nullopt;
   const double length = setup.material.length;
   std::vector<double> nodes(static_cast<std::size_t>(elements) + 1);
   for (int i = 0; i <= elements; ++i) nodes[static_cast<std::size_t>(i)] = length * i / elements;
@@ -302,10 +302,13 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
   // contact instants.
   const auto plus = [&](const bar::PiecewiseLinear& orbit_state, const std::vector<double>& d) {
     const bar::PiecewiseLinear draw(nodes, d);
-    std::vector<double> knots = orbit_state.knots();
+    const std::vector<double>& original = orbit_state.knots();
+    std::vector<double> knots = original;
     for (std::size_t i = 1; i + 1 < knots.size(); ++i) {
-      // At most a quarter of either neighbouring interval: the knots keep their order.
-      const double room = 0.25 * std::min(knots[i] - knots[i - 1], knots[i + 1] - knots[i]) /
+      // At most a quarter of either neighbouring interval of the orbit's knots: the knots keep
+      // their order, and the draw of the opposite sign moves each by exactly the opposite.
+      const double room = 0.25 *
+                          std::min(original[i] - original[i - 1], original[i + 1] - original[i]) /
                           (std::abs(relative_size) * length);
       knots[i] += relative_size * length * std::clamp(unit(random), -room, room);
     }
@@ -334,32 +337,65 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
     perturbed.u0 = bar::PiecewiseLinear(ux, uy);
     perturbed.v0 = bar::PiecewiseLinear(vx, vy);
   } catch (const core::InputError&) {
-    return g;  // knots the union cannot hold (a velocity with jumps): no check
+    return std::nullopt;  // knots the union cannot hold (a velocity with jumps)
   }
-  const exact_bar::ExactBarSolution solution(perturbed, periods * period);
+  return perturbed;
+}
+
+PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period, int periods,
+                                       double relative_size, int elements, unsigned seed) {
+  PerturbationGrowth g;
+  if (!(period > 0) || periods < 1) return g;
+  const std::optional<bar::BarSetup> perturbed =
+      perturbed_setup(setup, relative_size, elements, seed);
+  if (!perturbed) return g;
+  double amplitude = 0;
+  for (int i = 0; i <= elements; ++i)
+    amplitude = std::max(amplitude, std::abs(setup.u0(setup.material.length * i / elements)));
+  const exact_bar::ExactBarSolution solution(*perturbed, periods * period);
   const exact_bar::ExactBarSolution orbit(setup, period);
   if (!solution.ok() || !orbit.ok()) return g;
-  // u on 4 elements + 1 points, one profile of the solution per time.
+  // One profile of a solution per time, on 4 elements + 1 points: u at the nodes, and v
+  // projected on their hats (int v psi_i dx, continuous in the fronts' positions where nodal v
+  // jumps).
   bar::SnapshotRequest samples;
   samples.elements = 4 * elements;
-  // The orbit's u at time tau (mod T), and the distance of a perturbed u from one of them.
-  const auto orbit_u = [&](double tau) {
+  samples.projected_v = true;
+  struct Profile {
+    std::vector<double> u, v;
+  };
+  const auto profile = [&](const exact_bar::ExactBarSolution& of, double t) {
+    bar::FieldSnapshot snap = of.snapshot(t, samples);
+    return Profile{std::move(snap.u), std::move(snap.v_projected)};
+  };
+  // The orbit at time tau (mod T).
+  const auto orbit_at = [&](double tau) {
     tau = std::fmod(tau, period);
     if (tau < 0) tau += period;
-    return orbit.snapshot(tau, samples).u;
+    return profile(orbit, tau);
   };
-  const auto gap = [&](const std::vector<double>& u, const std::vector<double>& w) {
-    double d = 0;
-    for (std::size_t j = 0; j < u.size(); ++j) d = std::max(d, std::abs(u[j] - w[j]));
-    return d / amplitude;
+  // The distance of two states, relative to the amplitude: the larger of max |u - w| and
+  // max_j |sum_{i <= j} int (v - v_w) psi_i dx| / c. The partial sums are int_0^x (v - v_w) dx
+  // averaged over cell j; with u = f + g (d'Alembert), int_0^x v dx / c = g - f, so both parts
+  // are on the footing of f and g, which the free wave carries along unchanged: a
+  // perturbation's strain does not show up as growth when it turns into velocity. Two states
+  // with the same u and other velocities (the orbit at tau and at -tau in a standing wave) are
+  // apart.
+  const double wave_speed = setup.material.wave_speed();
+  const auto gap = [&](const Profile& a, const Profile& b) {
+    double du = 0, dv = 0, partial = 0;
+    for (std::size_t j = 0; j < a.u.size(); ++j) du = std::max(du, std::abs(a.u[j] - b.u[j]));
+    for (std::size_t j = 0; j < a.v.size(); ++j) {
+      partial += a.v[j] - b.v[j];
+      dv = std::max(dv, std::abs(partial));
+    }
+    return std::max(du, dv / wave_speed) / amplitude;
   };
-  const auto gap_at = [&](const std::vector<double>& u, double tau) {
-    return gap(u, orbit_u(tau));
-  };
+  const auto gap_at = [&](const Profile& a, double tau) { return gap(a, orbit_at(tau)); };
   // The whole-period scan's samples are the same at every k: the orbit there, once.
   constexpr int scan = 100;
-  std::vector<std::vector<double>> scanned(2 * scan + 1);
-  for (int i = -scan; i <= scan; ++i) scanned[i + scan] = orbit_u(0.5 * period * i / scan);
+  std::vector<Profile> scanned(2 * scan + 1);
+  for (int i = -scan; i <= scan; ++i) scanned[i + scan] = orbit_at(0.5 * period * i / scan);
   // The nearest state of the orbit: a perturbation of the energy moves the period, so the
   // perturbed state drifts along the orbit (linearly in k: the trivial pair's Jordan block);
   // that drift is no growth. The distance is to the orbit as a set (orbital stability): the
@@ -368,10 +404,10 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
   // sections around its best sample.
   const double r = 0.5 * (std::sqrt(5.0) - 1);
   // profiles: the orbit at the scan's samples (width * i / n), when they are the whole period's.
-  const auto nearest = [&](const std::vector<double>& u, double width, int n,
-                           const std::vector<std::vector<double>>* profiles) {
+  const auto nearest = [&](const Profile& a, double width, int n,
+                           const std::vector<Profile>* profiles) {
     const auto sample = [&](int i) {
-      return profiles ? gap(u, (*profiles)[i + n]) : gap_at(u, width * i / n);
+      return profiles ? gap(a, (*profiles)[i + n]) : gap_at(a, width * i / n);
     };
     double best = 0, best_d = sample(0);
     for (int i = -n; i <= n; ++i) {
@@ -381,18 +417,18 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
     double lo = best - width / n, hi = best + width / n;
     for (int it = 0; it < 40; ++it) {
       const double m1 = hi - r * (hi - lo), m2 = lo + r * (hi - lo);
-      if (gap_at(u, m1) < gap_at(u, m2))
+      if (gap_at(a, m1) < gap_at(a, m2))
         hi = m2;
       else
         lo = m1;
     }
-    return std::min(best_d, gap_at(u, 0.5 * (lo + hi)));
+    return std::min(best_d, gap_at(a, 0.5 * (lo + hi)));
   };
   const auto distance = [&](int k) {
     const double t = k * period,
                  window = std::min(0.25, 1e-2 + 10 * std::abs(relative_size) * k) * period;
-    const std::vector<double> u = solution.snapshot(t, samples).u;
-    return std::min(nearest(u, window, 20, nullptr), nearest(u, 0.5 * period, scan, &scanned));
+    const Profile a = profile(solution, t);
+    return std::min(nearest(a, window, 20, nullptr), nearest(a, 0.5 * period, scan, &scanned));
   };
 
   g.initial = distance(0);

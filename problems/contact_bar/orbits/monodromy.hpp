@@ -28,6 +28,7 @@
 //   core::EvalStatus st = contact_bar::full_state_monodromy(problem, x, o, M);   // 2N x 2N
 #pragma once
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -106,22 +107,28 @@ TdbemFronts orbit_tdbem_front_monodromy(const ContactBarOrbitProblem& problem,
 int jordan_defect(const Eigen::MatrixXd& K, const Eigen::VectorXcd& mu);
 int jordan_defect(const Eigen::MatrixXd& K);
 
-// The check that needs no representation: the orbit's state plus a random perturbation (u and
+// The perturbed state of the check below: the orbit's state plus a random perturbation (u and
 // v continuous and piecewise linear on `elements` uniform intervals, nodal values uniform in
-// [-1, 1] times relative_size times max|u0|, u = v = 0 at x = 0; the orbit's interior knots
-// moved by up to relative_size L, its fronts' shifts; u(L) put on a wall it would cross, so
-// that at a grazing one of the two signs keeps the end's value), simulated by
-// the exact characteristics solver for `periods` periods of T. At t = k T (k = 1..10, then
-// growing by half, and the last) the distance to the orbit as a set is taken: min over tau of
-// max_x |u(x, k T) - u_orbit(x, tau)| (on 4 elements + 1 points; a scan near tau = 0 and one
-// over the whole period), so that the drift along the orbit of a perturbed energy (the trivial
-// pair's Jordan block, linear in k) is not counted.
+// [-1, 1] times relative_size times max|u0|, u = v = 0 at x = 0), with the orbit's interior
+// knots moved by up to relative_size L (at most a quarter of the orbit's neighbouring
+// intervals: its fronts' shifts), and u(L) put on a wall it would cross, so that at a grazing
+// one of the two signs keeps the end's value. A negative relative_size draws the opposite
+// perturbation: every value and every knot's move the same with the other sign (the end's
+// value on a wall aside). Empty when the state cannot hold the draw (a velocity with jumps).
+std::optional<bar::BarSetup> perturbed_setup(const bar::BarSetup& setup, double relative_size,
+                                             int elements, unsigned seed);
+
+// The check that needs no representation: perturbed_setup's state simulated by the exact
+// characteristics solver for `periods` periods of T. At t = k T (k = 1..10, then growing by
+// half, and the last) the distance to the orbit as a set is taken: min over tau of the distance
+// of the two states (the larger of max_x |u - u_orbit(tau)| on 4 elements + 1 points and the
+// largest |int_0^x (v - v_orbit(tau)) dx| / c, averaged over each of their cells, over max|u0|;
+// a scan near tau = 0 and one over the whole period), so that the drift along the orbit of a
+// perturbed energy (the trivial pair's Jordan block, linear in k) is not counted.
 // A multiplier of modulus 1 + d in a direction the perturbation excites grows it like
 // (1 + d)^k; without growth every excited multiplier has |mu| <= largest^(1 / periods)
-// (README.md, section 'Stability'). A negative relative_size draws the same perturbation with
-// the opposite sign (but where two knots lie within 4 relative_size L of each other: a knot
-// moves by at most a quarter of its intervals, which its neighbour's move has changed): on a
-// kink of the period map (a grazing) the two lie on its two sides, to first order.
+// (README.md, section 'Stability'). On a kink of the period map (a grazing) the draw and its
+// opposite lie on its two sides, to first order.
 struct PerturbationGrowth {
   double initial = 0;  // distance at t = 0 (relative to max|u0|)
   double largest = 0;  // largest distance over the sampled k, over the initial one

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "core/stability/floquet.hpp"
@@ -211,6 +212,39 @@ TEST(ContactBarMonodromy, PerturbationsOfModesOneAndTwoDoNotGrowExponentially) {
       EXPECT_LT(g.largest, 3 * at_half) << "E/E_graze " << factor;
       EXPECT_LT(g.largest, 1e3) << "E/E_graze " << factor;
     }
+  }
+}
+
+// The draw and its opposite are exact opposites away from a wall (monodromy.hpp,
+// perturbed_setup): every value and every knot's move the same with the other sign, so the two
+// perturbed states average to the orbit's. Here with two knots of u0 2e-6 L apart, where a knot
+// may move by a quarter of its intervals only: each knot's room is the orbit's, not one its
+// neighbour's move has changed. Away from the knots (1e-6 L, the largest move) the average
+// leaves only the second order of the moves, a^2 of 1e-6 (a value at a moved knot over its
+// interval, ~1e-12 of the amplitude); a first-order mismatch of a clamped move is ~1e-7.
+TEST(ContactBarMonodromy, ThePerturbationAndItsOppositeAreExactOpposites) {
+  bar::BarSetup setup = test_support::paper_setup();
+  const std::vector<double> knots{0.0, 0.3, 0.3 + 2e-6, 0.7, 1.0};
+  setup.u0 = bar::PiecewiseLinear(knots, {0.0, -2e-3, -2.1e-3, -5e-3, -8e-3});
+  setup.v0 = bar::PiecewiseLinear({0.0, 0.4, 1.0}, {0.0, 0.01, -0.02});
+  for (unsigned seed : {1u, 7u, 11u}) {
+    const auto plus = contact_bar::perturbed_setup(setup, 1e-6, 40, seed);
+    const auto minus = contact_bar::perturbed_setup(setup, -1e-6, 40, seed);
+    ASSERT_TRUE(plus && minus);
+    double largest_draw = 0, largest_mismatch = 0;
+    for (int i = 0; i <= 20000; ++i) {
+      const double x = i / 20000.0;
+      if (std::any_of(knots.begin(), knots.end(),
+                      [&](double k) { return std::abs(x - k) < 1e-6; }) ||
+          std::abs(x - 0.4) < 1e-6)
+        continue;
+      largest_draw = std::max(largest_draw, std::abs(plus->u0(x) - setup.u0(x)));
+      largest_mismatch =
+          std::max({largest_mismatch, std::abs(plus->u0(x) + minus->u0(x) - 2 * setup.u0(x)),
+                    std::abs(plus->v0(x) + minus->v0(x) - 2 * setup.v0(x))});
+    }
+    EXPECT_GT(largest_draw, 1e-9) << seed;  // a draw of 1e-6 of the amplitude 8e-3
+    EXPECT_LT(largest_mismatch, 1e-10 * 8e-3) << seed;
   }
 }
 
