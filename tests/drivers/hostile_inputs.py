@@ -616,6 +616,14 @@ c("resume_state_truncated", "trace", ["--resume", "{OUT}"] + MORE, kind="ok", ou
   note="documented repair: a state line cut as by SIGKILL is dropped, the run continues")
 c("resume_valid_contact_bar", "trace", ["--resume", "{OUT}"] + MORE, kind="ok", out=False,
   prep=prep_copy("short"), note="5 points saved: continue to 8")
+for name, what in [("garbage", "text that is no list"),
+                   ("bad_bracket", "a negative bracket"),
+                   ("wrong_size", "a candidate of 3 unknowns on a problem of 21")]:
+    c(f"resume_branch_points_{name}", "trace", ["--resume", "{OUT}"] + MORE, "resume",
+      out=False, prep=prep_copy(f"detecting_{name}"), note=f"branch_points.txt: {what}")
+c("resume_branch_points_list_missing", "trace", ["--resume", "{OUT}"] + MORE, kind="ok",
+  out=False, prep=prep_copy("detecting_list_missing"),
+  note="no branch_points.txt: the rows of branch_points.csv are kept as they are")
 c("resume_valid_more_points", "trace", ["--resume", "{OUT}", "--max_points", "8"], kind="ok",
   out=False, prep=prep_copy("duff"), note="duffing, 5 points saved: continue to 8")
 
@@ -776,6 +784,24 @@ def make_fixtures():
     trace([S, "--branch", "mode1", "--shooting_elements", "20", "--max_points", "5"],
           f"{FX}/short")
     trace([D, "--max_points", "5"], f"{FX}/duff")
+    trace([S, "--branch", "mode1", "--shooting_elements", "20", "--max_points", "5",
+           "--detect_branch_points", "true"], f"{FX}/detecting")
+    for name, text in [("garbage", "hello\nworld\n"),
+                       ("bad_bracket", None), ("wrong_size", None)]:
+        d = f"{FX}/detecting_{name}"
+        shutil.copytree(f"{FX}/detecting", d)
+        saved = open(f"{d}/branch_points.txt").read().splitlines()
+        if name == "bad_bracket":
+            text = "\n".join(saved[:2] + ["bracket=-3 after_point=1 x=1"]) + "\n"
+        if name == "wrong_size":
+            text = "\n".join(saved[:2] + [
+                "bracket=0 after_point=1 arclength=0 test_value=0 sign_change=0 "
+                "location_steps=0 jacobian_evaluations=0 residual_evaluations=0 nullity=1 "
+                "attached_dimension=0 candidates=0 probed=0 verified_dimension=1 "
+                "tangent_angle=nan x=1,2,3 attached_point= attached_points=0 described=0"]) + "\n"
+        write(f"{d}/branch_points.txt", text)
+    shutil.copytree(f"{FX}/detecting", f"{FX}/detecting_list_missing")
+    os.remove(f"{FX}/detecting_list_missing/branch_points.txt")
     def nan_state(d):
         text = open(f"{d}/state.txt").read()
         write(f"{d}/state.txt", re.sub(r"z=[^ ]+", lambda m: "z=" + ",".join(

@@ -129,7 +129,7 @@ TEST(StabilityFiles, BarModeTwoWritesTheTdbemsKBesideTheExactOne) {
 }
 
 // Mode 1's K is [1], with its eigenvector: a perturbed orbit stays within a few times its size
-// (measured at most 1.2 over 1000 periods on the closed forms, test_monodromy.cpp).
+// (measured at most 1.8 over 1000 periods on the closed forms, test_monodromy.cpp).
 TEST(StabilityFiles, PerturbedModeOneOrbitsStayNear) {
   const fs::path out = cli::scratch("stability_cli", "bar_mode1_growth");
   const cli::Run r = cli::run(

@@ -185,11 +185,11 @@ TEST(ContactBarMonodromy, TheExactSolversMultipliersAgreeWithTheTdbems) {
 // The check without a representation (monodromy.hpp, perturbation_growth): a random
 // perturbation of 1e-6 of the closed-form orbits (exact) of modes 1 and 2, simulated by the
 // exact solver for 1000 periods. Mode 1 stays within a few times its initial size (measured
-// at most 1.2; a multiplier of modulus 1.002 in an excited direction would reach 7.4). Mode 2
-// may drift linearly in k along its Jordan block at -1, not exponentially: from k = 500 to
-// 1000 the distance at most triples (linear: 2; |mu| = 1.003 in an excited direction: 4.5),
-// and it stays far below the 1.09^1000 of the projected monodromy's multiplier (README.md,
-// 'Stability').
+// at most 1.8; a multiplier of modulus 1.002 in an excited direction would reach 7.4). Mode 2
+// may drift linearly in k along its Jordan block at -1, not exponentially: from the last sample
+// k_h <= 500 (366) to k = 1000 the distance grows like k^p with p under 1.5 (linear: 1, measured
+// 0.996 to 1.006; |mu| = 1.003 in an excited direction: 1.9), and it stays far below the
+// 1.09^1000 of the projected monodromy's multiplier (README.md, 'Stability').
 TEST(ContactBarMonodromy, PerturbationsOfModesOneAndTwoDoNotGrowExponentially) {
   bar::BarSetup setup = test_support::paper_setup();
   for (int mode : {1, 2}) {
@@ -206,10 +206,12 @@ TEST(ContactBarMonodromy, PerturbationsOfModesOneAndTwoDoNotGrowExponentially) {
         EXPECT_LT(g.largest, 5) << "E/E_graze " << factor;
         continue;
       }
+      int half = 1;
       double at_half = 0;
       for (const auto& [k, d] : g.history)
-        if (k <= 500) at_half = std::max(at_half, d);
-      EXPECT_LT(g.largest, 3 * at_half) << "E/E_graze " << factor;
+        if (k <= 500) half = k, at_half = std::max(at_half, d);
+      EXPECT_LT(std::log(g.largest / at_half) / std::log(1000.0 / half), 1.5)
+          << "E/E_graze " << factor;
       EXPECT_LT(g.largest, 1e3) << "E/E_graze " << factor;
     }
   }
