@@ -44,8 +44,9 @@ struct ContinuationHooks {
   // With options.branch_points.detect: called once per located candidate, in order.
   std::function<void(const BranchPointReport&)> on_branch_point;
   // With options.branch_points.detect: the brackets located or given up so far, whenever that
-  // count grows (after the on_branch_point calls of those brackets). What a saved list of
-  // candidates is complete up to (restart.hpp, LoopState::brackets).
+  // count changes (a resumed loop's first call gives its restored count), after the
+  // on_branch_point calls of those brackets: what a saved list of candidates is complete up to
+  // (restart.hpp, LoopState::brackets). On the loop's thread.
   std::function<void(int settled)> on_brackets_settled;
   // Describes a verified branch point from the located point on the branch and a point of the
   // attached family near it (both in the problem's own unknowns), e.g. the frequency ratio of the

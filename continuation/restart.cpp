@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "continuation/internal/loop_steps.hpp"
 #include "continuation/outputs.hpp"
@@ -49,7 +50,7 @@ class StateReader {
   }
   const std::string& text(const std::string& name) const {
     const auto it = fields_.find(name);
-    if (it == fields_.end()) fail(fmt::format("the loop state has no '{}'", name));
+    if (it == fields_.end()) fail(fmt::format("no '{}'", name));
     return it->second;
   }
   bool has(const std::string& name) const { return fields_.count(name) > 0; }
@@ -314,9 +315,14 @@ std::string format_branch_point(const BranchPointReport& r) {
   for (std::size_t k = 0; k < r.attached_points.size(); ++k)
     line += fmt::format(" attached{}={}", k, numbers(r.attached_points[k]));
   line += fmt::format(" described={}", r.attached_description.size());
-  for (std::size_t k = 0; k < r.attached_description.size(); ++k)
-    line += fmt::format(" name{0}={1} value{0}={2}", k, r.attached_description[k].first,
-                        number(r.attached_description[k].second));
+  for (std::size_t k = 0; k < r.attached_description.size(); ++k) {
+    const std::string& name = r.attached_description[k].first;
+    // The problem's observable names (csv columns): one token each.
+    if (name.empty() || name.find_first_of(" \t\n=") != std::string::npos)
+      throw std::logic_error(fmt::format("the description name '{}' is not one token", name));
+    line +=
+        fmt::format(" name{0}={1} value{0}={2}", k, name, number(r.attached_description[k].second));
+  }
   return line;
 }
 
@@ -330,8 +336,15 @@ BranchPointReport parse_branch_point(const std::string& line, const core::Proble
   r.test_value = in.value("test_value");
   r.sign_change = in.whole("sign_change") != 0;
   r.location_steps = in.whole("location_steps");
-  r.jacobian_evaluations = static_cast<long>(in.value("jacobian_evaluations"));
-  r.residual_evaluations = static_cast<long>(in.value("residual_evaluations"));
+  // Counts of a long run: whole numbers below 2^53.
+  const auto count = [&](const std::string& name) {
+    const double v = in.value(name);
+    if (!(v >= 0 && v < 9e15 && v == std::floor(v)))
+      in.fail(fmt::format("'{}' = {} is not a count", name, v));
+    return static_cast<long>(v);
+  };
+  r.jacobian_evaluations = count("jacobian_evaluations");
+  r.residual_evaluations = count("residual_evaluations");
   r.nullity = in.whole("nullity");
   r.attached_dimension = in.whole("attached_dimension");
   r.candidates = in.whole("candidates");
@@ -348,10 +361,12 @@ BranchPointReport parse_branch_point(const std::string& line, const core::Proble
     r.attached_description.emplace_back(in.text(fmt::format("name{}", k)),
                                         in.value(fmt::format("value{}", k)));
   const Eigen::Index n = problem.num_unknowns();
-  const bool sizes_agree = r.x.size() == n &&
-                           (r.attached_point.size() == 0 || r.attached_point.size() == n) &&
-                           std::all_of(r.attached_points.begin(), r.attached_points.end(),
-                                       [&](const core::Vector& y) { return y.size() == n; });
+  const bool sizes_agree =
+      r.x.size() == n && r.x.allFinite() &&
+      (r.attached_point.size() == 0 || r.attached_point.size() == n) &&
+      r.attached_point.allFinite() &&
+      std::all_of(r.attached_points.begin(), r.attached_points.end(),
+                  [&](const core::Vector& y) { return y.size() == n && y.allFinite(); });
   if (r.bracket < 0 || attached < 0 || described < 0 || !sizes_agree)
     in.fail(fmt::format("not a located candidate of this problem's {} unknowns", n));
   r.observables = problem.observables(r.x);
@@ -359,7 +374,8 @@ BranchPointReport parse_branch_point(const std::string& line, const core::Proble
 }
 
 // The brackets each point's state had made (state.txt, in the order of the file): -1 for a
-// point without a state (`K -`), -2 for a state that does not count them.
+// point without a state (`K -`), -2 for a state that does not count them (a run without
+// detection, or a loop without a detector).
 std::vector<std::pair<int, int>> saved_brackets(const std::filesystem::path& path) {
   std::vector<std::pair<int, int>> out;
   std::ifstream in(path);
@@ -369,9 +385,8 @@ std::vector<std::pair<int, int>> saved_brackets(const std::filesystem::path& pat
     const int point = std::atoi(line.c_str());
     const auto at = line.find(" brackets=");
     const bool stateless = line.size() >= 2 && line.compare(line.size() - 2, 2, " -") == 0;
-    out.emplace_back(point, stateless                 ? -1
-                            : at == std::string::npos ? -2
-                                                      : std::atoi(line.c_str() + at + 10));
+    const int made = at == std::string::npos ? -2 : std::atoi(line.c_str() + at + 10);
+    out.emplace_back(point, stateless ? -1 : made < 0 ? -2 : made);
   }
   return out;
 }
@@ -431,8 +446,8 @@ std::optional<BranchPointResume> branch_point_resume(const std::filesystem::path
   int made = -1;
   for (auto it = brackets.rbegin(); it != brackets.rend(); ++it) {
     if (it->first > last) continue;
-    if (it->second == -2) return std::nullopt;  // states that do not count brackets
-    if (it->second < 0) continue;               // a point without a state
+    if (it->second == -2) return std::nullopt;  // a state that does not count brackets
+    if (it->second < 0) continue;               // a point without a state (landed on a bound)
     if (it->second <= r.saved.settled) {
       r.point = it->first;
       made = it->second;

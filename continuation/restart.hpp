@@ -64,7 +64,7 @@ struct LoopState {
   std::vector<TestFunctionSample> samples;  // the detector's samples before z was added
   // Branch-point detector: the candidates it had bracketed before z was added (-1: not saved).
   // A resume from this state brackets again from there on; the candidates located earlier must
-  // come from the saved list (outputs.hpp, SavedBranchPoints).
+  // come from the saved list (SavedBranchPoints below).
   int brackets = -1;
 
   core::Vector unknowns() const { return z.cwiseProduct(scale); }
@@ -144,8 +144,9 @@ SavedBranchPoints read_saved_branch_points(const std::filesystem::path& dir,
 // last state had made. The resume starts from the last point `point` <= last whose state had
 // made at most the settled brackets (LoopState::brackets); the run from there is the
 // interrupted one's bit for bit and brackets the rest again. saved: the candidates bracketed
-// before that point. Empty when dir has no branch_points.txt or its states do not count brackets
-// (the rows of branch_points.csv are then merged as write_after_run says).
+// before that point. Empty when dir has no branch_points.txt, when a state on the way back does
+// not count brackets, or when none had made few enough (the rows of branch_points.csv are then
+// merged as write_after_run says). The caller checks that the point's state fits its run.
 struct BranchPointResume {
   int point = 0;
   SavedBranchPoints saved;

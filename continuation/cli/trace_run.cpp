@@ -140,11 +140,18 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
     continuation::check_saved_files(t.resume, "resume");
     const int last = continuation::repair_branch_files(t.resume, "resume");
     int from = -1;
-    if (options.branch_points.detect)
+    // A detecting resume along the branch takes up the saved candidates, from the point where
+    // the list is complete, when that point's state continues this run bit for bit; else it
+    // goes on from the last point, and branch_points.csv's saved rows are merged.
+    if (options.branch_points.detect && start_direction > 0)
       if (auto r = continuation::branch_point_resume(t.resume, last, problem, "resume")) {
-        from = r->point;
-        t.saved_branch_points = std::move(r->saved);
-        if (from < last) t.resume_drops_after = last;
+        const continuation::RestartPoint at =
+            continuation::restart_point(t.resume, r->point, options, "resume");
+        if (at.state && continuation::state_mismatch(*at.state, problem, options).empty()) {
+          from = r->point;
+          t.saved_branch_points = std::move(r->saved);
+          if (from < last) t.resume_drops_after = last;
+        }
       }
     t.restart = continuation::restart_point(t.resume, from, options, "resume");
     t.restart->record_saved_point = false;  // it is in the files
@@ -217,8 +224,8 @@ void print_trace_header(TraceRun& t) {
                      : "");
   if (t.resume_drops_after >= 0)
     fmt::print(
-        "  points {} to {} are traced again: the branch points they bracketed were still "
-        "being located when the run stopped (branch_points.txt)\n",
+        "  points {} to {} are traced again, from the last point whose branch points had all "
+        "been located (branch_points.txt)\n",
         restart->index + 1, t.resume_drops_after);
 }
 
@@ -242,6 +249,13 @@ TraceReport::TraceReport(TraceRun& t)
       writer_(t.out, t.periodic, t.restart.has_value() && !t.resume.empty()),
       progress_(t.options()) {
   if (!t.options().branch_points.detect) return;
+  // The list holds every candidate of the branch from a fresh start or a taken-up list only. A
+  // resume that took none up keeps none: a later resume merges branch_points.csv's rows.
+  keep_list_ = t.resume.empty() || t.saved_branch_points.has_value();
+  if (!keep_list_) {
+    std::filesystem::remove(t.out / "branch_points.txt");
+    return;
+  }
   if (t.saved_branch_points) located_ = *t.saved_branch_points;
   located_.write(t.out);
 }
@@ -252,16 +266,20 @@ continuation::ContinuationHooks TraceReport::hooks(const std::optional<StopSigna
   hooks.on_point = [this](const continuation::BranchPoint& p) { on_point(p); };
   hooks.reject_point = t_.setup.reject_point;
   hooks.describe_branch_point = t_.setup.describe_branch_point;
-  // Located candidates as they come (from the detector's thread, a few points after the bracket
-  // that holds them; continuation/README.md, 'Branch points'), between the point lines.
+  // Located candidates as they come (located on the detector's thread, reported on the loop's a
+  // few points after the bracket that holds them; continuation/README.md, 'Branch points'),
+  // between the point lines, and kept in branch_points.txt.
   hooks.on_branch_point = [this](const continuation::BranchPointReport& r) {
-    located_.reports.push_back(r);
-    located_.write(t_.out);
+    if (keep_list_) {
+      located_.reports.push_back(r);
+      located_.write(t_.out);
+    }
     progress_.finish();
     fmt::print("  {}\n", branch_point_line(r));
     std::fflush(stdout);
   };
   hooks.on_brackets_settled = [this](int settled) {
+    if (!keep_list_) return;
     located_.settled = settled;
     located_.write(t_.out);
   };
@@ -379,16 +397,19 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
     const auto verified =
         std::count_if(branch.branch_points.begin(), branch.branch_points.end(),
                       [](const continuation::BranchPointReport& r) { return r.verified(); });
-    fmt::print("branch points located on this branch: {} ({} verified; branch_points.csv)\n",
+    fmt::print("branch points located {}: {} ({} verified; branch_points.csv)\n",
+               t.resume.empty() || t.saved_branch_points ? "on this branch" : "by this run",
                branch.branch_points.size(), verified);
   }
   const continuation::FollowSelection& selection = t.run.follow.selection;
   if (selection.kind == continuation::FollowSelection::Kind::one &&
       selection.k > static_cast<int>(branch.branch_points.size())) {
     fmt::print(stderr,
-               "backbone trace: --follow {}: the branch has {} located branch points "
-               "(branch_points.csv), nothing to follow\n",
-               selection.k, branch.branch_points.size());
+               "backbone trace: --follow {}: {} {} located branch points (branch_points.csv), "
+               "nothing to follow\n",
+               selection.k,
+               t.resume.empty() || t.saved_branch_points ? "the branch has" : "this run has",
+               branch.branch_points.size());
     followed_complete = false;
   }
   if (branch.points.empty()) return followed_complete;

@@ -102,6 +102,7 @@ class TraceReport {
   // With detection: every candidate located so far (the saved ones of a resume first), kept in
   // t.out/branch_points.txt as they come.
   continuation::SavedBranchPoints located_;
+  bool keep_list_ = false;  // located_ is kept in branch_points.txt
   ProgressLine progress_;
   long dimension_flags_[3] = {0, 0, 0};  // branch.csv points per DimensionFlag (branch.hpp)
   long dimension_above_ = 0;             // points verified above the expected dimension

@@ -276,6 +276,7 @@ std::optional<Branch> ArclengthLoop::begin_from_guess(const core::Vector& guess,
   state->tangent = in_unit_scale(s_.tangent);
   state->ds = s_.ds;
   state->jacobian_point = s_.nearby_at;
+  if (detector_) state->brackets = detector_->brackets();
   const std::shared_ptr<const LoopState> first_state = state;
   steps_.report_first(std::move(state));
   detect(start_.index, s_.x, s_.tangent, start_.arclength);

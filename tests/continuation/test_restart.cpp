@@ -305,8 +305,16 @@ TEST(SavedBranchPoints, ResumeStartsWhereEveryBracketWasSettled) {
             .replace(continuation::format_state(minimal_state()).find(" brackets=-1"), 12, "") +
         "\n");
   EXPECT_FALSE(continuation::branch_point_resume(dir, 1, problem, "resume"));
+  // A state of a loop without a detector (brackets=-1) ends the search too.
+  write(state(0, 0) + state(1, -1));
+  EXPECT_FALSE(continuation::branch_point_resume(dir, 1, problem, "resume"));
   std::ofstream(dir / "branch_points.txt") << "not a list\n";
-  EXPECT_THROW(continuation::branch_point_resume(dir, 1, problem, "resume"), core::InputError);
+  try {
+    continuation::branch_point_resume(dir, 1, problem, "resume");
+    ADD_FAILURE() << "a list that is no list was read";
+  } catch (const core::InputError& e) {
+    EXPECT_EQ(e.key(), "resume");
+  }
 }
 
 // Pseudo-arclength round the fold of x^2 + 1000 lambda = 1 (tangent and secant predictors,

@@ -982,14 +982,14 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check, int growth_periods) 
         double largest = 0, power = -std::numeric_limits<double>::infinity();
         for (double size : {1e-6, -1e-6}) {
           const PerturbationGrowth g = perturbation_growth(setup, T, growth_periods, size, 40, 7);
-          int half = 1;           // the last sample at k <= periods / 2
-          double first_half = 1;  // the largest distance up to it (1 at k = 0)
-          for (const auto& [k, d] : g.history)
-            if (2 * k <= growth_periods) half = k, first_half = std::max(first_half, d);
           if (!g.ok) {
             largest = power = nan;
             break;
           }
+          int half = 1;           // the last sample at k <= periods / 2
+          double first_half = 1;  // the largest distance up to it (1 at k = 0)
+          for (const auto& [k, d] : g.history)
+            if (2 * k <= growth_periods) half = k, first_half = std::max(first_half, d);
           largest = std::max(largest, g.largest);
           power = half < growth_periods
                       ? std::max(power, std::log(g.largest / first_half) /

@@ -114,7 +114,8 @@ int jordan_defect(const Eigen::MatrixXd& K);
 // intervals: its fronts' shifts), and u(L) put on a wall it would cross, so that at a grazing
 // one of the two signs keeps the end's value. A negative relative_size draws the opposite
 // perturbation: every value and every knot's move the same with the other sign (the end's
-// value on a wall aside). Empty when the state cannot hold the draw (a velocity with jumps).
+// value on a wall aside). Empty when the state cannot hold the draw (a velocity with jumps), or
+// for relative_size 0 or not finite, or elements < 1.
 std::optional<bar::BarSetup> perturbed_setup(const bar::BarSetup& setup, double relative_size,
                                              int elements, unsigned seed);
 
