@@ -280,14 +280,23 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
   return M.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 
+namespace {
+// max |u0| on the `elements` uniform intervals' nodes: the perturbation's unit.
+double nodal_amplitude(const bar::BarSetup& setup, int elements) {
+  double amplitude = 0;
+  for (int i = 0; i <= elements; ++i)
+    amplitude = std::max(amplitude, std::abs(setup.u0(setup.material.length * i / elements)));
+  return amplitude;
+}
+}  // namespace
+
 std::optional<bar::BarSetup> perturbed_setup(const bar::BarSetup& setup, double relative_size,
                                              int elements, unsigned seed) {
   if (elements < 1 || !(relative_size != 0) || !std::isfinite(relative_size)) return std::nullopt;
   const double length = setup.material.length;
   std::vector<double> nodes(static_cast<std::size_t>(elements) + 1);
   for (int i = 0; i <= elements; ++i) nodes[static_cast<std::size_t>(i)] = length * i / elements;
-  double amplitude = 0;
-  for (double x : nodes) amplitude = std::max(amplitude, std::abs(setup.u0(x)));
+  const double amplitude = nodal_amplitude(setup, elements);
   std::mt19937 random(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const double size = relative_size * amplitude;
@@ -349,9 +358,7 @@ PerturbationGrowth perturbation_growth(const bar::BarSetup& setup, double period
   const std::optional<bar::BarSetup> perturbed =
       perturbed_setup(setup, relative_size, elements, seed);
   if (!perturbed) return g;
-  double amplitude = 0;
-  for (int i = 0; i <= elements; ++i)
-    amplitude = std::max(amplitude, std::abs(setup.u0(setup.material.length * i / elements)));
+  const double amplitude = nodal_amplitude(setup, elements);
   const exact_bar::ExactBarSolution solution(*perturbed, periods * period);
   const exact_bar::ExactBarSolution orbit(setup, period);
   if (!solution.ok() || !orbit.ok()) return g;
