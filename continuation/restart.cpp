@@ -274,7 +274,8 @@ void take_up(RestartPoint& restart, const std::string& key, int direction,
     throw core::InputError(key, fmt::format("the saved point has {} unknowns, this scene's "
                                             "problem {} (same grid keys?)",
                                             restart.x.size(), guess.size()));
-  if (restart.index + 1 >= options.max_points)
+  if (restart.index + 1 > options.max_points ||
+      (restart.index + 1 == options.max_points && !restart.loop_complete))
     throw core::InputError(
         "max_points", fmt::format("the saved branch has {} points already", restart.index + 1));
   if (restart.state) {

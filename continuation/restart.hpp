@@ -92,6 +92,10 @@ struct RestartPoint {
   // folder); false: it is not reported again (--resume: it is in the files).
   bool record_saved_point = true;
   std::string note;  // why the state was not used (take_up), empty otherwise
+  // --resume of a run killed after its loop had reached max_points (summary.txt still says
+  // "running"): no point is left to trace, the run redoes only what follows the loop (outputs,
+  // stability, follows).
+  bool loop_complete = false;
 };
 
 // "DIR:K" or "DIR/orbits.csv:K" (any file of DIR) -> (DIR, K); InputError naming `key`.
@@ -115,7 +119,8 @@ std::string state_mismatch(const LoopState& state, const core::Problem& problem,
 // fallback's secant reversed. A state that does not fit (state_mismatch) is dropped, its reason
 // in restart.note. Without a state: guess = x, direction = the secant (when saved), ds = the next
 // step within [ds_min, ds_max]. InputError naming `key` when the guess's size differs (another
-// grid), or naming max_points when no point would be left (max_points counts the whole branch).
+// grid), or naming max_points when no point would be left (max_points counts the whole branch)
+// and the saved run's loop is not known to have ended there (RestartPoint::loop_complete).
 void take_up(RestartPoint& restart, const std::string& key, int direction,
              const core::Problem& problem, ContinuationOptions& options, core::Vector& guess,
              core::Vector& hint);

@@ -154,7 +154,12 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
         }
       }
     t.restart = continuation::restart_point(t.resume, from, options, "resume");
-    t.restart->record_saved_point = false;  // it is in the files
+    // Killed after its last point (during its outputs or follows): those are done again, from a
+    // branch that holds the last point (not written again: TraceReport::on_point).
+    t.restart->loop_complete =
+        t.restart->index + 1 == options.max_points &&
+        core::read_text_value(t.resume / "summary.txt", "status") == "running";
+    t.restart->record_saved_point = t.restart->loop_complete;  // else it is in the files
   } else if (scene.has("start")) {
     const auto [dir, point] = continuation::parse_saved_point(scene.text("start"), "start");
     continuation::check_saved_files(dir, "start");
@@ -222,6 +227,11 @@ void print_trace_header(TraceRun& t) {
                                                                                ? "no saved state"
                                                                                : restart->note))
                      : "");
+  if (restart && restart->loop_complete)
+    fmt::print(
+        "  the saved branch has its {} points: its outputs, stability and follows are done "
+        "again\n",
+        options.max_points);
   if (t.resume_drops_after >= 0)
     fmt::print(
         "  points {} to {} are traced again, from the last point whose branch points had all "

@@ -270,8 +270,65 @@ TEST(BranchPointsCli, KilledRunLosesNoCandidateAndFollowsThemAll) {
   for (std::size_t k = 1; k <= a.rows(); ++k) {
     const fs::path dir = "branch_point_" + std::to_string(k);
     EXPECT_EQ(fs::exists(part / dir / "branch.csv"), fs::exists(full / dir / "branch.csv")) << k;
-    if (a.column("verified")[k - 1] == 1) EXPECT_TRUE(fs::exists(part / dir / "branch.csv")) << k;
+    if (a.column("verified")[k - 1] == 1) {
+      EXPECT_TRUE(fs::exists(part / dir / "branch.csv")) << k;
+    }
   }
+}
+
+// A run killed after its loop reached max_points, during its follows: summary.txt still says
+// "running", branch_points.csv and the followed folders are not written yet. The kill is made
+// exactly: the uninterrupted run's folder with those files removed and the status set back. The
+// resume has no point left to trace; it writes branch_points.csv and follows every verified
+// candidate again, byte for byte the uninterrupted run's. A finished run at its max_points is
+// still refused: resuming it would trace nothing.
+TEST(BranchPointsCli, RunKilledDuringItsFollowsResumesTheFollows) {
+  const std::string scene = paper +
+                            " --branch mode1 --shooting_elements 40 --period 3.1 --ds 0.05 "
+                            "--ds_max 0.05 --max_points 60 --detect_branch_points true "
+                            "--follow all --follow_max_points 5";
+  const fs::path full = cli::scratch("branch_points_cli", "full"),
+                 part = cli::scratch("branch_points_cli", "killed");
+  ASSERT_EQ(cli::run("trace", scene, full).code, 0);
+  const Table a = Table::read_csv(full / "branch_points.csv");
+  ASSERT_GE(a.rows(), 2u);
+  fs::copy(full, part, fs::copy_options::recursive);
+  const std::string log = part.string() + ".log";
+  const auto resume = [&] {
+    const std::string command = std::string(BACKBONE_BINARY_DIR) +
+                                "/bin/backbone trace --resume '" + part.string() + "' > '" + log +
+                                "' 2>&1";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  EXPECT_EQ(resume(), 2) << cli::file_text(log);
+  EXPECT_NE(cli::file_text(log).find("max_points: the saved branch has 60 points"),
+            std::string::npos)
+      << cli::file_text(log);
+  fs::remove(part / "branch_points.csv");
+  for (std::size_t k = 1; k <= a.rows(); ++k)
+    fs::remove_all(part / ("branch_point_" + std::to_string(k)));
+  std::string summary = cli::file_text(part / "summary.txt");
+  const auto status = summary.find("status complete");
+  ASSERT_NE(status, std::string::npos) << summary;
+  summary.replace(status, 15, "status running");
+  std::ofstream(part / "summary.txt") << summary;
+
+  ASSERT_EQ(resume(), 0) << cli::file_text(log);
+  for (const char* file :
+       {"branch.csv", "unknowns.csv", "state.txt", "branch_points.csv", "summary.txt"})
+    EXPECT_EQ(cli::file_text(part / file), cli::file_text(full / file)) << file;
+  int followed = 0;
+  for (std::size_t k = 1; k <= a.rows(); ++k) {
+    const fs::path dir = "branch_point_" + std::to_string(k);
+    EXPECT_EQ(fs::exists(part / dir), fs::exists(full / dir)) << k;
+    if (!fs::exists(full / dir / "unknowns.csv")) continue;
+    ++followed;
+    EXPECT_EQ(cli::file_text(part / dir / "unknowns.csv"),
+              cli::file_text(full / dir / "unknowns.csv"))
+        << k;
+  }
+  EXPECT_GE(followed, 2);
 }
 
 }  // namespace
