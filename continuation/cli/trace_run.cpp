@@ -301,6 +301,13 @@ continuation::ContinuationHooks TraceReport::hooks(const std::optional<StopSigna
   return hooks;
 }
 
+namespace {
+// A summary count, "-" when the run has none of that kind.
+std::string count_text(long n) {
+  return n < 0 ? "-" : std::to_string(n);
+}
+}  // namespace
+
 std::string TraceReport::summary(const std::string& status, const continuation::Branch* branch,
                                  int switch_index) const {
   const core::Problem& problem = t_.problem();
@@ -308,16 +315,32 @@ std::string TraceReport::summary(const std::string& status, const continuation::
       "problem {}\nbranch {}\nstatus {}\nequations {}\nunknowns {}\nexpected_dimension {}\n"
       "method {}\nnewton {}\nformulation {}\njacobian {}\npoints {}\nrejected_corrections {}\n"
       "switch_index {}\nstop_reason {}\nmessage {}\ndimension_rechecked {}\n"
-      "dimension_unconfirmed {}\ndimension_above_expected {}\n",
+      "dimension_unconfirmed {}\ndimension_above_expected {}\nstable_points {}\n"
+      "unstable_points {}\nundecided_points {}\nbranch_points_located {}\n"
+      "branch_points_verified {}\n",
       t_.entry->name, t_.branch_name, status, problem.num_equations(), problem.num_unknowns(),
       t_.expected_dimension, continuation::to_string(t_.run.options.method), t_.corrector->name(),
       t_.periodic ? core::scene_name(t_.run.formulation) : "-", problem.jacobian_description(),
       points_in_files, rejected, switch_index,
       branch ? continuation::to_string(branch->reason) : "-", branch ? branch->message : "-",
-      dimension_flags_[1], dimension_flags_[2], dimension_above_);
+      dimension_flags_[1], dimension_flags_[2], dimension_above_, count_text(stability_[0]),
+      count_text(stability_[1]), count_text(stability_[2]), count_text(branch_points_[0]),
+      count_text(branch_points_[1]));
 }
 
-void TraceReport::count_dimensions(const core::Table& branch_csv) {
+void TraceReport::count_branch_points(const core::Table& branch_points_csv) {
+  const std::vector<double> verified = branch_points_csv.column("verified");
+  branch_points_[0] = static_cast<long>(verified.size());
+  branch_points_[1] = std::count(verified.begin(), verified.end(), 1.0);
+}
+
+void TraceReport::count_points(const core::Table& branch_csv) {
+  const auto& columns = branch_csv.columns();
+  if (std::find(columns.begin(), columns.end(), "stable") != columns.end()) {
+    std::fill(std::begin(stability_), std::end(stability_), 0);
+    for (double stable : branch_csv.column("stable"))
+      ++stability_[stable == 1 ? 0 : stable == 0 ? 1 : 2];
+  }
   const std::vector<double> flags = branch_csv.column("dimension_flag");
   const std::vector<double> dimensions = branch_csv.column("dimension");
   std::fill(std::begin(dimension_flags_), std::end(dimension_flags_), 0);
@@ -337,7 +360,7 @@ void TraceReport::on_point(const continuation::BranchPoint& p) {
                continuation::dimension_warning(p));
   // A verified dimension above the expected one is a finding, not noise: other families pass
   // through the point (continuation/README.md, 'What a branch records'). Said where it changes;
-  // summary.txt counts such points (count_dimensions).
+  // summary.txt counts such points (count_points).
   if (p.dimension > t_.expected_dimension) {
     if (p.dimension != last_dimension_)
       fmt::print(stderr,
@@ -425,7 +448,7 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
   if (branch.points.empty()) return followed_complete;
   const core::Table table = core::Table::read_csv(t.out / "branch.csv");
   report.points_in_files = table.rows();
-  report.count_dimensions(table);  // the whole branch, a resumed run's saved points included
+  report.count_points(table);  // the whole branch, a resumed run's saved points included
   if (t.setup.covered_dimension == 0)
     continuation::plot_branch(
         t.out, table,
@@ -433,6 +456,8 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
         t.entry->units, t.entry->branch_axes);
   continuation::write_after_run(t.out, t.problem(), branch, !t.resume.empty(),
                                 options.branch_points.detect, t.setup.write_extra_outputs);
+  if (options.branch_points.detect)
+    report.count_branch_points(core::Table::read_csv(t.out / "branch_points.csv"));
   if (options.stability) {
     const continuation::Branch whole =
         t.resume.empty() ? branch

@@ -90,9 +90,12 @@ class TraceReport {
   // summary.txt: `key value` lines (problem, branch, status, counts, stop reason, ...).
   std::string summary(const std::string& status, const continuation::Branch* branch,
                       int switch_index) const;
-  // The summary's dimension counts from the whole branch.csv (its dimension and dimension_flag
-  // columns), so that a resumed run counts the points it did not correct itself.
-  void count_dimensions(const core::Table& branch_csv);
+  // The summary's counts from the whole branch.csv (its dimension and dimension_flag columns,
+  // and stable when the points have multipliers), so that a resumed run counts the points it did
+  // not correct itself.
+  void count_points(const core::Table& branch_csv);
+  // The summary's located and verified branch points: the rows of branch_points.csv.
+  void count_branch_points(const core::Table& branch_points_csv);
 
  private:
   void on_point(const continuation::BranchPoint& p);
@@ -107,6 +110,8 @@ class TraceReport {
   long dimension_flags_[3] = {0, 0, 0};  // branch.csv points per DimensionFlag (branch.hpp)
   long dimension_above_ = 0;             // points verified above the expected dimension
   int last_dimension_ = -1;              // the last point's verified dimension (-1: none yet)
+  long stability_[3] = {-1, -1, -1};     // stable, unstable, undecided points (-1: no column)
+  long branch_points_[2] = {-1, -1};     // located, verified (-1: no detection)
 };
 
 // After the run: the number of located branch points, the figure and the extra outputs of the

@@ -82,6 +82,16 @@ TEST(BranchPointsCli, DetectsTheModeOnePointAtTheExactPeriod) {
   // round-off of the march (problems/contact_bar/solver/README.md, 'Hard cases'), so the angle
   // moves by degrees under equivalent formulas. Bound 60 (mode 1 itself would give 0).
   EXPECT_GT(at("tangent_angle"), 60);
+  // summary.txt says what was found: the rows of branch_points.csv and the verified among them;
+  // no stability counts where the run computed no multipliers.
+  const auto summary = [&](const char* key) {
+    return backbone::core::read_text_value(out / "summary.txt", key);
+  };
+  const auto verified = t.column("verified");
+  EXPECT_EQ(summary("branch_points_located"), std::to_string(t.rows()));
+  EXPECT_EQ(summary("branch_points_verified"),
+            std::to_string(std::count(verified.begin(), verified.end(), 1.0)));
+  EXPECT_EQ(summary("stable_points"), "-");
   fs::remove_all(out);
 }
 

@@ -76,7 +76,18 @@ TEST(StabilityFiles, ImpactOscillatorBranchWritesItsMultipliersAndBifurcations) 
       backbone::core::Table::read_csv(out / "multipliers.csv");
   // Two multipliers per point (the state is (x, v)), each point's stable flag decided.
   EXPECT_EQ(multipliers.rows(), 2 * branch.rows());
-  for (const double s : branch.column("stable")) EXPECT_TRUE(s == 0 || s == 1);
+  const std::vector<double> stable = branch.column("stable");
+  for (const double s : stable) EXPECT_TRUE(s == 0 || s == 1);
+  // summary.txt counts them: every point once, none undecided; no branch points sought.
+  const auto summary = [&](const char* key) {
+    return backbone::core::read_text_value(out / "summary.txt", key);
+  };
+  EXPECT_EQ(summary("stable_points"),
+            std::to_string(std::count(stable.begin(), stable.end(), 1.0)));
+  EXPECT_EQ(summary("unstable_points"),
+            std::to_string(std::count(stable.begin(), stable.end(), 0.0)));
+  EXPECT_EQ(summary("undecided_points"), "0");
+  EXPECT_EQ(summary("branch_points_located"), "-");
   const backbone::core::Table found = backbone::core::Table::read_csv(out / "bifurcations.csv");
   ASSERT_EQ(found.rows(), 1u);
   EXPECT_EQ(found.text_column("type")[0], "grazing");
@@ -93,6 +104,7 @@ TEST(StabilityFiles, StabilityOffWritesNoMultipliers) {
   const cli::Run r = cli::run("trace", duffing + " --stability false --max_points 5", out);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_FALSE(fs::exists(out / "multipliers.csv"));
+  EXPECT_EQ(backbone::core::read_text_value(out / "summary.txt", "stable_points"), "-");
   const backbone::core::Table branch = backbone::core::Table::read_csv(out / "branch.csv");
   EXPECT_EQ(std::count(branch.columns().begin(), branch.columns().end(), "stable"), 0);
   // Duffing's shooting Jacobian is OdeOrbitProblem's, from the variational equations.
