@@ -30,6 +30,16 @@ core::Table orbit_table(const core::PeriodicOrbitProblem& problem, const Branch&
   return t;
 }
 
+std::string stability_counts(const core::Table* table) {
+  if (!table || std::find(table->columns().begin(), table->columns().end(), "stable") ==
+                    table->columns().end())
+    return "stable_points -\nunstable_points -\nundecided_points -\n";
+  long counts[3] = {0, 0, 0};  // stable, unstable, undecided
+  for (double stable : table->column("stable")) ++counts[stable == 1 ? 0 : (stable == 0 ? 1 : 2)];
+  return fmt::format("stable_points {}\nunstable_points {}\nundecided_points {}\n", counts[0],
+                     counts[1], counts[2]);
+}
+
 std::string stability_datablocks(const core::Table& table, const std::string& x,
                                  const std::string& y, const std::string& prefix) {
   const std::vector<double> xs = table.column(x), ys = table.column(y),

@@ -65,6 +65,11 @@ std::string branch_plot_script(const std::filesystem::path& csv, const core::Tab
 std::string stability_datablocks(const core::Table& table, const std::string& x,
                                  const std::string& y, const std::string& prefix);
 
+// summary.txt's stability lines: the points of a branch table by its `stable` column,
+// "stable_points N\nunstable_points N\nundecided_points N\n", each "-" without a table or when
+// it has no such column (no multipliers).
+std::string stability_counts(const core::Table* table);
+
 class BranchWriter {
  public:
   // Creates `out` (and its parents). periodic: the problem when it is a periodic-orbit problem

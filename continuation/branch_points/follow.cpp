@@ -167,8 +167,10 @@ std::vector<FollowedBranch> follow_branch_points(
       }
     }
     f.branch_point = k;
+    std::optional<core::Table> table;
     if (!f.branch.points.empty()) {
-      plot_branch(dir, core::Table::read_csv(dir / "branch.csv"),
+      table = core::Table::read_csv(dir / "branch.csv");
+      plot_branch(dir, *table,
                   fmt::format("attached at branch point {} ({} points)", k, f.branch.points.size()),
                   units);
       if (extra) extra(dir, f.branch);
@@ -177,10 +179,10 @@ std::vector<FollowedBranch> follow_branch_points(
         dir / "summary.txt",
         fmt::format(
             "branch_point {}\npoints {}\nstart_probe {}\nattempts {}\nstop_reason {}\nmessage "
-            "{}\njacobian {}\n",
+            "{}\njacobian {}\n{}",
             k, f.branch.points.size(), f.start ? f.start->probe : -1, f.attempts,
             f.branch.points.empty() ? "-" : to_string(f.branch.reason), f.message,
-            problem.jacobian_description()));
+            problem.jacobian_description(), stability_counts(table ? &*table : nullptr)));
     followed.push_back(std::move(f));
   }
   return followed;

@@ -315,17 +315,16 @@ std::string TraceReport::summary(const std::string& status, const continuation::
       "problem {}\nbranch {}\nstatus {}\nequations {}\nunknowns {}\nexpected_dimension {}\n"
       "method {}\nnewton {}\nformulation {}\njacobian {}\npoints {}\nrejected_corrections {}\n"
       "switch_index {}\nstop_reason {}\nmessage {}\ndimension_rechecked {}\n"
-      "dimension_unconfirmed {}\ndimension_above_expected {}\nstable_points {}\n"
-      "unstable_points {}\nundecided_points {}\nbranch_points_located {}\n"
+      "dimension_unconfirmed {}\ndimension_above_expected {}\n{}branch_points_located {}\n"
       "branch_points_verified {}\n",
       t_.entry->name, t_.branch_name, status, problem.num_equations(), problem.num_unknowns(),
       t_.expected_dimension, continuation::to_string(t_.run.options.method), t_.corrector->name(),
       t_.periodic ? core::scene_name(t_.run.formulation) : "-", problem.jacobian_description(),
       points_in_files, rejected, switch_index,
       branch ? continuation::to_string(branch->reason) : "-", branch ? branch->message : "-",
-      dimension_flags_[1], dimension_flags_[2], dimension_above_, count_text(stability_[0]),
-      count_text(stability_[1]), count_text(stability_[2]), count_text(branch_points_[0]),
-      count_text(branch_points_[1]));
+      dimension_flags_[1], dimension_flags_[2], dimension_above_,
+      stability_.empty() ? continuation::stability_counts(nullptr) : stability_,
+      count_text(branch_points_[0]), count_text(branch_points_[1]));
 }
 
 void TraceReport::count_branch_points(const core::Table& branch_points_csv) {
@@ -335,12 +334,7 @@ void TraceReport::count_branch_points(const core::Table& branch_points_csv) {
 }
 
 void TraceReport::count_points(const core::Table& branch_csv) {
-  const auto& columns = branch_csv.columns();
-  if (std::find(columns.begin(), columns.end(), "stable") != columns.end()) {
-    std::fill(std::begin(stability_), std::end(stability_), 0);
-    for (double stable : branch_csv.column("stable"))
-      ++stability_[stable == 1 ? 0 : stable == 0 ? 1 : 2];
-  }
+  stability_ = continuation::stability_counts(&branch_csv);
   const std::vector<double> flags = branch_csv.column("dimension_flag");
   const std::vector<double> dimensions = branch_csv.column("dimension");
   std::fill(std::begin(dimension_flags_), std::end(dimension_flags_), 0);

@@ -110,7 +110,7 @@ class TraceReport {
   long dimension_flags_[3] = {0, 0, 0};  // branch.csv points per DimensionFlag (branch.hpp)
   long dimension_above_ = 0;             // points verified above the expected dimension
   int last_dimension_ = -1;              // the last point's verified dimension (-1: none yet)
-  long stability_[3] = {-1, -1, -1};     // stable, unstable, undecided points (-1: no column)
+  std::string stability_;                // stability_counts of branch.csv (empty: not yet)
   long branch_points_[2] = {-1, -1};     // located, verified (-1: no detection)
 };
 

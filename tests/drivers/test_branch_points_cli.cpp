@@ -360,6 +360,8 @@ TEST(BranchPointsCli, FollowsTheAttachedFamilyAtConstantPeriod) {
   const fs::path dir = out / ("branch_point_" + std::to_string(row + 1));
   for (const char* file : {"branch.csv", "orbits.csv", "unknowns.csv", "summary.txt"})
     EXPECT_TRUE(fs::exists(dir / file)) << file;
+  // Without multipliers its summary counts none.
+  EXPECT_EQ(backbone::core::read_text_value(dir / "summary.txt", "stable_points"), "-");
   // The followed family is corrected with the trace's Jacobian (the scene's default, exact).
   EXPECT_EQ(backbone::core::read_text_value(dir / "summary.txt", "jacobian"), "exact");
   const Table b = Table::read_csv(dir / "branch.csv");

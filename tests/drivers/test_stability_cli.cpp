@@ -192,6 +192,44 @@ TEST(StabilityFiles, TheContinuumsGrazingLimitIsFlaggedWithoutTheTdbem) {
   fs::remove_all(out);
 }
 
+// summary.txt counts the points by stability, the followed branches' too. Mode 1 has one
+// front and K = [1] (problems/contact_bar/orbits/README.md, 'Stability'): every point of the
+// branch is stable. The followed families attached to it: each of their points is counted once.
+TEST(StabilityFiles, SummariesCountThePointsByStability) {
+  const fs::path out = cli::scratch("stability_cli", "counts");
+  const cli::Run r = cli::run("trace",
+                              paper +
+                                  " --branch mode1 --shooting_elements 40 --period 3.1 --ds 0.05 "
+                                  "--ds_max 0.05 --max_points 60 --detect_branch_points true "
+                                  "--follow all --follow_max_points 4 --stability true "
+                                  "--stability_growth_periods 0",
+                              out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto value = [](const fs::path& dir, const char* key) {
+    return backbone::core::read_text_value(dir / "summary.txt", key);
+  };
+  EXPECT_EQ(value(out, "stable_points"), "60");
+  EXPECT_EQ(value(out, "unstable_points"), "0");
+  EXPECT_EQ(value(out, "undecided_points"), "0");
+  int followed = 0;
+  const std::size_t rows = backbone::core::Table::read_csv(out / "branch_points.csv").rows();
+  for (std::size_t k = 1; k <= rows; ++k) {
+    const fs::path dir = out / ("branch_point_" + std::to_string(k));
+    if (!fs::exists(dir / "branch.csv")) continue;
+    ++followed;
+    const auto stable = backbone::core::Table::read_csv(dir / "branch.csv").column("stable");
+    const long counted = std::stol(value(dir, "stable_points")) +
+                         std::stol(value(dir, "unstable_points")) +
+                         std::stol(value(dir, "undecided_points"));
+    EXPECT_EQ(counted, static_cast<long>(stable.size())) << k;
+    EXPECT_EQ(value(dir, "stable_points"),
+              std::to_string(std::count(stable.begin(), stable.end(), 1.0)))
+        << k;
+  }
+  EXPECT_GE(followed, 4);
+  fs::remove_all(out);
+}
+
 TEST(StabilityInput, TdbemCheckNeedsTheTdbemAndTheFronts) {
   cli::expect_bad_input("trace",
                         paper +
