@@ -127,24 +127,27 @@ int run_trace(const std::vector<std::string>& args_in) {
                           {"out", "help", "branch", "start", "direction"});
   core::write_text_atomically(t.out / "summary.txt", report.summary("running", nullptr, -1));
 
-  // SIGINT / SIGTERM: stop before the next step (the point is finished and written, then the
-  // summary); a second one stops at once (continuation/cli/stop_signals.hpp).
+  // SIGINT / SIGTERM: stop before the next step (the point is finished and written), or at the
+  // next stage after the loop; the outputs so far and the summary are written. A second one
+  // stops at once (continuation/cli/stop_signals.hpp).
   std::optional<cli::StopSignals> stop(std::in_place);
   const cont::ContinuationHooks hooks = report.hooks(stop);
   cont::SwitchingBranch result =
       cli::run_continuation(t.problem(), t.setup.guess, t.direction, t.run, *t.corrector, hooks,
                             t.restart ? &*t.restart : nullptr);
-  const int stop_signal = stop->signal();
-  stop.reset();  // the default actions again
   report.progress().finish();
   cli::add_saved_branch_points(t, result.branch);
   const cont::Branch& branch = result.branch;
   const bool complete = !branch.points.empty() && !branch.ended_early();
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
   const bool followed_complete = cli::write_outputs_and_follow(t, report, branch, hooks);
-  core::write_text_atomically(
-      t.out / "summary.txt",
-      report.summary(complete ? "complete" : "ended early", &branch, result.switch_index));
+  const int stop_signal = stop->signal();
+  stop.reset();  // the default actions again
+  // An interrupted run's summary says so: --resume then does what it skipped.
+  core::write_text_atomically(t.out / "summary.txt", report.summary(stop_signal != 0 ? "interrupted"
+                                                                    : complete       ? "complete"
+                                                                               : "ended early",
+                                                                    &branch, result.switch_index));
   fmt::print("wrote {}\n", t.out.string());
   if (stop_signal != 0) {
     fmt::print(stderr,

@@ -120,6 +120,7 @@ std::vector<FollowedBranch> follow_branch_points(
   const auto* periodic = dynamic_cast<const core::PeriodicOrbitProblem*>(&problem);
   for (std::size_t i = 0; i < branch.branch_points.size(); ++i) {
     const int k = static_cast<int>(i) + 1;
+    if (hooks.cancel_requested && hooks.cancel_requested()) break;  // the rest left as they are
     if (!run.selection.selects(k)) continue;
     const BranchPointReport& report = branch.branch_points[i];
     if (!report.verified() && run.selection.kind == FollowSelection::Kind::all) continue;

@@ -118,6 +118,8 @@ struct FollowRun {
 core::NewtonOptions follow_newton_options(const core::NewtonOptions& newton,
                                           const ContinuationOptions& options);
 
+// Follows the selected rows of branch.branch_points into out/branch_point_K/. A stop request
+// (hooks.cancel_requested) ends the branch under way and leaves the rows after it untouched.
 std::vector<FollowedBranch> follow_branch_points(
     const core::Problem& problem, const Branch& branch, const FollowRun& run,
     core::Corrector& corrector, const ContinuationOptions& options, const ContinuationHooks& hooks,

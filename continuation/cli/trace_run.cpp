@@ -154,11 +154,12 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
         }
       }
     t.restart = continuation::restart_point(t.resume, from, options, "resume");
-    // Killed after its last point (during its outputs or follows): those are done again, from a
-    // branch that holds the last point (not written again: TraceReport::on_point).
-    t.restart->loop_complete =
-        t.restart->index + 1 == options.max_points &&
-        core::read_text_value(t.resume / "summary.txt", "status") == "running";
+    // Killed or interrupted after its last point (during its outputs or follows): those are
+    // done again, from a branch that holds the last point (not written again:
+    // TraceReport::on_point).
+    const std::string status = core::read_text_value(t.resume / "summary.txt", "status");
+    t.restart->loop_complete = t.restart->index + 1 == options.max_points &&
+                               (status == "running" || status == "interrupted");
     t.restart->record_saved_point = t.restart->loop_complete;  // else it is in the files
   } else if (scene.has("start")) {
     const auto [dir, point] = continuation::parse_saved_point(scene.text("start"), "start");
@@ -420,6 +421,8 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
                               const continuation::ContinuationHooks& hooks) {
   bool followed_complete = true;
   const continuation::ContinuationOptions& options = t.options();
+  // A stop request (SIGINT, SIGTERM) skips the stages not yet begun: --resume does them.
+  const auto stopping = [&hooks] { return hooks.cancel_requested && hooks.cancel_requested(); };
   if (options.branch_points.detect) {
     const auto verified =
         std::count_if(branch.branch_points.begin(), branch.branch_points.end(),
@@ -449,9 +452,16 @@ bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuati
         fmt::format("{} / {} ({} points)", t.entry->name, t.branch_name, table.rows()),
         t.entry->units, t.entry->branch_axes);
   continuation::write_after_run(t.out, t.problem(), branch, !t.resume.empty(),
-                                options.branch_points.detect, t.setup.write_extra_outputs);
+                                options.branch_points.detect,
+                                stopping() ? nullptr : t.setup.write_extra_outputs);
   if (options.branch_points.detect)
     report.count_branch_points(core::Table::read_csv(t.out / "branch_points.csv"));
+  if (stopping()) {
+    fmt::print(
+        "stop requested: the problem's outputs over the whole branch, its stability and "
+        "the follows are left to --resume\n");
+    return false;
+  }
   if (options.stability) {
     const continuation::Branch whole =
         t.resume.empty() ? branch

@@ -84,8 +84,8 @@ class TraceReport {
   continuation::BranchWriter& writer() { return writer_; }
   ProgressLine& progress() { return progress_; }
 
-  // stop: the signal handlers while they are installed (the followed branches run after they
-  // are reset, and then cannot be cancelled).
+  // stop: the signal handlers while they are installed (the whole run, the stages after the
+  // loop and the followed branches too).
   continuation::ContinuationHooks hooks(const std::optional<StopSignals>& stop);
   // summary.txt: `key value` lines (problem, branch, status, counts, stop reason, ...).
   std::string summary(const std::string& status, const continuation::Branch* branch,
@@ -117,7 +117,8 @@ class TraceReport {
 // After the run: the number of located branch points, the figure and the extra outputs of the
 // whole branch (saved points included), then the followed branches. Returns whether every
 // followed branch reached its bound or budget (false too when `--follow K` names a row the
-// run did not locate).
+// run did not locate). A stop request (hooks.cancel_requested) skips the stages not begun:
+// the problem's outputs over the branch, the stability report and the follows.
 bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
                               const continuation::ContinuationHooks& hooks);
 

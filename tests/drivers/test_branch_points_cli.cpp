@@ -6,9 +6,12 @@
 // T = 3.33 that its probes do not verify, and T = 3.2 with an attached family of dimension 6 or
 // 7 (it depends on N and on round-off, problems/contact_bar/orbits/README.md, 'Dimension changes').
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -339,6 +342,56 @@ TEST(BranchPointsCli, RunKilledDuringItsFollowsResumesTheFollows) {
         << k;
   }
   EXPECT_GE(followed, 2);
+}
+
+// SIGINT while the run follows its branch points (sent when branch_point_1/ appears): the
+// follow under way stops at its next point, the rows after it are left, the run exits 130 with
+// summary.txt's status "interrupted", and --resume does the follows again: the same files as the
+// uninterrupted run, byte for byte.
+TEST(BranchPointsCli, InterruptDuringTheFollowsIsResumed) {
+  const std::string scene = paper +
+                            " --branch mode1 --shooting_elements 40 --period 3.1 --ds 0.05 "
+                            "--ds_max 0.05 --max_points 60 --detect_branch_points true "
+                            "--follow all --follow_max_points 200";
+  const fs::path full = cli::scratch("branch_points_cli", "full"),
+                 part = cli::scratch("branch_points_cli", "interrupted");
+  ASSERT_EQ(cli::run("trace", scene, full).code, 0);
+  const std::string log = part.string() + ".log";
+  const std::string command = "exec " + std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace " +
+                              scene + " --out '" + part.string() + "' > '" + log + "' 2>&1";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    setpgid(0, 0);  // backbone (exec'd by the shell) in a group of its own, as from a terminal
+    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  setpgid(pid, pid);
+  int status = 0;
+  bool signalled = false;
+  for (int waited = 0; waited < 600000 && waitpid(pid, &status, WNOHANG) == 0; ++waited) {
+    if (!signalled && fs::exists(part / "branch_point_1")) {
+      kill(-pid, SIGINT);
+      signalled = true;
+    }
+    usleep(100);
+  }
+  ASSERT_TRUE(signalled) << cli::file_text(log);
+  ASSERT_TRUE(WIFEXITED(status)) << cli::file_text(log);
+  EXPECT_EQ(WEXITSTATUS(status), 130) << cli::file_text(log);
+  EXPECT_EQ(backbone::core::read_text_value(part / "summary.txt", "status"), "interrupted");
+  const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
+                             part.string() + "' > '" + log + "' 2>&1";
+  ASSERT_EQ(std::system(resume.c_str()), 0) << cli::file_text(log);
+  for (const char* file : {"branch.csv", "unknowns.csv", "branch_points.csv", "summary.txt"})
+    EXPECT_EQ(cli::file_text(part / file), cli::file_text(full / file)) << file;
+  const Table a = Table::read_csv(full / "branch_points.csv");
+  for (std::size_t k = 1; k <= a.rows(); ++k) {
+    const fs::path dir = "branch_point_" + std::to_string(k);
+    EXPECT_EQ(cli::file_text(part / dir / "unknowns.csv"),
+              cli::file_text(full / dir / "unknowns.csv"))
+        << k;
+  }
 }
 
 }  // namespace
