@@ -238,7 +238,13 @@ RestartPoint restart_point(const std::filesystem::path& dir, int point,
   r.x = read_unknowns(dir / "unknowns.csv", r.index, key);
   r.arclength = arclength[i];
   if (r.index > 0) {
-    r.secant = r.x - read_unknowns(dir / "unknowns.csv", r.index - 1, key);
+    r.previous_x = read_unknowns(dir / "unknowns.csv", r.index - 1, key);
+    r.secant = r.x - r.previous_x;
+    const auto before = std::find(index.begin(), index.end(), wanted - 1);
+    if (before != index.end())
+      r.previous_arclength = arclength[static_cast<std::size_t>(before - index.begin())];
+    else
+      r.previous_x.resize(0);
     r.next_step = adapted_step(step[i], static_cast<int>(iterations[i]), options);
   }
   r.state = read_state(dir / "state.txt", r.index, key);
@@ -281,6 +287,15 @@ void take_up(RestartPoint& restart, const std::string& key, int direction,
   if (restart.state) {
     restart.note = state_mismatch(*restart.state, problem, options);
     if (!restart.note.empty()) restart.state = nullptr;
+  }
+  // Along the branch the loop looks back on the saved point and the one before, as the files
+  // hold them (their observables recomputed from the saved unknowns: the same bits).
+  if (restart.state && direction > 0 && restart.previous_x.size() == restart.x.size()) {
+    auto known = std::make_shared<LoopState>(*restart.state);
+    known->known_points = {
+        {restart.index - 1, restart.previous_arclength, problem.observables(restart.previous_x)},
+        {restart.index, restart.arclength, problem.observables(restart.x)}};
+    restart.state = known;
   }
   if (restart.state && direction < 0) {
     auto back = std::make_shared<LoopState>(*restart.state);

@@ -41,6 +41,13 @@ struct BranchStart {
   int switch_index = -1;
 };
 
+// A point of the branch seen before a restart: index, arclength and observables.
+struct KnownPoint {
+  int index = 0;
+  double arclength = 0;
+  core::Observables observables;
+};
+
 struct LoopState {
   Method method = Method::arclength;  // the loop it continues: arclength or natural
   int index = 0;                      // the point's index on the branch
@@ -66,6 +73,10 @@ struct LoopState {
   // A resume from this state brackets again from there on; the candidates located earlier must
   // come from the saved list (SavedBranchPoints below).
   int brackets = -1;
+  // Not in the text form: the saved point and the one before it as the files hold them, which a
+  // resumed loop looks back on where an uninterrupted one has its last two points (the chord
+  // that aims a step at a bound ahead, LoopSteps::bound_within). Filled by take_up.
+  std::vector<KnownPoint> known_points;
 
   core::Vector unknowns() const { return z.cwiseProduct(scale); }
 };
@@ -91,7 +102,9 @@ struct RestartPoint {
   // true: the saved point is the first point of the restarted branch (--start into a new
   // folder); false: it is not reported again (--resume: it is in the files).
   bool record_saved_point = true;
-  std::string note;  // why the state was not used (take_up), empty otherwise
+  std::string note;         // why the state was not used (take_up), empty otherwise
+  core::Vector previous_x;  // the point before (empty at point 0) and its arclength
+  double previous_arclength = 0;
   // --resume of a run killed after its loop had reached max_points (summary.txt still says
   // "running"): no point is left to trace, the run redoes only what follows the loop (outputs,
   // stability, follows).

@@ -97,6 +97,7 @@ void LoopSteps::resume(const LoopState& state, bool record) {
   first_index_ = state.index;
   arclength_ = state.arclength;
   switch_index_ = state.switch_index;
+  known_points_ = state.known_points;
   if (!record) {
     ++first_index_;
     return;
@@ -290,13 +291,27 @@ bool LoopSteps::land(const Bound& bound, double value,
 }
 
 const Bound* LoopSteps::bound_within(double ds, double& value, double& ds_to_bound) const {
-  if (!options_.land_on_bounds || branch_.points.size() < 2) return nullptr;
-  const BranchPoint& a = branch_.points[branch_.points.size() - 2];
-  const BranchPoint& b = branch_.points.back();
+  if (!options_.land_on_bounds) return nullptr;
+  // The last two points, newest first: the recorded ones, then those known before a resume.
+  struct Seen {
+    int index;
+    double arclength;
+    const core::Observables* observables;
+  };
+  Seen last[2];
+  int seen = 0;
+  for (auto p = branch_.points.rbegin(); p != branch_.points.rend() && seen < 2; ++p)
+    last[seen++] = {p->index, p->arclength, &p->observables};
+  for (auto p = known_points_.rbegin(); p != known_points_.rend() && seen < 2; ++p)
+    if (seen == 0 || p->index < last[seen - 1].index)
+      last[seen++] = {p->index, p->arclength, &p->observables};
+  if (seen < 2) return nullptr;
+  const Seen &a = last[1], &b = last[0];
   const double chord = b.arclength - a.arclength;
   if (!(chord > 0) || b.index != a.index + 1) return nullptr;
   for (const Bound& bound : options_.bounds) {
-    const double va = a.observable(bound.observable), vb = b.observable(bound.observable);
+    const double va = core::observable_value(*a.observables, bound.observable),
+                 vb = core::observable_value(*b.observables, bound.observable);
     if (!std::isfinite(va) || !std::isfinite(vb)) continue;
     const double slope = (vb - va) / chord;
     const double target = slope > 0 ? bound.max : bound.min;

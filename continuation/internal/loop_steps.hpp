@@ -170,6 +170,10 @@ class LoopSteps {
   // branch begins with the next one (--resume). InputError when the state does not fit the
   // problem (restart.hpp: state_mismatch).
   void resume(const LoopState& state, bool record);
+  // After resume without recording: the saved point x (in the loop's units) is the next point's
+  // known neighbour, its residual evaluated here as finish() did when it was recorded, so that
+  // the next point's rank verification (and its evaluation counts) are the uninterrupted run's.
+  void remember_saved_point(const core::Vector& x) { recorder_.remember(x); }
   int switch_index() const { return switch_index_; }
 
   // Before each further step: false when the branch has options.max_points points or a cancel
@@ -215,8 +219,9 @@ class LoopSteps {
               int newton_iterations, double ds, bool force_rank, std::shared_ptr<LoopState> state,
               const core::Vector* curve_direction = nullptr);
 
-  // The bound whose observable, extrapolated along the chord of the last two recorded points,
-  // reaches it within ds of the last point (null: none, or fewer than two points): its value
+  // The bound whose observable, extrapolated along the chord of the last two points (recorded,
+  // or before a resume: the state's known points), reaches it within ds of the last point
+  // (null: none, or fewer than two points): its value
   // and the distance to it. The loop then aims its step at the bound (land_ahead) instead of
   // crossing it and landing back.
   const Bound* bound_within(double ds, double& value, double& ds_to_bound) const;
@@ -257,6 +262,7 @@ class LoopSteps {
   const ContinuationHooks& hooks_;
   PointRecorder recorder_;
   Branch branch_;
+  std::vector<KnownPoint> known_points_;    // a resumed state's (LoopState::known_points)
   std::vector<core::Vector> point_scales_;  // problem_.scale() when each point was added
   int first_index_ = 0;
   double arclength_ = 0;

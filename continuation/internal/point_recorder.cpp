@@ -120,6 +120,14 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   return p;
 }
 
+void PointRecorder::remember(const core::Vector& x) {
+  core::Vector r;
+  last_x_ = x;
+  last_residual_ = problem_.residual(x, r) == core::EvalStatus::ok
+                       ? r.lpNorm<Eigen::Infinity>()
+                       : std::numeric_limits<double>::quiet_NaN();
+}
+
 double PointRecorder::known_residual(const core::Vector* x) const {
   if (x && x->size() == last_x_.size() && *x == last_x_) return last_residual_;
   return std::numeric_limits<double>::quiet_NaN();

@@ -68,6 +68,9 @@ class PointRecorder {
   // First bound the point violates, or nullptr; `value` receives the bound value crossed.
   const Bound* violated_bound(const BranchPoint& point, double& value) const;
   double elapsed_seconds() const;
+  // Takes x as the last recorded point (its residual evaluated now): a resumed loop's saved
+  // point, which finish() recorded in the earlier run.
+  void remember(const core::Vector& x);
 
  private:
   // ||F(x)||_inf when x is the last point finish() recorded (the branch's previous point, the

@@ -121,6 +121,7 @@ Branch natural_loop(const ScaledProblem& problem, const core::Vector& guess,
   s.previous_step = from ? from->previous_step : 0;
   if (from) {
     steps.resume(*from, record_from);
+    if (!record_from) steps.remember_saved_point(s.x);
   } else {
     if (!steps.start(
             system, s.x,

@@ -216,6 +216,9 @@ void ArclengthLoop::adopt_units_of(const LoopState& state) {
 std::optional<Branch> ArclengthLoop::begin_from_state(const LoopState& from, bool record_from) {
   steps_.resume(from, record_from);
   adopt_units_of(from);
+  // Units that follow the point set its residual's scale after it was recorded: its residual
+  // norm then would not be the one recorded, so the next point verifies without it.
+  if (!record_from && !follow_scale_) steps_.remember_saved_point(s_.x);
   s_.ds = from.ds;
   s_.chord_misses = from.chord_misses;
   keep_base(from.jacobian_point);

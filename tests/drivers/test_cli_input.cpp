@@ -170,7 +170,7 @@ TEST(SimulateInput, AHistoryTooLargeToHoldIsRefusedUpFront) {
   // 50000 probes x 311 rows (3.1 s at dt = 0.01) x 100005 columns: 3e7 values, above a tenth of
   // max_steps (1e8).
   std::string probes = "probes =";
-  for (int i = 0; i < 50000; ++i) probes += " " + std::to_string(i / 50000.0);
+  for (int i = 0; i < 50000; ++i) (probes += ' ') += std::to_string(i / 50000.0);
   std::ifstream paper(scene);
   std::stringstream text;
   text << paper.rdbuf() << "\n" << probes << "\n";

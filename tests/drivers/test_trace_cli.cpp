@@ -218,6 +218,29 @@ TEST(TraceCli, ResumeContinuesAnInterruptedBranch) {
   fs::remove(part.string() + ".log");
 }
 
+// A resume from the point before the landing on the energy bound lands as the uninterrupted run
+// did: the loop aims its step at the bound along the chord of its last two points, which a
+// resumed loop takes from the files (LoopState::known_points). Without them it crossed the bound
+// and landed back, on other bits. branch.csv and unknowns.csv byte for byte.
+TEST(TraceCli, ResumeBeforeTheLandingLandsBitForBit) {
+  const fs::path full = cli::scratch("trace_cli", "full"), part = cli::scratch("trace_cli", "part");
+  ASSERT_EQ(cli::run("trace", small_mode1, full).code, 0);
+  const std::size_t rows = backbone::core::Table::read_csv(full / "branch.csv").rows();
+  ASSERT_GE(rows, 3u);
+  EXPECT_EQ(backbone::core::read_text_value(full / "summary.txt", "stop_reason"), "bound_reached");
+  ASSERT_EQ(cli::run("trace", small_mode1 + " --max_points " + std::to_string(rows - 1), part).code,
+            0);
+  const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
+                             part.string() + "' --max_points 1000 > '" + part.string() +
+                             ".log' 2>&1";
+  ASSERT_EQ(std::system(resume.c_str()), 0) << file_text(part.string() + ".log");
+  EXPECT_EQ(file_text(part / "branch.csv"), file_text(full / "branch.csv"));
+  EXPECT_EQ(file_text(part / "unknowns.csv"), file_text(full / "unknowns.csv"));
+  fs::remove_all(full);
+  fs::remove_all(part);
+  fs::remove(part.string() + ".log");
+}
+
 // A branch that ended on its bound gains no point when taken up again (the restart's last
 // point lies on the bound: landing again would add a copy of it), whatever other key is given:
 // branch.csv stays byte for byte, exit 0. A key that moves the bound extends it.
@@ -447,12 +470,12 @@ TEST(ReadmeCommands, TraceResumeInspectContinuumAndAtlasRunAsWritten) {
   ASSERT_EQ(cli::run("trace", paper + " --branch mode1", mode1).code, 0);
   // A finished branch resumed: nothing left to do, exit 0, the same points.
   const auto before = backbone::core::Table::read_csv(mode1 / "branch.csv").rows();
-  const std::string resume = "'" + std::string(BACKBONE_BINARY_DIR) +
+  const std::string resume = std::string("'") + BACKBONE_BINARY_DIR +
                              "/bin/backbone' trace --resume '" + mode1.string() +
                              "' > /dev/null 2>&1";
   EXPECT_EQ(std::system(resume.c_str()), 0);
   EXPECT_EQ(backbone::core::Table::read_csv(mode1 / "branch.csv").rows(), before);
-  const std::string inspect = "'" + std::string(BACKBONE_BINARY_DIR) + "/bin/backbone' inspect " +
+  const std::string inspect = std::string("'") + BACKBONE_BINARY_DIR + "/bin/backbone' inspect " +
                               paper + " --orbit '" + (mode1 / "orbits.csv").string() +
                               ":10' > /dev/null 2>&1";
   EXPECT_EQ(std::system(inspect.c_str()), 0);
