@@ -224,8 +224,12 @@ po::options_description trace_keys() {
        "(0, 0.5); with the grid representation pass 1e-2")  //
       ("stability_elements", po::value<long>()->default_value(0),
        "intervals of a uniform (u, v) grid for the monodromy, in [0, 2000] (0: the shooting "
-       "grid itself, mapped by its free knots); M is "
-       "2N x 2N, dense (128 MB and about a minute of eigenvalues at 2000)")  //
+       "grid itself, mapped by its free knots); M is 2N x 2N, dense, from 4N simulations "
+       "(max_stability_work bounds their cost)")  //
+      ("max_stability_work", po::value<double>()->default_value(1e10),
+       "refuse a grid monodromy whose simulations cost more than this many element-steps per "
+       "point (4 N simulations of N intervals over T at stability_courant: about 30 s per point "
+       "at 1e10 on this machine class, near 270 intervals on the paper scene's mode 1)")  //
       ("stability_courant", po::value<double>()->default_value(1.0 / 32),
        "c dt / dx of the monodromy's simulations at most, in (0, 1]: the velocity columns of "
        "the monodromy carry an error of 0.46 (c dt / dx)^2")  //
@@ -1009,6 +1013,53 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check, int growth_periods) 
   };
 }
 
+namespace {
+
+// The stability keys apply with --stability true, and the grid's with the grid representation:
+// one given where it does nothing is refused, lest a run be read as what it did not compute.
+void check_stability_keys(const core::Scene& scene) {
+  auto given = [&](const char* key) { return !scene.values()[key].defaulted(); };
+  const bool stability = scene.flag("stability");
+  const bool grid =
+      parse_representation("stability_representation", scene.text("stability_representation")) ==
+      MonodromyOptions::Representation::grid;
+  for (const char* key : {"stability_representation", "stability_elements", "stability_courant",
+                          "stability_step", "stability_growth_periods"})
+    if (!stability && given(key)) throw core::InputError(key, "applies with --stability true");
+  for (const char* key : {"stability_elements", "stability_courant", "stability_step"})
+    if (!grid && given(key))
+      throw core::InputError(key,
+                             "applies with --stability_representation grid (the fronts' K "
+                             "has no grid)");
+  for (const char* key : {"stability_growth_periods"})
+    if (grid && given(key))
+      throw core::InputError(key, "applies with --stability_representation fronts");
+}
+
+// The grid monodromy's cost per point, before any work: 4 N simulations of N intervals over the
+// period T at c dt = stability_courant dx, about 4 N^2 c T / (courant dx) element-steps (measured
+// on mode 1: 4.1e9 in 13 s at 200 intervals, 3.3e10 in 62 s at 400), against max_stability_work.
+void check_grid_monodromy_work(const core::Scene& scene, const cli::TraceSetup& s) {
+  const auto* p = dynamic_cast<const ContactBarOrbitProblem*>(s.problem.get());
+  if (!p || p->monodromy_options().representation != MonodromyOptions::Representation::grid) return;
+  const MonodromyOptions& o = p->monodromy_options();
+  const double n = o.elements > 0 ? o.elements : p->options().elements + p->options().free_knots;
+  const bar::Material& material = p->setup_template().material;
+  const double period = s.guess[p->period_index()];
+  const double steps = period * material.wave_speed() * n / (o.courant * material.length);
+  const double work = 4 * n * n * steps;
+  const double limit = scene.positive("max_stability_work");
+  if (work <= limit) return;
+  throw core::InputError(
+      o.elements > 0 ? "stability_elements" : "shooting_elements",
+      fmt::format("the grid monodromy of {:.0f} intervals marches 4 x {:.0f} simulations of {:.3g} "
+                  "steps, {:.3g} element-steps per point, above max_stability_work {:.3g}: "
+                  "fewer intervals, a larger stability_courant, or a larger max_stability_work",
+                  n, n, steps, work, limit));
+}
+
+}  // namespace
+
 cli::TraceSetup setup_trace_with_reports(const core::Scene& scene, const std::string& branch) {
   const bool tdbem_check = scene.flag("stability_tdbem_check");
   if (tdbem_check) {
@@ -1028,9 +1079,11 @@ cli::TraceSetup setup_trace_with_reports(const core::Scene& scene, const std::st
           "stability_tdbem_check",
           fmt::format("needs {} (the TD-BEM's own K from the orbit's fronts)", missing));
   }
+  check_stability_keys(scene);
   cli::TraceSetup s = setup_trace(scene, branch);
   const int growth_periods = static_cast<int>(scene.integer("stability_growth_periods", 0, 10000));
   if (scene.flag("stability")) add_front_report(s, tdbem_check, growth_periods);
+  if (scene.flag("stability")) check_grid_monodromy_work(scene, s);
   return s;
 }
 
