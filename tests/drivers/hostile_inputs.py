@@ -204,6 +204,14 @@ c("stability_tdbem_check_on_exact_solver", "trace",
 c("stability_growth_periods_negative", "trace",
   ["{S}", "--branch", "mode1", "--stability", "true", "--stability_growth_periods", "-5"],
   "stability_growth_periods")
+c("stability_key_without_stability", "trace",
+  ["{S}", "--branch", "mode1", "--stability_representation", "grid"], "stability_representation")
+c("stability_grid_key_with_fronts", "trace",
+  ["{S}", "--branch", "mode1", "--stability", "true", "--stability_elements", "50"],
+  "stability_elements")
+c("stability_grid_too_costly", "trace",
+  ["{S}", "--branch", "mode1", "--stability", "true", "--stability_representation", "grid",
+   "--stability_elements", "2000"], "stability_elements")
 c("stability_growth_periods_huge", "trace",
   ["{S}", "--branch", "mode1", "--stability", "true", "--stability_growth_periods", "1e9"],
   "stability_growth_periods")
