@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include <Eigen/Eigenvalues>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -915,7 +916,25 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check, int growth_periods) 
     if (growth_periods > 0)
       columns.insert(columns.end(), {"growth_largest", "growth_modulus", "growth_power"});
     core::Table table(columns);
+    // Progress: the perturbed orbits take seconds per point on fine grids, after the loop.
+    const auto started = std::chrono::steady_clock::now();
+    auto said = started;
+    if (growth_periods > 0 || tdbem_check)
+      fmt::print("fronts.csv: K of {} points{}{}\n", b.points.size(),
+                 tdbem_check ? ", the TD-BEM's K" : "",
+                 growth_periods > 0
+                     ? fmt::format(", perturbed orbits over {} periods", growth_periods)
+                     : "");
+    std::size_t done = 0;
     for (const auto& point : b.points) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - said > std::chrono::seconds(10)) {
+        said = now;
+        fmt::print("  fronts.csv: {} of {} points in {:.0f} s\n", done, b.points.size(),
+                   std::chrono::duration<double>(now - started).count());
+        std::fflush(stdout);
+      }
+      ++done;
       const exact_bar::FrontMonodromy m = orbit_front_monodromy(*p, point.x);
       // Grazings and closings on fronts, by the exact solver (kinks, where K is one side's).
       const bar::BarSetup setup = p->setup_at(point.x);
