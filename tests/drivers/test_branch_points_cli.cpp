@@ -32,6 +32,12 @@ const std::string paper =
 const std::string detecting =
     paper + " --branch mode1 --shooting_elements 40 --energy_max 3e-5 --detect_branch_points true";
 
+// 60 points of mode 1 from T = 3.1 at 40 intervals, following its branch points: about 1 s.
+const std::string mode1_with_follows =
+    paper +
+    " --branch mode1 --shooting_elements 40 --period 3.1 --ds 0.05 --ds_max 0.05 "
+    "--max_points 60 --detect_branch_points true --follow all";
+
 // The verified row whose period is nearest `period`; -1 when there is none.
 int verified_row_near(const Table& t, double period) {
   const auto periods = t.column("period"), verified = t.column("verified");
@@ -296,10 +302,7 @@ TEST(BranchPointsCli, KilledRunLosesNoCandidateAndFollowsThemAll) {
 // candidate again, byte for byte the uninterrupted run's. A finished run at its max_points is
 // still refused: resuming it would trace nothing.
 TEST(BranchPointsCli, RunKilledDuringItsFollowsResumesTheFollows) {
-  const std::string scene = paper +
-                            " --branch mode1 --shooting_elements 40 --period 3.1 --ds 0.05 "
-                            "--ds_max 0.05 --max_points 60 --detect_branch_points true "
-                            "--follow all --follow_max_points 5";
+  const std::string scene = mode1_with_follows + " --follow_max_points 5";
   const fs::path full = cli::scratch("branch_points_cli", "full"),
                  part = cli::scratch("branch_points_cli", "killed");
   ASSERT_EQ(cli::run("trace", scene, full).code, 0);
@@ -349,10 +352,7 @@ TEST(BranchPointsCli, RunKilledDuringItsFollowsResumesTheFollows) {
 // summary.txt's status "interrupted", and --resume does the follows again: the same files as the
 // uninterrupted run, byte for byte.
 TEST(BranchPointsCli, InterruptDuringTheFollowsIsResumed) {
-  const std::string scene = paper +
-                            " --branch mode1 --shooting_elements 40 --period 3.1 --ds 0.05 "
-                            "--ds_max 0.05 --max_points 60 --detect_branch_points true "
-                            "--follow all --follow_max_points 200";
+  const std::string scene = mode1_with_follows + " --follow_max_points 200";
   const fs::path full = cli::scratch("branch_points_cli", "full"),
                  part = cli::scratch("branch_points_cli", "interrupted");
   ASSERT_EQ(cli::run("trace", scene, full).code, 0);
