@@ -105,9 +105,9 @@ struct RestartPoint {
   std::string note;         // why the state was not used (take_up), empty otherwise
   core::Vector previous_x;  // the point before (empty at point 0) and its arclength
   double previous_arclength = 0;
-  // --resume of a run killed after its loop had reached max_points (summary.txt still says
-  // "running"): no point is left to trace, the run redoes only what follows the loop (outputs,
-  // stability, follows).
+  // --resume of a run killed or stopped after its loop had reached max_points (summary.txt says
+  // "running" or "interrupted"): no point is left to trace, the run redoes only what follows the
+  // loop (outputs, stability, follows).
   bool loop_complete = false;
 };
 
