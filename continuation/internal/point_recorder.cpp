@@ -99,10 +99,7 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   p.index = index;
   p.x = x;
   p.observables = problem_.observables(x);
-  core::Vector r;
-  p.residual = problem_.residual(x, r) == core::EvalStatus::ok
-                   ? r.lpNorm<Eigen::Infinity>()
-                   : std::numeric_limits<double>::quiet_NaN();
+  p.residual = residual_norm(x);
   p.newton_iterations = newton_iterations;
   p.step_size = ds;
   p.arclength = arclength;
@@ -120,12 +117,15 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   return p;
 }
 
-void PointRecorder::remember(const core::Vector& x) {
+double PointRecorder::residual_norm(const core::Vector& x) const {
   core::Vector r;
+  return problem_.residual(x, r) == core::EvalStatus::ok ? r.lpNorm<Eigen::Infinity>()
+                                                         : std::numeric_limits<double>::quiet_NaN();
+}
+
+void PointRecorder::remember(const core::Vector& x) {
   last_x_ = x;
-  last_residual_ = problem_.residual(x, r) == core::EvalStatus::ok
-                       ? r.lpNorm<Eigen::Infinity>()
-                       : std::numeric_limits<double>::quiet_NaN();
+  last_residual_ = residual_norm(x);
 }
 
 double PointRecorder::known_residual(const core::Vector* x) const {

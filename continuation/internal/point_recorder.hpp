@@ -73,6 +73,7 @@ class PointRecorder {
   void remember(const core::Vector& x);
 
  private:
+  double residual_norm(const core::Vector& x) const;  // ||F(x)||_inf, NaN when F fails
   // ||F(x)||_inf when x is the last point finish() recorded (the branch's previous point, the
   // verification's known neighbour), else NaN.
   double known_residual(const core::Vector* x) const;

@@ -1050,9 +1050,9 @@ void check_stability_keys(const core::Scene& scene) {
       throw core::InputError(key,
                              "applies with --stability_representation grid (the fronts' K "
                              "has no grid)");
-  for (const char* key : {"stability_growth_periods"})
-    if (grid && given(key))
-      throw core::InputError(key, "applies with --stability_representation fronts");
+  if (grid && given("stability_growth_periods"))
+    throw core::InputError("stability_growth_periods",
+                           "applies with --stability_representation fronts");
 }
 
 // The grid monodromy's cost per point, before any work: 4 N simulations of N intervals over the
@@ -1101,8 +1101,10 @@ cli::TraceSetup setup_trace_with_reports(const core::Scene& scene, const std::st
   check_stability_keys(scene);
   cli::TraceSetup s = setup_trace(scene, branch);
   const int growth_periods = static_cast<int>(scene.integer("stability_growth_periods", 0, 10000));
-  if (scene.flag("stability")) add_front_report(s, tdbem_check, growth_periods);
-  if (scene.flag("stability")) check_grid_monodromy_work(scene, s);
+  if (scene.flag("stability")) {
+    add_front_report(s, tdbem_check, growth_periods);
+    check_grid_monodromy_work(scene, s);
+  }
   return s;
 }
 
