@@ -224,6 +224,27 @@ void ExactBarSolution::keep_closings_on_fronts() {
   front_closing_candidates_.clear();
 }
 
+// An open end that reaches its wall just as a front arrives closes at the front. Where the
+// front carries no jump (a knot of u0 whose slope does not change: on mode 1 every grid node x_j
+// whose echo arrives at the closing, T = 3 L/c + x_j / c), the map is smooth there and the
+// closing is the root of w + yc s = wall at s = 0: it moves by d s = -dw / yc, and the open
+// history before it (of the same value) extends to it. A front whose relative jump is under
+// 1e-12 counts as none: the derivative's error is that jump. Across a front with a jump the
+// closing stays on the front (README.md, 'Tangent').
+void ExactBarSolution::move_closing_at_a_silent_front(Side side, const Segment& before, double yc,
+                                                      bool approaching, const EndState& state,
+                                                      SegmentTangent& piece) {
+  auto& emitted = side == Side::right ? b_tan_ : a_tan_;
+  const auto& track = side == Side::right ? right_ : left_;
+  if (!approaching || emitted.empty() || track.segments.empty() || track.segments.back().closed)
+    return;
+  if (!(std::abs(before.at(before.r1) - yc) <= 1e-12 * std::abs(yc))) return;
+  const Eigen::VectorXd d_sc = state.du / -yc;
+  const Sensitivity sparse = d_sc.sparseView(1.0, 0.0);
+  piece.dr0 += sparse;
+  emitted.back().dr1 += sparse;
+}
+
 void ExactBarSolution::march_end(Side side, long k, EndState& state) {
   const bool right = side == Side::right;
   const bar::End& model = right ? setup_.right : setup_.left;
@@ -309,6 +330,9 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
               (front_closing_candidates_.empty() ||
                front_closing_candidates_.back() != std::pair{side, i - 1}))
             front_closing_candidates_.emplace_back(side, i - 1);
+          if (tangent && events == 0 && open_at_start && i > 0)
+            move_closing_at_a_silent_front(side, incoming.segments[i - 1], yc,
+                                           (wall > 0 ? q : -q) > 0, state, piece);
           state.closed = true;
           state.side = wall;
           state.u = wall_u;

@@ -142,8 +142,9 @@ class ExactBarSolution {
   bar::FieldSnapshot snapshot(double t, const bar::SnapshotRequest& request) const;
 
   // With a tangent: the derivatives of snapshot(t, {elements, projected_v}).v_projected. At a
-  // kink of the solution map (an event exactly on a front, a grazing) one of the one-sided
-  // derivatives is taken: the one of the event's side as the march resolved it.
+  // kink of the solution map (an event exactly on a front with a jump, a grazing) the
+  // derivative is the march's choice (README.md, 'Tangent'); a closing on a front without a
+  // jump, where the map is smooth, takes the closing's own motion.
   ProjectedVelocityTangent projected_velocity_tangent(double t, int elements) const;
 
   // The state at t in characteristic form (neighbouring pieces of equal value merged, so that
@@ -215,6 +216,8 @@ class ExactBarSolution {
 
   void march();
   void march_end(Side side, long k, EndState& state);
+  void move_closing_at_a_silent_front(Side side, const Segment& before, double yc, bool approaching,
+                                      const EndState& state, SegmentTangent& piece);
   void march_windows(EndState& left_state, EndState& right_state);
   void seed_characteristic_state(EndState& left_state, EndState& right_state);
   void emit(Side side, long k, double r0, double r1, double in0, double in_slope,

@@ -634,8 +634,8 @@ cli::TraceSetup setup_trace(const core::Scene& scene, const std::string& branch)
   check_time_step(setup.material, s.guess[problem->period_index()], options.steps_per_period);
   // Energy grows along the family: the direction of the contact family's own tangent, which the
   // first step follows (start_along_direction). The first orbit may sit on a branch point (end
-  // amplitude 1.25 g0 is T = 3.8 L/c), where the exact Jacobian is one-sided and its null
-  // vector points 48 degrees off the mode, towards the attached family.
+  // amplitude 1.25 g0 is T = 3.8 L/c), where the Jacobian's null space holds the attached
+  // family too.
   s.direction = problem->contact_family_guess(mode, ratio * 1.01) -
                 problem->contact_family_guess(mode, ratio);
   s.branch_options = [given = s.branch_options](continuation::ContinuationOptions& o,

@@ -5,6 +5,7 @@
 // knots), with the exact solver and the TD-BEM.
 #include <gtest/gtest.h>
 
+#include <Eigen/SVD>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -126,6 +127,47 @@ TEST(ExactJacobian, AnnihilatesModeOnesTangentOnItsClosedForm) {
     // t from differences of the closed form (error 1e-12 relative): |J t| at that level.
     EXPECT_LT((exact * t).norm() / exact.norm(), 1e-11) << ratio;
   }
+}
+
+// Mode 1 at T = 3.8 L/c (end amplitude 1.25 g0, the bench's start) is a branch point: with
+// 2 / T = p / q = 10 / 19 the warps u0 = u0(L) (x + sum_j a_j sin(j p pi x)) are orbits of the
+// same period (orbits/README.md, 'Dimension changes'), and a grid of 40 intervals holds
+// ceil(40 / 10) - 1 = 3 of them. The closing at 1 + g0 / s = 1.8 L/c meets the echo of node 32
+// (x = 0.8 L), a front of no strength, where the tangent must take the closing's own motion.
+// The law's directions are the independent oracle: J annihilates them and the mode's tangent,
+// and nothing else.
+TEST(ExactJacobian, AnnihilatesTheAttachedWarpsAtABranchPoint) {
+  OrbitOptions o = grid_of_twenty();
+  o.elements = 40;
+  o.test_elements = 80;
+  o.exact_jacobian = true;
+  ContactBarOrbitProblem p(one_wall(), std::make_shared<TdbemSolver>(ContactMethod::event), o);
+  const double ratio = 1.25;
+  const core::Vector x = p.contact_family_guess(1, ratio);
+  ASSERT_DOUBLE_EQ(x[p.period_index()], 3.8);
+  core::Matrix J;
+  ASSERT_EQ(p.jacobian(x, J), core::EvalStatus::ok);
+  std::vector<core::Vector> family;
+  core::Vector t =
+      p.contact_family_guess(1, ratio * (1 + 1e-6)) - p.contact_family_guess(1, ratio * (1 - 1e-6));
+  family.push_back(t / t.norm());
+  for (int j = 1; j <= 3; ++j) {
+    core::Vector d = core::Vector::Zero(x.size());
+    for (int i = 0; i < o.elements; ++i)  // node i + 1 at x = (i + 1) / 40 (L = 1)
+      d[i] = std::sin(j * 10 * M_PI * (i + 1) / 40.0);
+    family.push_back(d / d.norm());
+  }
+  const double norm = J.norm();
+  // Each direction is exact to round-off (t: central differences of a rational curve, 1e-12),
+  // so |J d| sits at round-off of |J|. A closing moved with the front instead leaves
+  // |J t| / |J| = 3.5e-4 and a fifth singular value of 1e-3 |J|.
+  for (std::size_t k = 0; k < family.size(); ++k)
+    EXPECT_LT((J * family[k]).norm() / norm, 1e-11) << "direction " << k;
+  // Nothing else: the fifth smallest singular value, 2.3e-2 |J|, is the grid spectrum.
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<core::Matrix>(J).singularValues();
+  const Eigen::Index n = sv.size();
+  EXPECT_LT(sv[n - 4] / sv[0], 1e-12);
+  EXPECT_GT(sv[n - 5] / sv[0], 1e-2);
 }
 
 }  // namespace
