@@ -30,6 +30,14 @@ bool same_to_ulps(double a, double b) {
   return std::abs(a - b) <= 8 * epsilon * (std::abs(a) + std::abs(b));
 }
 
+// Whether a front between a signal's values (or slopes) a and b carries a jump: a relative jump
+// under 1e-12 is none. The knots of a u0 on a grid leave such fronts where the slope does not
+// change (the slopes' round-off), and an event on one is no kink of the map: the tangent's error
+// in treating it as none is that jump (move_closing_at_a_silent_front).
+bool carries_jump(double a, double b) {
+  return std::abs(a - b) > 1e-12 * (std::abs(a) + std::abs(b));
+}
+
 // Cap on stored segments: a runaway event cascade is reported as a failure, not a hang.
 constexpr std::size_t max_segments = 20'000'000;
 
@@ -214,7 +222,7 @@ void ExactBarSolution::keep_closings_on_fronts() {
     const Segment& s = incoming.segments[b];
     const Segment& next = incoming.segments[b + 1];
     const double before = s.at(s.r1), after = next.at(next.r0);
-    const bool jump = !same_to_ulps(before, after) || !same_to_ulps(s.slope, next.slope);
+    const bool jump = carries_jump(before, after) || carries_jump(s.slope, next.slope);
     const double t = global_time(s.k, s.r1);
     if (jump && t <= t_end_ + tol) closings_on_fronts_.push_back(t);
   }
@@ -228,9 +236,8 @@ void ExactBarSolution::keep_closings_on_fronts() {
 // front carries no jump (a knot of u0 whose slope does not change: on mode 1 every grid node x_j
 // whose echo arrives at the closing, T = 3 L/c + x_j / c), the map is smooth there and the
 // closing is the root of w + yc s = wall at s = 0: it moves by d s = -dw / yc, and the open
-// history before it (of the same value) extends to it. A front whose relative jump is under
-// 1e-12 counts as none: the derivative's error is that jump. Across a front with a jump the
-// closing stays on the front (README.md, 'Tangent').
+// history before it (of the same value) extends to it. Across a front with a jump
+// (carries_jump) the closing stays on the front (README.md, 'Tangent').
 void ExactBarSolution::move_closing_at_a_silent_front(Side side, const Segment& before, double yc,
                                                       bool approaching, const EndState& state,
                                                       SegmentTangent& piece) {
@@ -238,7 +245,7 @@ void ExactBarSolution::move_closing_at_a_silent_front(Side side, const Segment& 
   const auto& track = side == Side::right ? right_ : left_;
   if (!approaching || emitted.empty() || track.segments.empty() || track.segments.back().closed)
     return;
-  if (!(std::abs(before.at(before.r1) - yc) <= 1e-12 * std::abs(yc))) return;
+  if (carries_jump(before.at(before.r1), yc)) return;
   const Eigen::VectorXd d_sc = state.du / -yc;
   const Sensitivity sparse = d_sc.sparseView(1.0, 0.0);
   piece.dr0 += sparse;

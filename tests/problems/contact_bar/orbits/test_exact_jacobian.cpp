@@ -15,6 +15,7 @@
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"
 #include "problems/exact_bar/exact_bar_solver.hpp"
+#include "problems/exact_bar/exact_solution.hpp"
 
 namespace backbone::contact_bar {
 namespace {
@@ -145,6 +146,8 @@ TEST(ExactJacobian, AnnihilatesTheAttachedWarpsAtABranchPoint) {
   const double ratio = 1.25;
   const core::Vector x = p.contact_family_guess(1, ratio);
   ASSERT_DOUBLE_EQ(x[p.period_index()], 3.8);
+  // The closing meets a front without a jump: no kink of the map.
+  EXPECT_TRUE(exact_bar::ExactBarSolution(p.setup_at(x), 3.8).closings_on_fronts().empty());
   core::Matrix J;
   ASSERT_EQ(p.jacobian(x, J), core::EvalStatus::ok);
   std::vector<core::Vector> family;
