@@ -134,6 +134,9 @@ struct Branch {
   // A resumed run: branch_points holds the candidates with after_point >= this (the earlier
   // run's rows below it stand; write_after_run merges them); -1 when the run did not resume.
   int branch_points_from = -1;
+  // Converged corrections refused (hooks.reject_point, the arclength loop's turn check) while
+  // tracing it, a resumed run's earlier ones included (LoopState::rejected_corrections).
+  int rejected_corrections = 0;
   // True when the branch ended for a reason other than reaching its planned end
   // (max_points, a bound, or the boundary of the solution set).
   bool ended_early() const {

@@ -357,7 +357,8 @@ core::Vector read_unknowns(const std::filesystem::path& path, int point, const s
 Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
                     const Branch& resumed, const core::FloquetOptions* floquet) {
   Branch whole;
-  const int first = resumed.points.empty() ? 0 : resumed.points.front().index;
+  const int first =
+      resumed.points.empty() ? std::numeric_limits<int>::max() : resumed.points.front().index;
   if (first > 0) {
     const auto columns = read_columns(dir / "unknowns.csv", {"point", "index", "value"}, "resume");
     std::map<int, std::vector<double>> saved;  // point -> values in file order (index order)
@@ -377,6 +378,8 @@ Branch whole_branch(const std::filesystem::path& dir, const core::Problem& probl
   for (const BranchPoint& p : resumed.points)
     if (whole.points.empty() || p.index > whole.points.back().index) whole.points.push_back(p);
   whole.branch_points = resumed.branch_points;
+  whole.branch_points_from = resumed.branch_points_from;
+  whole.rejected_corrections = resumed.rejected_corrections;
   whole.reason = resumed.reason;
   whole.message = resumed.message;
   return whole;

@@ -119,8 +119,9 @@ core::Vector read_unknowns(const std::filesystem::path& path, int point, const s
 
 // The saved points up to resumed's first (dir/unknowns.csv, their observables recomputed, and
 // their multipliers with floquet non-null), then resumed's later ones: the whole branch as the
-// files of a resumed run hold it. The restart point is the saved one: a restart without a saved
-// loop state corrects it again, to other round-off, and branch.csv keeps the saved row.
+// files of a resumed run hold it (every saved point when the resumed loop added none). The restart
+// point is the saved one: a restart without a saved loop state corrects it again, to other
+// round-off, and branch.csv keeps the saved row.
 Branch whole_branch(const std::filesystem::path& dir, const core::Problem& problem,
                     const Branch& resumed, const core::FloquetOptions* floquet);
 

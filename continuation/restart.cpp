@@ -91,11 +91,11 @@ std::string format_state(const LoopState& s) {
   std::string line = fmt::format(
       "method={} index={} arclength={} ds={} lambda={} previous_step={} switch_index={} "
       "jacobian_scale={} scale={} z={} tangent={} previous={} jacobian_point={} chord_misses={} "
-      "brackets={} samples={}",
+      "rejected_corrections={} brackets={} samples={}",
       to_string(s.method), s.index, number(s.arclength), number(s.ds), number(s.lambda),
       number(s.previous_step), s.switch_index, number(s.jacobian_scale), numbers(s.scale),
       numbers(s.z), numbers(s.tangent), numbers(s.previous), numbers(s.jacobian_point),
-      s.chord_misses, s.brackets, s.samples.size());
+      s.chord_misses, s.rejected_corrections, s.brackets, s.samples.size());
   for (std::size_t k = 0; k < s.samples.size(); ++k) {
     const TestFunctionSample& a = s.samples[k];
     line += fmt::format(
@@ -129,6 +129,11 @@ LoopState parse_state(const std::string& line, const std::string& key, const std
   // fresh Jacobian.
   if (in.has("jacobian_point")) s.jacobian_point = in.vector("jacobian_point");
   if (in.has("chord_misses")) s.chord_misses = in.whole("chord_misses");
+  if (in.has("rejected_corrections")) {
+    s.rejected_corrections = in.whole("rejected_corrections");
+    if (s.rejected_corrections < 0)
+      in.fail(fmt::format("rejected_corrections {} is negative", s.rejected_corrections));
+  }
   if (in.has("brackets")) s.brackets = in.whole("brackets");
   const int samples = in.whole("samples");
   if (samples < 0 || samples > 3) in.fail(fmt::format("{} detector samples (at most 3)", samples));

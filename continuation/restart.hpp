@@ -39,6 +39,7 @@ struct BranchStart {
   int index = 0;
   double arclength = 0;
   int switch_index = -1;
+  int rejected_corrections = 0;  // refused before this start (Branch::rejected_corrections)
 };
 
 // A point of the branch seen before a restart: index, arclength and observables.
@@ -62,12 +63,13 @@ struct LoopState {
   // next correction starts from was computed; empty: a fresh Jacobian (scaled_problem.hpp,
   // jacobian_at_unknowns).
   core::Vector jacobian_point;
-  int chord_misses = 0;       // corrections since a chord on it last helped (pseudo_arclength.cpp)
-  double ds = 0;              // the step the next point is tried with
-  double lambda = 0;          // natural: the parameter's value at z (its row's value)
-  double previous_step = 0;   // natural: the parameter step that reached z (0: none)
-  int switch_index = -1;      // natural_then_arclength: first arclength point, -1 before
-  double jacobian_scale = 0;  // branch-point detector: its Jacobian scale (0: unset)
+  int chord_misses = 0;  // corrections since a chord on it last helped (pseudo_arclength.cpp)
+  int rejected_corrections = 0;  // Branch::rejected_corrections up to this point
+  double ds = 0;                 // the step the next point is tried with
+  double lambda = 0;             // natural: the parameter's value at z (its row's value)
+  double previous_step = 0;      // natural: the parameter step that reached z (0: none)
+  int switch_index = -1;         // natural_then_arclength: first arclength point, -1 before
+  double jacobian_scale = 0;     // branch-point detector: its Jacobian scale (0: unset)
   std::vector<TestFunctionSample> samples;  // the detector's samples before z was added
   // Branch-point detector: the candidates it had bracketed before z was added (-1: not saved).
   // A resume from this state brackets again from there on; the candidates located earlier must

@@ -138,9 +138,10 @@ int run_trace(const std::vector<std::string>& args_in) {
   report.progress().finish();
   cli::add_saved_branch_points(t, result.branch);
   const cont::Branch& branch = result.branch;
-  const bool complete = !branch.points.empty() && !branch.ended_early();
   fmt::print("stopped: {} ({})\n", cont::to_string(branch.reason), branch.message);
   const bool followed_complete = cli::write_outputs_and_follow(t, report, branch, hooks);
+  // A resumed loop may add no point (its first step reaches a bound): the branch is the files'.
+  const bool complete = report.points_in_files > 0 && !branch.ended_early();
   const int stop_signal = stop->signal();
   stop.reset();  // the default actions again
   // An interrupted run's summary says so: --resume then does what it skipped.

@@ -296,7 +296,6 @@ continuation::ContinuationHooks TraceReport::hooks(const std::optional<StopSigna
   };
   hooks.on_attempt = [this](const continuation::StepAttempt& a) {
     if (a.rejection.empty()) return;
-    ++rejected;
     fmt::print("  point {:4d}  rejected at ds {:.3g}: {}\n", a.point, a.ds, a.rejection);
   };
   return hooks;
@@ -321,7 +320,7 @@ std::string TraceReport::summary(const std::string& status, const continuation::
       t_.entry->name, t_.branch_name, status, problem.num_equations(), problem.num_unknowns(),
       t_.expected_dimension, continuation::to_string(t_.run.options.method), t_.corrector->name(),
       t_.periodic ? core::scene_name(t_.run.formulation) : "-", problem.jacobian_description(),
-      points_in_files, rejected, switch_index,
+      points_in_files, branch ? count_text(branch->rejected_corrections) : "-", switch_index,
       branch ? continuation::to_string(branch->reason) : "-", branch ? branch->message : "-",
       dimension_flags_[1], dimension_flags_[2], dimension_above_,
       stability_.empty() ? continuation::stability_counts(nullptr) : stability_,
@@ -417,8 +416,17 @@ void add_saved_branch_points(const TraceRun& t, continuation::Branch& branch) {
   branch.branch_points_from = 0;  // every candidate of the branch is in the list
 }
 
-bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
+bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& traced,
                               const continuation::ContinuationHooks& hooks) {
+  // A resumed loop that added no point (its first step reached a bound): the branch is the saved
+  // points, whose outputs a killed run may not have written.
+  continuation::Branch saved;
+  if (traced.points.empty() && !t.resume.empty() && t.restart) {
+    saved = continuation::whole_branch(t.out, t.problem(), traced,
+                                       t.options().stability ? &t.options().floquet : nullptr);
+    if (saved.branch_points_from < 0) saved.branch_points_from = t.restart->index + 1;
+  }
+  const continuation::Branch& branch = saved.points.empty() ? traced : saved;
   bool followed_complete = true;
   const continuation::ContinuationOptions& options = t.options();
   // A stop request (SIGINT, SIGTERM) skips the stages not yet begun: --resume does them.

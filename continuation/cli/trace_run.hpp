@@ -80,7 +80,6 @@ class TraceReport {
   explicit TraceReport(TraceRun& t);
 
   std::size_t points_in_files = 0;  // the whole branch, a resumed run's saved points included
-  long rejected = 0;
   continuation::BranchWriter& writer() { return writer_; }
   ProgressLine& progress() { return progress_; }
 
@@ -119,7 +118,7 @@ class TraceReport {
 // followed branch reached its bound or budget (false too when `--follow K` names a row the
 // run did not locate). A stop request (hooks.cancel_requested) skips the stages not begun:
 // the problem's outputs over the branch, the stability report and the follows.
-bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& branch,
+bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& traced,
                               const continuation::ContinuationHooks& hooks);
 
 // A resumed detecting run's branch holds the candidates it located; the saved ones located

@@ -48,7 +48,8 @@ LoopSteps::LoopSteps(const ScaledProblem& problem, core::Corrector& corrector,
       recorder_(problem, options, &problem.base()),
       first_index_(start.index),
       arclength_(start.arclength),
-      switch_index_(start.switch_index) {}
+      switch_index_(start.switch_index),
+      rejected_(start.rejected_corrections) {}
 
 std::string LoopSteps::describe(const core::Vector& z) const {
   return describe_point(problem_.to_unknowns(z));
@@ -64,6 +65,7 @@ void LoopSteps::attach(BranchPoint& point, std::shared_ptr<LoopState> state) con
   state->arclength = point.arclength;
   state->scale = problem_.unit_scale();
   state->switch_index = switch_index_;
+  state->rejected_corrections = rejected_;
   point.state = std::move(state);
 }
 
@@ -97,6 +99,7 @@ void LoopSteps::resume(const LoopState& state, bool record) {
   first_index_ = state.index;
   arclength_ = state.arclength;
   switch_index_ = state.switch_index;
+  rejected_ = state.rejected_corrections;
   known_points_ = state.known_points;
   if (!record) {
     ++first_index_;
@@ -136,6 +139,7 @@ Branch LoopSteps::take() {
   for (std::size_t i = 0; i < branch_.points.size(); ++i)
     branch_.points[i].x = branch_.points[i].x.cwiseProduct(point_scales_[i]);
   point_scales_.clear();
+  branch_.rejected_corrections = rejected_;
   return std::move(branch_);
 }
 
@@ -172,6 +176,7 @@ bool LoopSteps::start(const core::Problem& system, core::Vector& z, const std::s
   const core::Vector guess = z;
   const core::NewtonSummary s = corrector_.solve(system, z);
   const std::string rejection = s.converged() ? rejection_of(z) : std::string();
+  if (!rejection.empty()) ++rejected_;
   if (hooks_.on_attempt)
     hooks_.on_attempt({0, 0.0, s.converged() && rejection.empty(), s, rejection});
   if (!s.converged()) {
@@ -275,6 +280,7 @@ bool LoopSteps::land(const Bound& bound, double value,
     const bool ahead = s.converged() && (z - x).dot(forward) > 0;
     rejection = ahead ? rejection_of(z) : std::string();
     landed = ahead && rejection.empty();
+    if (!rejection.empty()) ++rejected_;
     if (hooks_.on_attempt) hooks_.on_attempt({index, ds, landed, s, rejection});
     if (s.converged()) break;
   }

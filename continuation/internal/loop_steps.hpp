@@ -88,6 +88,7 @@ struct CorrectedStep {
   core::NewtonSummary summary;  // of the last try
   core::NewtonStatus last_failure = core::NewtonStatus::converged;
   std::string last_message;
+  int rejections = 0;  // converged tries refused by check or hooks.reject_point
 };
 
 // check(y), run first on a converged y, is the loop's own test (pseudo-arclength: the turn of
@@ -111,6 +112,7 @@ CorrectedStep correct_with_shrinking(double ds, int index, const ContinuationOpt
       rejection = hooks.reject_point(y);
       r.accepted = rejection.empty();
     }
+    if (!rejection.empty()) ++r.rejections;
     if (hooks.on_attempt) hooks.on_attempt({index, r.ds, r.accepted, r.summary, rejection});
     if (r.accepted) return r;
     r.last_failure = r.summary.status;
@@ -188,8 +190,11 @@ class LoopSteps {
   }
   template <class Attempt, class Check>
   CorrectedStep correct(double ds, core::Vector& y, Attempt&& attempt, Check&& check) {
-    return correct_with_shrinking(ds, next_index(), options_, hooks_, y,
-                                  std::forward<Attempt>(attempt), std::forward<Check>(check));
+    CorrectedStep r =
+        correct_with_shrinking(ds, next_index(), options_, hooks_, y,
+                               std::forward<Attempt>(attempt), std::forward<Check>(check));
+    rejected_ += r.rejections;
+    return r;
   }
 
   // Arclength of the last recorded point.
@@ -267,6 +272,7 @@ class LoopSteps {
   int first_index_ = 0;
   double arclength_ = 0;
   int switch_index_ = -1;
+  int rejected_ = 0;  // Branch::rejected_corrections so far
   bool defer_first_ = false, first_pending_ = false;
   std::size_t first_position_ = 0;
   core::Vector first_direction_;

@@ -41,11 +41,12 @@ void hand_over(SwitchingBranch& result, const core::Problem& problem, const Loop
       if (p.index != first) hooks.on_point(p);
     };
   Branch arclength = pseudo_arclength(problem, last_x, secant, corrector, rest, inner,
-                                      {first, last_arclength, count});
+                                      {first, last_arclength, count, branch.rejected_corrections});
   if (arclength.points.size() > 1) result.switch_index = count;
   for (BranchPoint& p : arclength.points)
     if (p.index != first) branch.points.push_back(std::move(p));
   branch.reason = arclength.reason;
+  branch.rejected_corrections = arclength.rejected_corrections;
   branch.message = fmt::format(
       "natural in {} for points 0..{} ({}); pseudo-arclength from point "
       "{}: {}",

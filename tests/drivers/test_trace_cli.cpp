@@ -241,6 +241,35 @@ TEST(TraceCli, ResumeBeforeTheLandingLandsBitForBit) {
   fs::remove(part.string() + ".log");
 }
 
+// The impact oscillator's elastic branch up to its grazing (11 points, 3 refused corrections:
+// one before point 10, two before its last step reaches the bound). Stopped at 11 points, its
+// resume has no point to add: the next step ends the branch, as in the uninterrupted run. The
+// resume is complete (exit 0), and its files, summary.txt included, are the uninterrupted run's:
+// the refused corrections of the first run are counted from the saved loop state.
+TEST(TraceCli, AResumeWhoseFirstStepEndsTheBranchCompletesIt) {
+  const std::string scene = std::string(BACKBONE_SOURCE_DIR) +
+                            "/problems/impact_oscillator/scenes/impact.ini --restitution 1";
+  const fs::path full = cli::scratch("trace_cli", "impact_full"),
+                 part = cli::scratch("trace_cli", "impact_part");
+  ASSERT_EQ(cli::run("trace", scene, full).code, 0);
+  const std::size_t rows = backbone::core::Table::read_csv(full / "branch.csv").rows();
+  ASSERT_EQ(cli::run("trace", scene + " --max_points " + std::to_string(rows), part).code, 0);
+  const std::string refused =
+      backbone::core::read_text_value(full / "summary.txt", "rejected_corrections");
+  ASSERT_NE(backbone::core::read_text_value(part / "summary.txt", "rejected_corrections"),
+            refused);  // some are refused after the split
+  const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
+                             part.string() + "' --max_points 1000 > '" + part.string() +
+                             ".log' 2>&1";
+  ASSERT_EQ(std::system(resume.c_str()), 0) << file_text(part.string() + ".log");
+  for (const char* f : {"branch.csv", "unknowns.csv", "summary.txt", "state.txt",
+                        "bifurcations.csv", "multipliers.csv", "branch.png"})
+    EXPECT_EQ(file_text(part / f), file_text(full / f)) << f;
+  fs::remove_all(full);
+  fs::remove_all(part);
+  fs::remove(part.string() + ".log");
+}
+
 // A branch that ended on its bound gains no point when taken up again (the restart's last
 // point lies on the bound: landing again would add a copy of it), whatever other key is given:
 // branch.csv stays byte for byte, exit 0. A key that moves the bound extends it.
