@@ -91,9 +91,9 @@ struct ContinuationOptions {
   // Pseudo-arclength: the first step follows the direction hint instead of the tangent at the
   // first point. For a start on a nonsmooth boundary of the solution set, where F has no
   // derivative and the finite-difference tangent mixes the two sides (the contact bar's
-  // grazing limits: 8 to 83 degrees off the family, measured), or on a branch point, where an
-  // exact Jacobian is one-sided and its null vector may point along the attached family; with a
-  // hint that is the exact direction of the family. Not passed on to followed families
+  // grazing limits: 8 to 83 degrees off the family, measured), or on a branch point, where the
+  // Jacobian's null space holds the attached family too; with a hint that is the exact direction
+  // of the family. Not passed on to followed families
   // (follow_attached).
   bool start_along_direction = false;
   double ds = 1e-2;      // first step

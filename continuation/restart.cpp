@@ -206,6 +206,24 @@ std::shared_ptr<const LoopState> read_state(const std::filesystem::path& path, i
   return nullptr;
 }
 
+// LoopState::rejected_corrections of the last state saved at or before point `point` (0 when
+// there is none): the count a restart from a point without a state carries on.
+int refused_up_to(const std::filesystem::path& path, int point) {
+  std::ifstream in(path);
+  std::string line;
+  int refused = 0;
+  const std::string token = " rejected_corrections=";
+  while (std::getline(in, line)) {
+    char* end = nullptr;
+    const long k = std::strtol(line.c_str(), &end, 10);
+    if (end == line.c_str() || k > point) continue;
+    const auto at = line.find(token);
+    if (at == std::string::npos) continue;
+    refused = std::max(refused, std::atoi(line.c_str() + at + token.size()));
+  }
+  return refused;
+}
+
 }  // namespace
 
 RestartPoint restart_point(const std::filesystem::path& dir, int point,
@@ -253,6 +271,8 @@ RestartPoint restart_point(const std::filesystem::path& dir, int point,
     r.next_step = adapted_step(step[i], static_cast<int>(iterations[i]), options);
   }
   r.state = read_state(dir / "state.txt", r.index, key);
+  r.rejected_corrections =
+      r.state ? r.state->rejected_corrections : refused_up_to(dir / "state.txt", r.index);
   return r;
 }
 

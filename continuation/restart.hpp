@@ -107,6 +107,10 @@ struct RestartPoint {
   std::string note;         // why the state was not used (take_up), empty otherwise
   core::Vector previous_x;  // the point before (empty at point 0) and its arclength
   double previous_arclength = 0;
+  // Corrections refused on the saved branch up to the point: its state's count, else that of
+  // the last state saved before it (0 without one); BranchStart::rejected_corrections of a
+  // restart without a state.
+  int rejected_corrections = 0;
   // --resume of a run killed or stopped after its loop had reached max_points (summary.txt says
   // "running" or "interrupted"): no point is left to trace, the run redoes only what follows the
   // loop (outputs, stability, follows).

@@ -241,7 +241,8 @@ SwitchingBranch run_continuation(const core::Problem& problem, const core::Vecto
   const LoopState* from = restart ? restart->state.get() : nullptr;
   const bool record = restart && restart->record_saved_point;
   const BranchStart start =
-      restart ? BranchStart{restart->index, restart->arclength, -1} : BranchStart{};
+      restart ? BranchStart{restart->index, restart->arclength, -1, restart->rejected_corrections}
+              : BranchStart{};
   if (options.method == Method::arclength)
     return {from ? pseudo_arclength(problem, *from, record, corrector, options, hooks)
                  : pseudo_arclength(problem, guess, direction, corrector, options, hooks, start),

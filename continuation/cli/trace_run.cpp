@@ -175,6 +175,14 @@ TraceRun prepare_trace(const ProblemPlugin& entry, core::Scene scene_in,
   if (t.restart)
     continuation::take_up(*t.restart, restart_key, static_cast<int>(start_direction), problem,
                           options, t.setup.guess, t.direction);
+  if (t.restart && t.resume.empty()) {  // --start: a new branch counts its own refusals
+    t.restart->rejected_corrections = 0;
+    if (t.restart->state) {
+      auto own = std::make_shared<continuation::LoopState>(*t.restart->state);
+      own->rejected_corrections = 0;
+      t.restart->state = std::move(own);
+    }
+  }
   const core::Observables at_start = problem.observables(t.setup.guess);
   if (t.restart && !t.resume.empty())
     check_saved_columns(t.resume, at_start,
@@ -418,19 +426,19 @@ void add_saved_branch_points(const TraceRun& t, continuation::Branch& branch) {
 
 bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& traced,
                               const continuation::ContinuationHooks& hooks) {
+  const continuation::ContinuationOptions& options = t.options();
+  // A stop request (SIGINT, SIGTERM) skips the stages not yet begun: --resume does them.
+  const auto stopping = [&hooks] { return hooks.cancel_requested && hooks.cancel_requested(); };
   // A resumed loop that added no point (its first step reached a bound): the branch is the saved
   // points, whose outputs a killed run may not have written.
   continuation::Branch saved;
   if (traced.points.empty() && !t.resume.empty() && t.restart) {
-    saved = continuation::whole_branch(t.out, t.problem(), traced,
-                                       t.options().stability ? &t.options().floquet : nullptr);
+    saved = continuation::whole_branch(
+        t.out, t.problem(), traced, options.stability && !stopping() ? &options.floquet : nullptr);
     if (saved.branch_points_from < 0) saved.branch_points_from = t.restart->index + 1;
   }
   const continuation::Branch& branch = saved.points.empty() ? traced : saved;
   bool followed_complete = true;
-  const continuation::ContinuationOptions& options = t.options();
-  // A stop request (SIGINT, SIGTERM) skips the stages not yet begun: --resume does them.
-  const auto stopping = [&hooks] { return hooks.cancel_requested && hooks.cancel_requested(); };
   if (options.branch_points.detect) {
     const auto verified =
         std::count_if(branch.branch_points.begin(), branch.branch_points.end(),

@@ -117,7 +117,9 @@ class TraceReport {
 // whole branch (saved points included), then the followed branches. Returns whether every
 // followed branch reached its bound or budget (false too when `--follow K` names a row the
 // run did not locate). A stop request (hooks.cancel_requested) skips the stages not begun:
-// the problem's outputs over the branch, the stability report and the follows.
+// the problem's outputs over the branch, the stability report and the follows. It sets
+// report.points_in_files (branch.csv's rows), on which the run's verdict rests: a resumed
+// loop that added no point (its first step reached a bound) stands on the saved points.
 bool write_outputs_and_follow(TraceRun& t, TraceReport& report, const continuation::Branch& traced,
                               const continuation::ContinuationHooks& hooks);
 

@@ -337,7 +337,11 @@ void ExactBarSolution::march_end(Side side, long k, EndState& state) {
               (front_closing_candidates_.empty() ||
                front_closing_candidates_.back() != std::pair{side, i - 1}))
             front_closing_candidates_.emplace_back(side, i - 1);
-          if (tangent && events == 0 && open_at_start && i > 0)
+          // The previous open piece's emission must not have been read yet: the right end of
+          // window k reads what the left end emitted in window k - 1 before the left end marches
+          // window k (march_windows), so a left end at its window's first segment keeps the
+          // closing on the front.
+          if (tangent && events == 0 && open_at_start && i > 0 && (right || i > begin))
             move_closing_at_a_silent_front(side, incoming.segments[i - 1], yc,
                                            (wall > 0 ? q : -q) > 0, state, piece);
           state.closed = true;

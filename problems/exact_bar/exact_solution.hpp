@@ -133,9 +133,9 @@ class ExactBarSolution {
 
   // The instants in (0, t_end], in time order, where an open end reaches a wall (the front or a
   // clearance end's back wall) exactly, to the march's snap (64 eps tau), as a front arrives
-  // (the incoming signal jumps by more than 1e-12 of its value): it closes there, or grazes the
-  // wall and leaves. They are the kinks of the solution map; a tangent through one takes the
-  // march's choice (README.md, 'Tangent').
+  // (the incoming signal's value or slope jumps by more than 1e-12 of it): it closes there, or
+  // grazes the wall and leaves. They are the kinks of the solution map; a tangent through one takes
+  // the march's choice (README.md, 'Tangent').
   const std::vector<double>& closings_on_fronts() const { return closings_on_fronts_; }
 
   // The field on the uniform grid of request.elements intervals at time t; every projection

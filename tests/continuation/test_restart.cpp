@@ -110,6 +110,7 @@ TEST(LoopState, TextFormReadsBackBitForBit) {
   s.tangent = vec(0.6, -0.8);
   s.jacobian_point = vec(-2.0 / 3.0, 1e300);
   s.chord_misses = 11;
+  s.rejected_corrections = 6;
   s.brackets = 4;
   continuation::TestFunctionSample a;
   a.index = 16;
@@ -136,6 +137,7 @@ TEST(LoopState, TextFormReadsBackBitForBit) {
   EXPECT_EQ(b.previous.size(), 0);
   EXPECT_TRUE(b.jacobian_point == s.jacobian_point);
   EXPECT_EQ(b.chord_misses, 11);
+  EXPECT_EQ(b.rejected_corrections, 6);
   EXPECT_EQ(b.brackets, 4);
   ASSERT_EQ(b.samples.size(), 2u);
   EXPECT_EQ(b.samples[1].index, 16);
@@ -180,7 +182,8 @@ TEST(LoopState, DefectsAreInputErrorsNamingTheKey) {
   EXPECT_NO_THROW(continuation::parse_state(good, "resume", "test"));
   for (const std::string& bad :
        {std::string("method=arclength"), good + " z=1,x", good + " tangent=1", good + " ds=0",
-        good + " samples=4", good + " junk", good + " jacobian_point=1,2,3"}) {
+        good + " samples=4", good + " junk", good + " jacobian_point=1,2,3",
+        good + " rejected_corrections=-1"}) {
     try {
       continuation::parse_state(bad, "resume", "test");
       ADD_FAILURE() << bad;

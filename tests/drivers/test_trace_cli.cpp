@@ -245,7 +245,8 @@ TEST(TraceCli, ResumeBeforeTheLandingLandsBitForBit) {
 // one before point 10, two before its last step reaches the bound). Stopped at 11 points, its
 // resume has no point to add: the next step ends the branch, as in the uninterrupted run. The
 // resume is complete (exit 0), and its files, summary.txt included, are the uninterrupted run's:
-// the refused corrections of the first run are counted from the saved loop state.
+// the refused corrections of the first run are counted from the saved loop state. A new branch
+// started from the last point counts its own alone.
 TEST(TraceCli, AResumeWhoseFirstStepEndsTheBranchCompletesIt) {
   const std::string scene = std::string(BACKBONE_SOURCE_DIR) +
                             "/problems/impact_oscillator/scenes/impact.ini --restitution 1";
@@ -254,10 +255,18 @@ TEST(TraceCli, AResumeWhoseFirstStepEndsTheBranchCompletesIt) {
   ASSERT_EQ(cli::run("trace", scene, full).code, 0);
   const std::size_t rows = backbone::core::Table::read_csv(full / "branch.csv").rows();
   ASSERT_EQ(cli::run("trace", scene + " --max_points " + std::to_string(rows), part).code, 0);
-  const std::string refused =
-      backbone::core::read_text_value(full / "summary.txt", "rejected_corrections");
-  ASSERT_NE(backbone::core::read_text_value(part / "summary.txt", "rejected_corrections"),
-            refused);  // some are refused after the split
+  const auto refused = [](const fs::path& dir) {
+    return std::stoi(backbone::core::read_text_value(dir / "summary.txt", "rejected_corrections"));
+  };
+  const int before_split = refused(part);
+  ASSERT_GT(refused(full), before_split);  // some are refused after the split
+  const fs::path started = cli::scratch("trace_cli", "impact_started");
+  ASSERT_EQ(
+      cli::run("trace", scene + " --start '" + part.string() + ":" + std::to_string(rows - 1) + "'",
+               started)
+          .code,
+      0);
+  EXPECT_EQ(refused(started), refused(full) - before_split);
   const std::string resume = std::string(BACKBONE_BINARY_DIR) + "/bin/backbone trace --resume '" +
                              part.string() + "' --max_points 1000 > '" + part.string() +
                              ".log' 2>&1";
@@ -267,6 +276,7 @@ TEST(TraceCli, AResumeWhoseFirstStepEndsTheBranchCompletesIt) {
     EXPECT_EQ(file_text(part / f), file_text(full / f)) << f;
   fs::remove_all(full);
   fs::remove_all(part);
+  fs::remove_all(started);
   fs::remove(part.string() + ".log");
 }
 

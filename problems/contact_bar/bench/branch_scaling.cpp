@@ -331,7 +331,8 @@ void run_grid_studies(ScalingRuns& r, const std::vector<int>& grids) {
   }
   // The exact Jacobian (orbits/README.md, 'Exact Jacobian', the trace's default) against the
   // differences on the same grids, in one loop so that each pair runs back to back: from the
-  // grid rows' start (1.25 g0, T = 3.8: a branch point, where the exact Jacobian is one-sided)
+  // grid rows' start (1.25 g0, T = 3.8: a branch point, whose null space the attached family
+  // shares)
   // and from the trace's default start (1.05 g0, T = 83/21: a family with p = 42, which none of
   // these grids holds).
   for (int n : grids)

@@ -936,7 +936,8 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check, int growth_periods) 
       }
       ++done;
       const exact_bar::FrontMonodromy m = orbit_front_monodromy(*p, point.x);
-      // Grazings and closings on fronts, by the exact solver (kinks, where K is one side's).
+      // Grazings and closings on fronts, by the exact solver (kinks, where K takes the march's
+      // choice: exact_bar/README.md, 'Tangent').
       const bar::BarSetup setup = p->setup_at(point.x);
       const ContactStructure structure = setup.right.has_wall() && setup.right.gap > 0
                                              ? contact_structure(setup, p->period(point.x))
@@ -981,7 +982,7 @@ void add_front_report(cli::TraceSetup& s, bool tdbem_check, int growth_periods) 
         const bool both = m.ok && t.ok && t.K.rows() == m.K.rows();
         if (!t.ok)
           fmt::print("  fronts.csv: point {} has no TD-BEM K: {}\n", point.index, t.message);
-        // On a kink the exact K is one side's derivative (exact_bar/README.md, 'Fronts'): it
+        // On a kink the exact K takes the march's choice (exact_bar/README.md, 'Tangent'): it
         // is set against the TD-BEM's nearest of its central and one-sided differences.
         const Eigen::MatrixXd* nearest = &t.K;
         if (both)

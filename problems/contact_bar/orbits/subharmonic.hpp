@@ -28,8 +28,9 @@ struct ContactStructure {
   int contact_phases = 0;    // closed intervals of positive duration per period (a phase that
                              // straddles t = 0 = T counts once)
   int grazing_instants = 0;  // instants where the open end reaches the wall and leaves it
-  // Instants in (0, T] where the end reaches a wall (front or back) as a front arrives, to
-  // round-off (exact_bar::ExactBarSolution::closings_on_fronts): the kinks of the period map.
+  // Instants in (0, T] where the end reaches a wall (front or back) as a front with a jump
+  // arrives, to round-off (exact_bar::ExactBarSolution::closings_on_fronts): the kinks of the
+  // period map.
   int closings_on_fronts = 0;
   double min_gap = 0;        // min over the period of g0 - u(L, t) [m]
   double first_contact = 0;  // duration of the phase that contains t = 0 (0 if none) [s]
