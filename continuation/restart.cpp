@@ -206,21 +206,32 @@ std::shared_ptr<const LoopState> read_state(const std::filesystem::path& path, i
   return nullptr;
 }
 
+// Per line of state.txt after its header: the point and the whole value of its state's field
+// `name`; -1 for a point without a state (`K -`), -2 for a state without the field (or with a
+// negative value).
+std::vector<std::pair<int, int>> saved_field(const std::filesystem::path& path,
+                                             const std::string& name) {
+  std::vector<std::pair<int, int>> out;
+  std::ifstream in(path);
+  std::string line;
+  const std::string token = " " + name + "=";
+  for (bool header = true; std::getline(in, line); header = false) {
+    if (header) continue;
+    const int point = std::atoi(line.c_str());
+    const auto at = line.find(token);
+    const bool stateless = line.size() >= 2 && line.compare(line.size() - 2, 2, " -") == 0;
+    const int value = at == std::string::npos ? -2 : std::atoi(line.c_str() + at + token.size());
+    out.emplace_back(point, stateless ? -1 : value < 0 ? -2 : value);
+  }
+  return out;
+}
+
 // LoopState::rejected_corrections of the last state saved at or before point `point` (0 when
 // there is none): the count a restart from a point without a state carries on.
 int refused_up_to(const std::filesystem::path& path, int point) {
-  std::ifstream in(path);
-  std::string line;
   int refused = 0;
-  const std::string token = " rejected_corrections=";
-  while (std::getline(in, line)) {
-    char* end = nullptr;
-    const long k = std::strtol(line.c_str(), &end, 10);
-    if (end == line.c_str() || k > point) continue;
-    const auto at = line.find(token);
-    if (at == std::string::npos) continue;
-    refused = std::max(refused, std::atoi(line.c_str() + at + token.size()));
-  }
+  for (const auto& [k, n] : saved_field(path, "rejected_corrections"))
+    if (k <= point && n >= 0) refused = n;
   return refused;
 }
 
@@ -414,24 +425,6 @@ BranchPointReport parse_branch_point(const std::string& line, const core::Proble
   return r;
 }
 
-// The brackets each point's state had made (state.txt, in the order of the file): -1 for a
-// point without a state (`K -`), -2 for a state that does not count them (a run without
-// detection, or a loop without a detector).
-std::vector<std::pair<int, int>> saved_brackets(const std::filesystem::path& path) {
-  std::vector<std::pair<int, int>> out;
-  std::ifstream in(path);
-  std::string line;
-  for (bool header = true; std::getline(in, line); header = false) {
-    if (header) continue;
-    const int point = std::atoi(line.c_str());
-    const auto at = line.find(" brackets=");
-    const bool stateless = line.size() >= 2 && line.compare(line.size() - 2, 2, " -") == 0;
-    const int made = at == std::string::npos ? -2 : std::atoi(line.c_str() + at + 10);
-    out.emplace_back(point, stateless ? -1 : made < 0 ? -2 : made);
-  }
-  return out;
-}
-
 }  // namespace
 
 void SavedBranchPoints::write(const std::filesystem::path& out) const {
@@ -481,7 +474,10 @@ std::optional<BranchPointResume> branch_point_resume(const std::filesystem::path
                                                      const core::Problem& problem,
                                                      const std::string& key) {
   if (!std::filesystem::exists(dir / "branch_points.txt")) return std::nullopt;
-  const std::vector<std::pair<int, int>> brackets = saved_brackets(dir / "state.txt");
+  // The brackets each point's state had made, in the order of the file: -1 for a point without
+  // a state, -2 for a state that does not count them (a run without detection, or a loop
+  // without a detector).
+  const std::vector<std::pair<int, int>> brackets = saved_field(dir / "state.txt", "brackets");
   BranchPointResume r;
   r.saved = read_saved_branch_points(dir, problem, key);
   int made = -1;

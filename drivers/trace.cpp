@@ -145,10 +145,9 @@ int run_trace(const std::vector<std::string>& args_in) {
   const int stop_signal = stop->signal();
   stop.reset();  // the default actions again
   // An interrupted run's summary says so: --resume then does what it skipped.
-  core::write_text_atomically(t.out / "summary.txt", report.summary(stop_signal != 0 ? "interrupted"
-                                                                    : complete       ? "complete"
-                                                                               : "ended early",
-                                                                    &branch, result.switch_index));
+  const char* status = stop_signal != 0 ? "interrupted" : complete ? "complete" : "ended early";
+  core::write_text_atomically(t.out / "summary.txt",
+                              report.summary(status, &branch, result.switch_index));
   fmt::print("wrote {}\n", t.out.string());
   if (stop_signal != 0) {
     fmt::print(stderr,
