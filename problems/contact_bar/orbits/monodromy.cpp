@@ -31,6 +31,12 @@ MonodromyOptions::Representation parse_representation(const std::string& key,
   throw core::InputError(key, fmt::format("must be fronts or grid (got '{}')", value));
 }
 
+MonodromyOptions::Derivatives parse_derivatives(const std::string& key, const std::string& value) {
+  if (value == "tangent") return MonodromyOptions::Derivatives::tangent;
+  if (value == "differences") return MonodromyOptions::Derivatives::differences;
+  throw core::InputError(key, fmt::format("must be tangent or differences (got '{}')", value));
+}
+
 namespace {
 
 // The orbit x simulated by the exact solver and its state at a time of free flight
@@ -227,6 +233,29 @@ EvalStatus full_state_map(const ContactBarOrbitProblem& problem, const std::vect
   return mapped.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 
+namespace {
+
+// M from one march with the tangent in the nodes' hats: the u rows are the nodal displacements'
+// derivatives, the v rows the projected velocity's, solved with the mass matrix column by column.
+EvalStatus tangent_monodromy(const ContactBarOrbitProblem& problem,
+                             const std::vector<double>& nodes, double period, double dt,
+                             const Vector& state, Matrix& M) {
+  const int n = static_cast<int>(nodes.size()) - 1;
+  bar::BarSetup s = problem.setup_template();
+  s.u0 = nodal_function(nodes, state.data());
+  s.v0 = nodal_function(nodes, state.data() + n);
+  TdbemMarch march(s, dt, ContactMethod::event, TangentDirections{nodes, true});
+  if (!march.advance_to(period)) return EvalStatus::non_finite;
+  M.resize(2 * n, 2 * n);
+  for (int i = 1; i <= n; ++i)
+    M.row(i - 1) = march.tangent_displacement(nodes[static_cast<std::size_t>(i)]).transpose();
+  const Matrix V = march.tangent_projected_velocity(nodes);
+  for (int j = 0; j < 2 * n; ++j) M.col(j).tail(n) = solve_mass(nodes, V.col(j).segment(1, n));
+  return M.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
+}
+
+}  // namespace
+
 EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vector& x,
                                 const MonodromyOptions& options, Matrix& M) {
   options.validate();
@@ -256,6 +285,11 @@ EvalStatus full_state_monodromy(const ContactBarOrbitProblem& problem, const Vec
   const bar::End& right = problem.setup_template().right;
   const bool on_wall =
       right.type == bar::EndType::contact && std::abs(base[n - 1] - right.gap) <= 1e-12 * u_scale;
+  const auto* tdbem = dynamic_cast<const TdbemSolver*>(&problem.solver());
+  if (options.derivatives == MonodromyOptions::Derivatives::tangent && tdbem &&
+      tdbem->method() == ContactMethod::event && !on_wall &&
+      problem.setup_template().body_force == 0)
+    return tangent_monodromy(problem, nodes, period, dt, base, M);
   Vector f_base;
   if (on_wall) {
     const EvalStatus st = full_state_map(problem, nodes, period, dt, base, f_base);

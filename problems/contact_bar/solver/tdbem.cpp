@@ -82,10 +82,6 @@ TdbemMarch::GridTime TdbemMarch::grid_time(double t) const {
   return g;
 }
 
-inline TdbemMarch::GridTime TdbemMarch::retarded(double t_seconds_before) const {
-  return minus(now_, normalized(0, t_seconds_before / step_));
-}
-
 TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod method)
     : setup_(setup), method_(method), dt_(dt) {
   setup_.validate();
@@ -188,22 +184,6 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
   }
 }
 
-inline std::size_t TdbemMarch::knot_index(int e, GridTime s, std::size_t* hint) const {
-  const auto& k = ends_[e].knots;
-  if (!hint)
-    return static_cast<std::size_t>(
-        std::lower_bound(k.begin(), k.end(), s,
-                         [](const Knot& a, const GridTime& v) { return a.t < v; }) -
-        k.begin());
-  // Times are sorted: stepping down while the previous knot is not before s, then up while
-  // this one is before s, lands on the lower bound from any start.
-  std::size_t i = std::min(*hint, k.size());
-  while (i > 0 && k[i - 1].t >= s) --i;
-  while (i < k.size() && k[i].t < s) ++i;
-  *hint = i;
-  return i;
-}
-
 double TdbemMarch::q_at(int e, GridTime s, std::size_t* hint) const {
   const auto& k = ends_[e].knots;
   const std::size_t i = knot_index(e, s, hint);
@@ -247,8 +227,9 @@ void TdbemMarch::push_knot(int e, GridTime t, double u, double s, bool kink) {
   EndState& E = ends_[e];
   const double q = 0.5 * c_ * s + 0.5 * u;
   // A tracked kink whose slope change turns out to vanish (to round-off) is no kink: drop its
-  // echo, so that echo trains do not accumulate over long runs (one per contact event).
-  if (method_ == ContactMethod::event && E.knots.size() >= 2 && E.knots.back().kink) {
+  // echo, so that echo trains do not accumulate over long runs (one per contact event). With a
+  // tangent every echo stays: a kink of size zero may have a derivative that is not.
+  if (method_ == ContactMethod::event && !tangent_ && E.knots.size() >= 2 && E.knots.back().kink) {
     Knot& k1 = E.knots.back();
     const Knot& k0 = E.knots[E.knots.size() - 2];
     const double before = (k1.q - k0.q) / steps_between(k1.t, k0.t);
@@ -269,6 +250,12 @@ void TdbemMarch::push_knot(int e, GridTime t, double u, double s, bool kink) {
   const Knot& last = E.knots.back();
   const double slope = (q - last.q) / seconds_between(t, last.t);
   E.knots.push_back({t, u, s, q, slope, false});
+  if (tangent_) {
+    KnotTangent& next = tangent_->next;
+    next.dq = 0.5 * c_ * next.ds + 0.5 * next.du;
+    next.moving = (next.dt.array() != 0).any();
+    E.tangents.push_back(std::move(next));
+  }
   if (!std::isfinite(u) || !std::isfinite(s)) ok_ = false;
   if (kink) mark_kink(e);
 }
@@ -341,6 +328,7 @@ void TdbemMarch::step_end(int e, GridTime ta, GridTime tb) {
   std::vector<GridTime>& cuts = cuts_;
   cuts.clear();
   bool kink_at_end = false;
+  GridTime end_kink = tb;  // the kink arriving at tb
   while (!E.pending.empty() && steps_between(E.pending.front(), tb) <= merge_steps_) {
     const GridTime p = E.pending.front();
     E.pending.pop_front();
@@ -349,9 +337,11 @@ void TdbemMarch::step_end(int e, GridTime ta, GridTime tb) {
       // knot at ta: it stays tracked, so its echo train goes on and no later step interpolates
       // across it (which would lose energy).
       mark_kink(e);
+      if (tangent_ && !E.tangents.back().moving) retag_last(e, arrival_dt(e, p));
       continue;
     }
     if (steps_between(tb, p) <= merge_steps_) {
+      if (!kink_at_end) end_kink = p;
       kink_at_end = true;
       continue;
     }
@@ -359,9 +349,11 @@ void TdbemMarch::step_end(int e, GridTime ta, GridTime tb) {
   }
   GridTime a = ta;
   for (const GridTime& cut : cuts) {
+    if (tangent_) tangent_->end_dt = arrival_dt(e, cut);
     substep_event(e, a, cut, true);
     a = cut;
   }
+  if (tangent_) tangent_->end_dt = kink_at_end ? arrival_dt(e, end_kink) : tangent_->zero;
   substep_event(e, a, tb, kink_at_end);
 }
 
@@ -372,11 +364,18 @@ void TdbemMarch::substep_event(int e, GridTime ta, GridTime tb, bool kink_at_end
     case bar::EndType::fixed: {
       const double s = -2 * r_end(e, tb) / c_;
       E.force = -ea_ * E.normal * (s - a.s) / seconds_between(tb, ta);
+      if (tangent_)
+        set_next_tangent(tangent_->end_dt, tangent_->zero,
+                         -2 / c_ * r_tangent(e, tb, tangent_->end_dt));
       push_knot(e, tb, 0.0, s, kink_at_end);
       return;
     }
     case bar::EndType::free:
       E.force = 0;
+      if (tangent_) {
+        const Eigen::VectorXd ds = E.tangents.back().ds;
+        set_next_tangent(tangent_->end_dt, 2 * r_tangent(e, tb, tangent_->end_dt) + c_ * ds, ds);
+      }
       push_knot(e, tb, 2 * r_end(e, tb) + c_ * a.s, a.s, kink_at_end);
       return;
     case bar::EndType::contact:
@@ -400,6 +399,13 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   const double h = steps_between(tb, ta);
   const double r_b = r_end(e, tb);  // R_e(tb), used below (a pure function of the history)
   const double u_b = 2 * r_b + c_ * a.s;
+  // The tangent: knot a's, and u_b's at tb moving with end_dt.
+  KnotTangent ga;
+  Eigen::VectorXd du_b;
+  if (tangent_) {
+    ga = E.tangents.back();
+    du_b = 2 * r_tangent(e, tb, tangent_->end_dt) + c_ * ga.ds;
+  }
   // n: the outward normal of the wall in question (the end's for the front wall, its opposite
   // for the back one), so that a violation n (u - wall) > 0 is a penetration of either.
   double n = E.normal, wall = E.wall;
@@ -411,6 +417,7 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   const double pb = n * (u_b - wall);
   if (!(pb > 0)) {
     E.force = 0;
+    if (tangent_) set_next_tangent(tangent_->end_dt, du_b, ga.ds);
     push_knot(e, tb, u_b, a.s, kink_at_end);
     return;
   }
@@ -432,6 +439,14 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
       root = next;
     }
   }
+  // The closing instant's derivative: the root of the chord from (ta, pa) to (tb, pb), both
+  // moving with their knots; the closing knot is on the wall (du = 0) with the open S.
+  Eigen::VectorXd dt_close;
+  if (tangent_) {
+    const double w = std::clamp(root / h, 0.0, 1.0);
+    dt_close = (1 - w) * ga.dt + w * tangent_->end_dt -
+               seconds_between(tb, ta) / (pb - pa) * n * ((1 - w) * ga.du + w * du_b);
+  }
   // A crossing within round-off of ta or tb is put there, and the end is then held where it
   // is (a round-off off the wall): a closed end's outgoing wave is minus its incoming one, an
   // open end's plus, so moving the instant by a round-off leaves every slope of Q, and the
@@ -441,10 +456,20 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   E.closed = true;
   if (root <= root_snap_steps) {  // closed from ta
     E.contact_u = a.u;
+    if (tangent_) {
+      KnotTangent& last = E.tangents.back();
+      last.dt = dt_close;
+      last.du.setZero();
+      last.dq = 0.5 * c_ * last.ds;
+      last.moving = true;
+    }
     mark_kink(e);
     events_.push_back({seconds(ta), e == 1, true, back});
     const double s = (E.contact_u - 2 * r_b) / c_;
     E.force = -ea_ * E.normal * (s - a.s) / seconds_between(tb, ta);
+    if (tangent_)
+      set_next_tangent(tangent_->end_dt, tangent_->zero,
+                       -2 / c_ * r_tangent(e, tb, tangent_->end_dt));
     push_knot(e, tb, E.contact_u, s, kink_at_end);
     return;
   }
@@ -452,11 +477,13 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
     E.contact_u = u_b;
     E.force = 0;
     events_.push_back({seconds(tb), e == 1, true, back});
+    if (tangent_) set_next_tangent(dt_close, tangent_->zero, ga.ds);
     push_knot(e, tb, E.contact_u, a.s, true);
     return;
   }
   const GridTime t_close = later(ta, root);
   E.contact_u = wall;
+  if (tangent_) set_next_tangent(dt_close, tangent_->zero, ga.ds);
   push_knot(e, t_close, wall, a.s, true);
   events_.push_back({seconds(t_close), e == 1, true, back});
   solve_closed_to(e, t_close, tb, kink_at_end);
@@ -481,6 +508,10 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
   auto closed_step = [&](GridTime t_end, bool kink) {
     const double s = (E.contact_u - 2 * (t_end == tb ? r_b : r_end(e, t_end))) / c_;
     E.force = -ea_ * E.normal * (s - a.s) / seconds_between(t_end, ta);
+    // A release inside the sub-step needs a body force, which the tangent refuses: t_end is tb.
+    if (tangent_)
+      set_next_tangent(tangent_->end_dt, tangent_->zero,
+                       -2 / c_ * r_tangent(e, t_end, tangent_->end_dt));
     push_knot(e, t_end, E.contact_u, s, kink);
   };
   if (alpha < 0 && pb < 0) {
@@ -519,6 +550,15 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
 // size of u again: O(window), once every many steps.
 void TdbemMarch::regauge() {
   const double shift = 0.5 * (ends_[0].knots.back().q - ends_[1].knots.back().q);
+  if (tangent_) {
+    const Eigen::VectorXd d_shift =
+        0.5 * (ends_[0].tangents.back().dq - ends_[1].tangents.back().dq);
+    for (int e = 0; e < 2; ++e)
+      for (KnotTangent& k : ends_[e].tangents) {
+        k.dq += e == 0 ? -d_shift : d_shift;
+        k.ds += (e == 0 ? -2 / c_ : 2 / c_) * d_shift;
+      }
+  }
   for (int e = 0; e < 2; ++e) {
     const double dq = e == 0 ? -shift : shift, ds = 2 * dq / c_;
     auto& knots = ends_[e].knots;
@@ -559,7 +599,10 @@ bool TdbemMarch::advance_to(double target) {
     // Keep exactly the window [t - tau, t] (plus one knot before it).
     const GridTime window_start = minus(now_, tau_grid_);
     for (auto& E : ends_)
-      while (E.knots.size() > 2 && E.knots[1].t <= window_start) E.knots.pop_front();
+      while (E.knots.size() > 2 && E.knots[1].t <= window_start) {
+        E.knots.pop_front();
+        if (tangent_) E.tangents.pop_front();
+      }
     // Once every query is at a positive retarded time (t > tau), keep Q at the size of u.
     if (window_start > GridTime{} && ends_[0].knots.front().t > GridTime{} &&
         ends_[1].knots.front().t > GridTime{} &&

@@ -31,11 +31,24 @@
 //   bar::FieldSnapshot s = tdbem.snapshot(setup, 1.55, r);  // marches to 1.55 only
 //   contact_bar::TdbemMarch m(setup, 1e-2, contact_bar::ContactMethod::event);
 //   m.advance_to(2.5);  double v = m.velocity(0.3);  auto events = m.events();
+//
+// Tangent (tdbem_tangent.cpp): constructed with TangentDirections, the march also carries the
+// derivative of every history knot in the hats of a node grid (u0 and v0 at its nodes 1..N):
+// of its value and of its time, so the contact instants and their echoes move with the data.
+// The readouts give the derivative of the field at the current time: the march's own tangent,
+// no differences. Where the orbit sits on a kink of the march (an event on a step boundary, two
+// kinks merged) it is one side's; a readout on a moving knot takes the mean of the two sides.
+// Not yet the march's derivative everywhere: solver/README.md, 'Tangent', says where it is not.
+//   contact_bar::TdbemMarch m(setup, dt, ContactMethod::event, {nodes, true});
+//   m.advance_to(T);  Eigen::VectorXd du = m.tangent_displacement(0.3);  // P = 2N entries
 #pragma once
 
+#include <Eigen/Dense>
+#include <algorithm>
 #include <compare>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -55,11 +68,23 @@ struct ContactEvent {
   bool back_wall = false;  // the wall behind a clearance end
 };
 
+// The directions of the march's tangent: the hats psi_1..psi_N of `nodes` (0 = y_0 < ... <
+// y_N = L) as perturbations of u0, then, with `velocity`, of v0 (P = N or 2N).
+struct TangentDirections {
+  std::vector<double> nodes;
+  bool velocity = true;
+};
+
 // The boundary march with its history window; the field at the current time on demand.
 class TdbemMarch {
  public:
   // Throws InputError for a bad setup or dt (dt must be finite, > 0 and <= L / c).
   TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod method);
+  // With the tangent in `directions`: the event method, no body force, u0 and v0 without
+  // jumps (InputError "tangent" otherwise). The data's knots gain the nodes (a hat's kink is a
+  // kink of the perturbed data): the march's values are the plain march's when they hold them.
+  TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod method,
+             const TangentDirections& directions);
 
   // Marches on the grid k dt and takes a last partial step to t (t need not be on the grid).
   // Returns false (and stays false) when the march produced non-finite values.
@@ -90,6 +115,12 @@ class TdbemMarch {
   // u, v and u_x are polynomials (v and u_x linear).
   std::vector<double> breakpoints() const { return breakpoints(std::vector<double>{0.0, L_}); }
   std::size_t stored_knots() const;  // history window size (both ends)
+
+  // The tangent at the current time (P = tangent_size(); 0 without one): d/dp of
+  // displacement(x), and of projected_velocity(nodes) (one row per node, any node grid).
+  int tangent_size() const { return tangent_ ? tangent_->size : 0; }
+  Eigen::VectorXd tangent_displacement(double x) const;
+  Eigen::MatrixXd tangent_projected_velocity(const std::vector<double>& nodes) const;
 
  private:
   // A time on the march's step grid: step + tick / 2^62 steps of step_ seconds, tick in
@@ -190,6 +221,21 @@ class TdbemMarch {
     std::vector<T> data_;
     std::size_t head_ = 0;
   };
+  // A knot's derivative in the P directions: of its time (seconds; zero on the step grid, the
+  // contact instant's or the arriving kink's otherwise) and of its values taken at that time.
+  struct KnotTangent {
+    Eigen::VectorXd dt, du, ds, dq;
+    bool moving = false;  // dt != 0
+  };
+  struct Tangent {
+    std::vector<double> nodes;  // y_0..y_N
+    int n = 0;                  // N
+    bool velocity = true;
+    int size = 0;            // P
+    KnotTangent next;        // the next pushed knot's (push_knot), filled by its caller
+    Eigen::VectorXd end_dt;  // the time derivative of the current sub-step's end
+    Eigen::VectorXd zero;    // P zeros
+  };
   struct EndState {
     bar::End end;
     double normal = 1;     // outward normal
@@ -200,7 +246,8 @@ class TdbemMarch {
     double contact_u = 0;  // U held while closed: the wall, or a round-off off it (solve_open)
     double wall_at(int s) const { return s > 0 ? wall : wall_back; }
     Fifo<Knot> knots;
-    Fifo<GridTime> pending;  // times of kinks of R_e still ahead (event method)
+    Fifo<KnotTangent> tangents;  // knots' derivatives, index for index (with a tangent)
+    Fifo<GridTime> pending;      // times of kinks of R_e still ahead (event method)
     double force = 0;
     bool closed = false;
   };
@@ -232,6 +279,30 @@ class TdbemMarch {
   std::vector<double> project(int elements, bool velocity) const;
   double window_energy() const;  // energy() without body force once t > tau, O(window)
 
+  // The tangent's pieces (tdbem_tangent.cpp).
+  static bar::BarSetup with_node_knots(const bar::BarSetup& setup,
+                                       const TangentDirections& directions);
+  // The hats' values at x, their slopes on `side`, their integrals over [a, b], times coef,
+  // added to the u0 block (first N) or the v0 block of d.
+  void add_hat_values(Eigen::VectorXd& d, bool v_block, double x, double coef) const;
+  void add_hat_slopes(Eigen::VectorXd& d, bool v_block, double x, int side, double coef) const;
+  void add_hat_integrals(Eigen::VectorXd& d, bool v_block, double a, double b, double coef) const;
+  // dQ_e(s) with s moving by ds (nullptr: s fixed); on a knot the left interval's slope.
+  Eigen::VectorXd q_tangent(int e, GridTime s, const Eigen::VectorXd* ds) const;
+  // dQ_e/dt just after the last knot, from the end's state and R (a readout on that knot).
+  double next_slope(int e) const;
+  // d of the slope q_slope(e, s) reads, s fixed.
+  Eigen::VectorXd q_slope_tangent(int e, GridTime s) const;
+  // dR_e(t), t moving by dt.
+  Eigen::VectorXd r_tangent(int e, GridTime t, const Eigen::VectorXd& dt) const;
+  // The time derivative of a kink of R_e arriving at p: its source knot's on the other end
+  // (tau earlier), zero for a data knot.
+  Eigen::VectorXd arrival_dt(int e, GridTime p) const;
+  // The last knot of end e moves with dt: its values follow along its left interval.
+  void retag_last(int e, const Eigen::VectorXd& dt);
+  void set_next_tangent(const Eigen::VectorXd& dt, const Eigen::VectorXd& du,
+                        const Eigen::VectorXd& ds);
+
   bar::BarSetup setup_;
   ContactMethod method_;
   double dt_, L_, c_, tau_, ea_, body_coef_, v0_total_;
@@ -249,7 +320,29 @@ class TdbemMarch {
   mutable std::size_t retarded_hint_[2] = {0, 0};
   std::vector<GridTime> cuts_;  // step_end's sub-step instants (kept to reuse its storage)
   std::vector<ContactEvent> events_;
+  std::unique_ptr<Tangent> tangent_;  // with TangentDirections
 };
+
+// The march's hot lookups, shared by tdbem.cpp and tdbem_tangent.cpp.
+inline TdbemMarch::GridTime TdbemMarch::retarded(double t_seconds_before) const {
+  return minus(now_, normalized(0, t_seconds_before / step_));
+}
+
+inline std::size_t TdbemMarch::knot_index(int e, GridTime s, std::size_t* hint) const {
+  const auto& k = ends_[e].knots;
+  if (!hint)
+    return static_cast<std::size_t>(
+        std::lower_bound(k.begin(), k.end(), s,
+                         [](const Knot& a, const GridTime& v) { return a.t < v; }) -
+        k.begin());
+  // Times are sorted: stepping down while the previous knot is not before s, then up while
+  // this one is before s, lands on the lower bound from any start.
+  std::size_t i = std::min(*hint, k.size());
+  while (i > 0 && k[i - 1].t >= s) --i;
+  while (i < k.size() && k[i].t < s) ++i;
+  *hint = i;
+  return i;
+}
 
 class TdbemSolver : public bar::BarSolver {
  public:
