@@ -191,7 +191,8 @@ po::options_description trace_keys() {
       ("stability_representation", po::value<std::string>()->default_value("fronts"),
        "fronts: the isolated multipliers exactly, from the orbit's fronts, one tangent "
        "simulation per point (fronts.csv beside the branch: K's checks and Jordan defect); "
-       "grid: the projected full state (u, v) on a grid of stability_elements, by differences "
+       "grid: the projected full state (u, v) on a grid of stability_elements, from the TD-BEM "
+       "march's tangent (central differences with another solver or a state on the wall) "
        "(problems/contact_bar/orbits/README.md, 'Stability')")  //
       ("stability_tdbem_check", po::value<bool>()->default_value(false),
        "with stability_representation fronts: K also by central differences of the TD-BEM's "
@@ -225,8 +226,8 @@ po::options_description trace_keys() {
        "(0, 0.5); with the grid representation pass 1e-2")  //
       ("stability_elements", po::value<long>()->default_value(0),
        "intervals of a uniform (u, v) grid for the monodromy, in [0, 2000] (0: the shooting "
-       "grid itself, mapped by its free knots); M is 2N x 2N, dense, from 4N simulations "
-       "(max_stability_work bounds their cost)")  //
+       "grid itself, mapped by its free knots); M is 2N x 2N, dense, from one march carrying "
+       "2N directions or 4N simulations (max_stability_work bounds the latter's cost)")  //
       ("max_stability_work", po::value<double>()->default_value(1e10),
        "refuse a grid monodromy whose simulations cost more than this many element-steps per "
        "point (4 N simulations of N intervals over T at stability_courant: about 30 s per point "
@@ -235,7 +236,8 @@ po::options_description trace_keys() {
        "c dt / dx of the monodromy's simulations at most, in (0, 1]: the velocity columns of "
        "the monodromy carry an error of 0.46 (c dt / dx)^2")  //
       ("stability_step", po::value<double>()->default_value(1e-6),
-       "difference step of the monodromy, relative to the orbit's amplitude, in (0, 1e-2)")  //
+       "difference step of the grid monodromy where the tangent does not apply, relative to the "
+       "orbit's amplitude, in (0, 1e-2)")  //
       ("return_tolerance", po::value<double>()->default_value(1e-6),
        "reject a converged point whose orbit, re-simulated over T by the exact oracle, misses "
        "u0 or v0 = 0 by more than this, relative to max|u0| (0: no check). Catches spurious "

@@ -415,6 +415,7 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   }
   auto gap_violation = [&](GridTime t) { return n * (2 * r_end(e, t) + c_ * a.s - wall); };
   const double pb = n * (u_b - wall);
+  if (tangent_ && std::abs(pb) <= kink_margin()) tangent_->on_kink = true;  // a grazing at tb
   if (!(pb > 0)) {
     E.force = 0;
     if (tangent_) set_next_tangent(tangent_->end_dt, du_b, ga.ds);
@@ -454,6 +455,10 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   // the energy in proportion to the round-off and shift the next closing by more, an error that
   // grows period after period on mode 1, whose closings all fall on grid points.
   E.closed = true;
+  // A closing on a kink of R (a sub-step end that is one) has two one-sided derivatives.
+  if (tangent_ &&
+      ((root <= root_snap_steps && a.kink) || (h - root <= root_snap_steps && kink_at_end)))
+    tangent_->on_kink = true;
   if (root <= root_snap_steps) {  // closed from ta
     E.contact_u = a.u;
     if (tangent_) {
@@ -503,6 +508,8 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
   const double pm = gap_violation(later(ta, 0.5 * h));
   const double r_b = r_end(e, tb);  // R_e(tb), used again by a step closed up to tb
   const double pb = n * (2 * r_b + c_ * a.s - E.contact_u);
+  // Held or released by the sign of pb: a pb of round-off is a decision on a kink.
+  if (tangent_ && std::abs(pb) <= kink_margin()) tangent_->on_kink = true;
   const double alpha = (4 * pm - pb) / h;  // the force at ta+ is EA alpha / (c step)
   const double beta = 2 * (pb - 2 * pm) / (h * h);
   auto closed_step = [&](GridTime t_end, bool kink) {

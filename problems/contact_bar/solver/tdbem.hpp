@@ -36,9 +36,9 @@
 // derivative of every history knot in the hats of a node grid (u0 and v0 at its nodes 1..N):
 // of its value and of its time, so the contact instants and their echoes move with the data.
 // The readouts give the derivative of the field at the current time: the march's own tangent,
-// no differences. Where the orbit sits on a kink of the march (an event on a step boundary, two
-// kinks merged) it is one side's; a readout on a moving knot takes the mean of the two sides.
-// Not yet the march's derivative everywhere: solver/README.md, 'Tangent', says where it is not.
+// no differences. A kink within a round-off of the readout is on it, and takes the mean of the
+// two sides; at a contact decision on a kink (tangent_on_kink) it is the side of the march's
+// own decisions (solver/README.md, 'Tangent').
 //   contact_bar::TdbemMarch m(setup, dt, ContactMethod::event, {nodes, true});
 //   m.advance_to(T);  Eigen::VectorXd du = m.tangent_displacement(0.3);  // P = 2N entries
 #pragma once
@@ -121,6 +121,11 @@ class TdbemMarch {
   int tangent_size() const { return tangent_ ? tangent_->size : 0; }
   Eigen::VectorXd tangent_displacement(double x) const;
   Eigen::MatrixXd tangent_projected_velocity(const std::vector<double>& nodes) const;
+  // Whether the march made a contact decision on a kink of its map: a held or released end, or
+  // a free one at a wall, whose gap or force test came within round-off (1e-12 of the scene's
+  // displacement scale) of the other outcome, or a closing on a kink of R. The tangent is then
+  // the side of the march's own decisions, and the other side's derivative differs.
+  bool tangent_on_kink() const { return tangent_ && tangent_->on_kink; }
 
  private:
   // A time on the march's step grid: step + tick / 2^62 steps of step_ seconds, tick in
@@ -235,6 +240,7 @@ class TdbemMarch {
     KnotTangent next;        // the next pushed knot's (push_knot), filled by its caller
     Eigen::VectorXd end_dt;  // the time derivative of the current sub-step's end
     Eigen::VectorXd zero;    // P zeros
+    bool on_kink = false;    // tangent_on_kink()
   };
   struct EndState {
     bar::End end;
@@ -289,8 +295,11 @@ class TdbemMarch {
   void add_hat_integrals(Eigen::VectorXd& d, bool v_block, double a, double b, double coef) const;
   // dQ_e(s) with s moving by ds (nullptr: s fixed); on a knot the left interval's slope.
   Eigen::VectorXd q_tangent(int e, GridTime s, const Eigen::VectorXd* ds) const;
-  // dQ_e/dt just after the last knot, from the end's state and R (a readout on that knot).
-  double next_slope(int e) const;
+  // dQ_e/dt just after time t (the last knot's, or a kink's arriving next), from the end's
+  // contact state and R (a readout on that knot).
+  double next_slope(int e, GridTime t) const;
+  // The slope of Q_e just after knot i (past a sliver interval; next_slope after the last).
+  double slope_after(int e, std::size_t i) const;
   // d of the slope q_slope(e, s) reads, s fixed.
   Eigen::VectorXd q_slope_tangent(int e, GridTime s) const;
   // dR_e(t), t moving by dt.
@@ -300,6 +309,7 @@ class TdbemMarch {
   Eigen::VectorXd arrival_dt(int e, GridTime p) const;
   // The last knot of end e moves with dt: its values follow along its left interval.
   void retag_last(int e, const Eigen::VectorXd& dt);
+  double kink_margin() const { return 1e-12 * gauge_scale_; }
   void set_next_tangent(const Eigen::VectorXd& dt, const Eigen::VectorXd& du,
                         const Eigen::VectorXd& ds);
 

@@ -25,6 +25,14 @@ namespace backbone::contact_bar {
 using core::InputError;
 using Eigen::VectorXd;
 
+namespace {
+// A kink within this many steps of a readout's time is on it: an event time carries the
+// round-off of its root (where mode 1's end turns at T, the kink fell 1.1e-11 steps from T at 40
+// intervals and 1.6e-9 at 80), and which side of a readout a moving kink falls must not depend
+// on that. Differences at the monodromy's step move a contact instant by 1e-3 steps or so.
+constexpr double readout_snap_steps = 1e-6;
+}  // namespace
+
 bar::BarSetup TdbemMarch::with_node_knots(const bar::BarSetup& setup,
                                           const TangentDirections& directions) {
   const std::vector<double>& y = directions.nodes;
@@ -34,14 +42,12 @@ bar::BarSetup TdbemMarch::with_node_knots(const bar::BarSetup& setup,
                                             "nodes)",
                                             length, y.size()));
   for (std::size_t i = 1; i < y.size(); ++i)
-    if (!(y[i] > y[i - 1]))
-      throw InputError("tangent", "the nodes must increase strictly");
+    if (!(y[i] > y[i - 1])) throw InputError("tangent", "the nodes must increase strictly");
   bar::BarSetup out = setup;
   for (bar::PiecewiseLinear* f : {&out.u0, &out.v0}) {
     const std::vector<double>& k = f->knots();
     for (std::size_t i = 1; i < k.size(); ++i)
-      if (k[i] == k[i - 1])
-        throw InputError("tangent", "u0 and v0 must be continuous (no jumps)");
+      if (k[i] == k[i - 1]) throw InputError("tangent", "u0 and v0 must be continuous (no jumps)");
     std::vector<double> x;
     std::merge(k.begin(), k.end(), y.begin(), y.end(), std::back_inserter(x));
     x.erase(std::unique(x.begin(), x.end()), x.end());
@@ -58,8 +64,9 @@ TdbemMarch::TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod meth
                        const TangentDirections& directions)
     : TdbemMarch(with_node_knots(setup, directions), dt, method) {
   if (method != ContactMethod::event)
-    throw InputError("tangent", "needs the event method (the projection's closings are not "
-                                "instants)");
+    throw InputError("tangent",
+                     "needs the event method (the projection's closings are not "
+                     "instants)");
   if (setup.body_force != 0) throw InputError("tangent", "is built without a body force");
   auto t = std::make_unique<Tangent>();
   t->nodes = directions.nodes;
@@ -94,16 +101,14 @@ void TdbemMarch::add_hat_values(VectorXd& d, bool v_block, double x, double coef
   d[offset + j] += coef * theta;
 }
 
-void TdbemMarch::add_hat_slopes(VectorXd& d, bool v_block, double x, int side,
-                                double coef) const {
+void TdbemMarch::add_hat_slopes(VectorXd& d, bool v_block, double x, int side, double coef) const {
   const std::vector<double>& y = tangent_->nodes;
   const int n = tangent_->n, offset = v_block ? n : 0;
   if ((side < 0 && !(x > 0)) || (side > 0 && !(x < L_)) || x < 0 || x > L_) return;
   // The element on `side` of x: [y_j, y_j+1] with y_j < x <= y_j+1 (left) or y_j <= x < y_j+1.
-  const auto it = side < 0 ? std::lower_bound(y.begin(), y.end(), x)
-                           : std::upper_bound(y.begin(), y.end(), x);
-  const auto j =
-      static_cast<int>(std::clamp<std::ptrdiff_t>(it - y.begin() - 1, 0, n - 1));
+  const auto it =
+      side < 0 ? std::lower_bound(y.begin(), y.end(), x) : std::upper_bound(y.begin(), y.end(), x);
+  const auto j = static_cast<int>(std::clamp<std::ptrdiff_t>(it - y.begin() - 1, 0, n - 1));
   const double h = y[static_cast<std::size_t>(j) + 1] - y[static_cast<std::size_t>(j)];
   if (j >= 1) d[offset + j - 1] -= coef / h;
   d[offset + j] += coef / h;
@@ -133,20 +138,30 @@ VectorXd TdbemMarch::q_tangent(int e, GridTime s, const VectorXd* ds) const {
   const auto& k = ends_[e].knots;
   const auto& g = ends_[e].tangents;
   std::size_t i = knot_index(e, s, nullptr);
-  // A time within merge_steps_ of a knot is on it: a readout's retarded time t - x / c carries
-  // the round-off of x / c, and a moving knot's side must not depend on it.
-  if (i > 0 && steps_between(s, k[i - 1].t) <= merge_steps_) --i;
-  if (i == k.size()) return g.back().dq;  // beyond the last knot Q is held (q_at)
-  if (i == 0 || steps_between(k[i].t, s) <= merge_steps_) {
+  // A time this close to a knot is on it: an event's, within merge_steps_ (the march's rule); a
+  // readout's (t - x / c, which carries the round-off of x / c) within readout_snap_steps.
+  const double snap = ds ? merge_steps_ : readout_snap_steps;
+  if (i > 0 && steps_between(s, k[i - 1].t) <= snap) --i;
+  // A readout at the end of the history with a kink arriving a round-off later: the mean of the
+  // sides adds half the motion of that kink (it would be a knot before s on the other side).
+  VectorXd pending = tangent_->zero;
+  const auto& next = ends_[e].pending;
+  if (!ds && i + 1 >= k.size() && !next.empty() &&
+      steps_between(next.front(), s) <= readout_snap_steps) {
+    const VectorXd dt = arrival_dt(e, next.front());
+    pending = -0.5 * (next_slope(e, next.front()) - k.back().slope) * dt;
+  }
+  if (i == k.size()) return g.back().dq + pending;  // beyond the last knot Q is held (q_at)
+  if (i == 0 || steps_between(k[i].t, s) <= snap) {
     // On a knot: an event time s moves along the left interval (its values are that
     // interval's end); a fixed time (a readout) on a moving knot sits on a kink of the map, and
     // takes the mean of the two sides, as central differences do.
     VectorXd d = g[i].dq;
     if (i == 0) return d;
     if (ds) return d + k[i].slope * (*ds - g[i].dt);
-    if (!g[i].moving) return d;
-    const double after = i + 1 < k.size() ? k[i + 1].slope : next_slope(e);
-    return d - 0.5 * (k[i].slope + after) * g[i].dt;
+    if (!g[i].moving) return d + pending;
+    const double after = slope_after(e, i);
+    return d - 0.5 * (k[i].slope + after) * g[i].dt + pending;
   }
   const double w = steps_between(s, k[i - 1].t) / steps_between(k[i].t, k[i - 1].t);
   const double m = k[i].slope;
@@ -156,11 +171,20 @@ VectorXd TdbemMarch::q_tangent(int e, GridTime s, const VectorXd* ds) const {
   return d;
 }
 
-double TdbemMarch::next_slope(int e) const {
+double TdbemMarch::slope_after(int e, std::size_t i) const {
+  // A sliver interval (a kink a round-off before a step's end) has a slope of round-off over
+  // round-off: the one after it stands for it.
+  const auto& k = ends_[e].knots;
+  std::size_t j = i + 1;
+  if (j < k.size() && steps_between(k[j].t, k[i].t) <= readout_snap_steps) ++j;
+  return j < k.size() ? k[j].slope : next_slope(e, k[i].t);
+}
+
+double TdbemMarch::next_slope(int e, GridTime t) const {
   // Q_e = U_e - R_e: an open end holds S (U = 2 R + c S, Q' = R'), a closed or fixed one U
   // (Q' = -R'). R' is the other end's slope after t - tau, or the data's before tau.
   const EndState& E = ends_[e];
-  const GridTime t = E.knots.back().t, source = minus(t, tau_grid_);
+  const GridTime source = minus(t, tau_grid_);
   double rate;
   if (source <= GridTime{}) {
     const double ct = c_ * seconds(t);
@@ -276,10 +300,13 @@ Eigen::MatrixXd TdbemMarch::tangent_projected_velocity(const std::vector<double>
     result.row(static_cast<Eigen::Index>(k)) += weight * (1 - theta) * d.transpose();
     result.row(static_cast<Eigen::Index>(k) + 1) += weight * theta * d.transpose();
   };
+  // A knot whose characteristic is within `edge` of an end is at that end (readout_snap_steps):
+  // the sliver piece between them is its motion, counted below, not integrated here.
+  const double edge = std::max(1e-12 * L_, c_ * readout_snap_steps * step_);
   // v at fixed x, differentiated: the slopes' derivatives, or the data's hats before tau.
   for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
     const double a = pts[i], b = pts[i + 1], h = b - a;
-    if (!(h > 1e-15 * L_)) continue;
+    if (!(h > 1e-15 * L_) || b <= edge || a >= L_ - edge) continue;
     const double mid = 0.5 * (a + b);
     for (double x : {mid - g * h, mid + g * h}) {
       const GridTime s0 = retarded(x / c_), sL = retarded((L_ - x) / c_);
@@ -308,20 +335,32 @@ Eigen::MatrixXd TdbemMarch::tangent_projected_velocity(const std::vector<double>
     const auto& tg = ends_[e].tangents;
     // A knot whose characteristic is at an end (now, or tau ago) moves it in or out of the
     // bar: one side's term, taken at half weight (the mean of the sides).
-    for (std::size_t i = 1; i < k.size(); ++i) {
+    // Knot 0 may be the one at t - tau exactly (the window keeps it): its stored slope is still
+    // the interval's before it.
+    for (std::size_t i = 0; i < k.size(); ++i) {
       if (!tg[i].moving) continue;
       const double along = c_ * seconds_between(now_, k[i].t);
       double x = e == 0 ? along : L_ - along;
-      const double edge = 1e-12 * L_;
       if (x < -edge || x > L_ + edge) continue;
       const bool at_end = x <= edge || x >= L_ - edge;
       x = std::clamp(x, 0.0, L_);
-      const double later_slope = i + 1 < k.size() ? k[i + 1].slope : next_slope(e);
+      const double later_slope = slope_after(e, i);
       const double earlier_slope = k[i].slope, weight = at_end ? 0.5 : 1.0;
       if (e == 0)
         add_row(x, weight, (later_slope - earlier_slope) * (-c_) * tg[i].dt);
       else
         add_row(x, weight, (earlier_slope - later_slope) * c_ * tg[i].dt);
+    }
+    // A kink arriving a round-off after now: on the other side it has arrived, its
+    // characteristic at this end; half its term.
+    const auto& next = ends_[e].pending;
+    if (!next.empty() && steps_between(next.front(), now_) <= readout_snap_steps) {
+      const VectorXd dt = arrival_dt(e, next.front());
+      const double jump = next_slope(e, next.front()) - k.back().slope;  // later - earlier
+      if (e == 0)
+        add_row(0.0, 0.5, jump * (-c_) * dt);
+      else
+        add_row(L_, 0.5, -jump * c_ * dt);
     }
   }
   return result;
