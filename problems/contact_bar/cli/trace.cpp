@@ -178,8 +178,9 @@ po::options_description trace_keys() {
       ("jacobian", po::value<std::string>()->default_value("exact"),
        "the shooting Jacobian: exact (from the exact solution's tangent: "
        "problems/contact_bar/orbits/README.md, section 'Exact Jacobian'; the regular formulation "
-       "with the exact solver or the TD-BEM's event march, without path rows; else differences) "
-       "or differences (finite differences, compressed by its pattern)")  //
+       "with the exact solver or the TD-BEM's event march, without path rows; else differences), "
+       "tdbem (the TD-BEM march's own tangent, the same matrix: a uniform grid away from the "
+       "wall, else as exact) or differences (finite differences, compressed by its pattern)")  //
       ("max_dense_work", po::value<double>()->default_value(2e10),
        "refuse a trace whose dense factorizations (the rank report's SVD of the m x n "
        "Jacobian, m n^2 operations) cost more than this (> 0; 2e10: about 2000 intervals, "
@@ -352,7 +353,9 @@ OrbitOptions shooting_grid(const core::Scene& scene) {
   options.elements =
       static_cast<int>(shooting_elements > 0 ? shooting_elements : scene.integer("elements", 2));
   options.steps_per_period = static_cast<int>(scene.integer("steps_per_period", 2));
-  options.exact_jacobian = scene.choice("jacobian", {"differences", "exact"}) == "exact";
+  const std::string jacobian = scene.choice("jacobian", {"differences", "exact", "tdbem"});
+  options.exact_jacobian = jacobian != "differences";
+  options.tdbem_jacobian = jacobian == "tdbem";
   check_residual_work(scene, options);
   return options;
 }

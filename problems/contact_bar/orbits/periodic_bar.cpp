@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <vector>
 
 #include "core/errors.hpp"
@@ -586,7 +587,24 @@ bool ContactBarOrbitProblem::exact_jacobian_applies_to_solver() const {
   return tdbem && tdbem->method() == ContactMethod::event;
 }
 
+bool ContactBarOrbitProblem::tdbem_jacobian_applies() const {
+  const auto* tdbem = dynamic_cast<const TdbemSolver*>(&solver_);
+  return options_.tdbem_jacobian && tdbem && tdbem->method() == ContactMethod::event &&
+         formulation() == core::ShootingFormulation::half_period_velocity &&
+         options_.free_knots == 0 && !options_.start_on_wall &&
+         !(path_rows_enabled_ && options_.path_rows() > 0);
+}
+
 std::string ContactBarOrbitProblem::jacobian_description() const {
+  if (tdbem_jacobian_applies()) return "tdbem";
+  if (options_.tdbem_jacobian)
+    return exact_description() +
+           " (tdbem applies to the TD-BEM's event march, the regular formulation and a uniform "
+           "grid away from the wall, without path rows)";
+  return exact_description();
+}
+
+std::string ContactBarOrbitProblem::exact_description() const {
   if (exact_jacobian_applies()) return "exact";
   if (!options_.exact_jacobian) return "differences";
   std::vector<std::string> reasons;
@@ -608,7 +626,46 @@ ContactBarOrbitProblem ContactBarOrbitProblem::without_path_rows() const {
 // The regular residual r_i = (L/c) / u_s int v(x, T/2) psi_i dx / m_i differentiated through
 // the exact solution (exact_bar, 'Tangent'): the unknowns move u0's knots (the free knots map
 // the grid) and values, and T moves the instant T/2.
+EvalStatus ContactBarOrbitProblem::tdbem_jacobian(const Vector& x, core::Matrix& J) const {
+  if (!tdbem_jacobian_applies()) return EvalStatus::failed;
+  if (const EvalStatus status = admissible(x); status != EvalStatus::ok) return status;
+  const int n = options_.elements, unknowns = num_unknowns();
+  const int m = options_.test_elements > 0 ? options_.test_elements : state_size();
+  const double length = setup_.material.length, period = x[period_index()];
+  const double c = setup_.material.wave_speed();
+  std::vector<double> nodes, test_nodes;
+  for (int i = 0; i <= n; ++i) nodes.push_back(length * i / n);
+  for (int i = 0; i <= m; ++i) test_nodes.push_back(length * i / m);
+  std::optional<TdbemMarch> march;
+  try {
+    march.emplace(setup_at(x), time_step(period), ContactMethod::event,
+                  TangentDirections{nodes, false});
+  } catch (const InputError&) {
+    return EvalStatus::failed;
+  }
+  if (!march->advance_to(0.5 * period)) return EvalStatus::failed;
+  const core::Matrix V = march->tangent_projected_velocity(test_nodes);  // (m + 1) x n
+  std::vector<double> u(test_nodes.size());
+  for (std::size_t i = 0; i < test_nodes.size(); ++i) u[i] = march->displacement(test_nodes[i]);
+  const double dx = length / m, end_strain = march->strain(length);
+  const double scale = setup_.material.travel_time() / displacement_scale();
+  const int rows = path_rows_enabled_ ? options_.path_rows() : 0;
+  J = core::Matrix::Zero(m + rows, unknowns);
+  for (int i = 1; i <= m; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const double mass = i == m ? 0.5 * dx : dx;
+    J.row(i - 1).head(n) = scale / mass * V.row(i);
+    // int u_x psi_i' dx: psi_i rises over the element before node i and falls over the one after.
+    double ux_dpsi = (u[k] - u[k - 1]) / dx;
+    if (i < m) ux_dpsi -= (u[k + 1] - u[k]) / dx;
+    const double dv_dt = c * c * ((i == m ? end_strain : 0.0) - ux_dpsi);
+    J(i - 1, period_index()) = 0.5 * scale / mass * dv_dt;
+  }
+  return J.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
+}
+
 EvalStatus ContactBarOrbitProblem::compute_jacobian(const Vector& x, core::Matrix& J) const {
+  if (tdbem_jacobian_applies()) return tdbem_jacobian(x, J);
   if (!exact_jacobian_applies()) return PeriodicOrbitProblem::compute_jacobian(x, J);
   const int n = options_.elements, k = options_.free_knots, unknowns = num_unknowns();
   const int m = options_.test_elements > 0 ? options_.test_elements : state_size();

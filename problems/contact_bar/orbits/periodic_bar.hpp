@@ -85,6 +85,9 @@ struct OrbitOptions {
   // 'Exact Jacobian') instead of finite differences: for the exact solver and the TD-BEM's
   // event march (which reproduces the exact solution on these states), without path rows.
   bool exact_jacobian = false;
+  // The same Jacobian from the TD-BEM march's own tangent (ContactBarOrbitProblem::
+  // tdbem_jacobian) where it applies, else as exact_jacobian says.
+  bool tdbem_jacobian = false;
   int path_rows() const { return (fixed_energy > 0 ? 1 : 0) + (fixed_shape >= 0 ? 1 : 0); }
   int nodal_unknowns() const { return elements - (start_on_wall ? 1 : 0); }
   int state_size() const { return nodal_unknowns() + free_knots; }
@@ -170,6 +173,15 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // the exact solution's tangent; else finite differences (core::Problem).
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
   bool exact_jacobian_applies() const;
+  // The regular residual's Jacobian from the TD-BEM march's tangent (solver/tdbem.hpp,
+  // 'Tangent'): its u0 columns are the march's derivative in the hats of the grid; its period
+  // column is half the time derivative of the projected v at T/2, c^2 (u_x(L) psi_i(L) -
+  // int u_x psi_i'), from the march's field (the march is exact on these states, so moving T
+  // moves only the instant). For the TD-BEM's event march, the regular formulation, a uniform
+  // grid (no free knots) not starting on the wall, without path rows; EvalStatus failed
+  // otherwise.
+  core::EvalStatus tdbem_jacobian(const core::Vector& x, core::Matrix& J) const;
+  bool tdbem_jacobian_applies() const;
   // Where the Jacobian comes from, for the trace's header and summary.txt: "exact",
   // "differences", "differences (...)" saying why the exact one does not apply, or, when only
   // the path rows stand in the way, that F alone (rank reports, the atlas) takes the exact one.
@@ -242,6 +254,7 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   double gap() const;
   // The solver has the exact tangent: the exact one, or the TD-BEM's event march.
   bool exact_jacobian_applies_to_solver() const;
+  std::string exact_description() const;  // jacobian_description() without tdbem
   core::Vector mode_guess(int mode, double ratio, core::Vector x) const;
   std::shared_ptr<const bar::BarSolver> owned_solver_;  // empty unless shared
   bar::BarSetup setup_;
