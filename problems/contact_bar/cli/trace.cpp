@@ -193,7 +193,8 @@ po::options_description trace_keys() {
        "fronts: the isolated multipliers exactly, from the orbit's fronts, one tangent "
        "simulation per point (fronts.csv beside the branch: K's checks and Jordan defect); "
        "grid: the projected full state (u, v) on a grid of stability_elements, from the TD-BEM "
-       "march's tangent (central differences with another solver or a state on the wall) "
+       "march's tangent (central differences with another solver, contact projection or a "
+       "state on the wall) "
        "(problems/contact_bar/orbits/README.md, 'Stability')")  //
       ("stability_tdbem_check", po::value<bool>()->default_value(false),
        "with stability_representation fronts: K also by central differences of the TD-BEM's "
@@ -309,14 +310,20 @@ void check_time_step(const bar::Material& material, double period, int steps_per
                   2 * static_cast<long>(std::ceil(period / transit / 2))));
 }
 
+// max_memory in GB (0: half of this machine's memory), and the words that say which.
+std::pair<double, std::string> memory_limit(const core::Scene& scene) {
+  const double given = scene.non_negative("max_memory");
+  if (given > 0) return {given, ""};
+  const double physical =
+      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  return {physical / 2 / 1e9, " (half of this machine's memory)"};
+}
+
 // The memory a trace needs before it starts: the corrector and the rank report hold about nine
 // copies of the dense m x n Jacobian (J, its QR or COD, the bordered system, the SVD's
 // workspace), so a grid whose copies do not fit is refused up front (key max_memory).
 void check_memory(const core::Scene& scene, const OrbitOptions& options) {
-  const double given = scene.non_negative("max_memory");
-  const double physical =
-      static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
-  const double limit_gb = given > 0 ? given : physical / 2 / 1e9;
+  const auto [limit_gb, limit_origin] = memory_limit(scene);
   const double equations = options.test_elements > 0 ? options.test_elements : options.state_size();
   const double unknowns = options.state_size() + 1.0;
   const double need_gb = 9 * equations * unknowns * sizeof(double) / 1e9;
@@ -337,8 +344,7 @@ void check_memory(const core::Scene& scene, const OrbitOptions& options) {
       fmt::format("{} intervals make a {:.0f} x {:.0f} Jacobian; the corrector and the rank "
                   "reports need about {:.3g} GB, above max_memory {:.3g} GB{}: lower "
                   "shooting_elements (or test_elements), or raise max_memory",
-                  options.elements, equations, unknowns, need_gb, limit_gb,
-                  given > 0 ? "" : " (half of this machine's memory)"));
+                  options.elements, equations, unknowns, need_gb, limit_gb, limit_origin));
 }
 
 // The shooting grid of the scene: shooting_elements (0: the scene's elements) and
@@ -1063,7 +1069,10 @@ void check_stability_keys(const core::Scene& scene) {
 
 // The grid monodromy's cost per point, before any work: 4 N simulations of N intervals over the
 // period T at c dt = stability_courant dx, about 4 N^2 c T / (courant dx) element-steps (measured
-// on mode 1: 4.1e9 in 13 s at 200 intervals, 3.3e10 in 62 s at 400), against max_stability_work.
+// on mode 1: 4.1e9 in 13 s at 200 intervals, 3.3e10 in 62 s at 400), against max_stability_work;
+// the TD-BEM's tangent does the same work in one march, cheaper by a constant. Its memory: each
+// end's window of about N / courant knots carries four vectors of 2N doubles, and the window's
+// array may hold as much again: 256 N^2 / courant bytes, against max_memory.
 void check_grid_monodromy_work(const core::Scene& scene, const cli::TraceSetup& s) {
   const auto* p = dynamic_cast<const ContactBarOrbitProblem*>(s.problem.get());
   if (!p || p->monodromy_options().representation != MonodromyOptions::Representation::grid) return;
@@ -1074,6 +1083,18 @@ void check_grid_monodromy_work(const core::Scene& scene, const cli::TraceSetup& 
   const double steps = period * material.wave_speed() * n / (o.courant * material.length);
   const double work = 4 * n * n * steps;
   const double limit = scene.positive("max_stability_work");
+  const auto* tdbem = dynamic_cast<const TdbemSolver*>(&p->solver());
+  if (tdbem && tdbem->method() == ContactMethod::event) {
+    const auto [limit_gb, limit_origin] = memory_limit(scene);
+    const double need_gb = 256 * n * n / o.courant / 1e9;
+    if (need_gb > limit_gb)
+      throw core::InputError(
+          o.elements > 0 ? "stability_elements" : "shooting_elements",
+          fmt::format("the grid monodromy of {:.0f} intervals carries the march's tangent in "
+                      "{:.0f} directions, about {:.3g} GB, above max_memory {:.3g} GB{}: fewer "
+                      "intervals, a larger stability_courant, or a larger max_memory",
+                      n, 2 * n, need_gb, limit_gb, limit_origin));
+  }
   if (work <= limit) return;
   throw core::InputError(
       o.elements > 0 ? "stability_elements" : "shooting_elements",

@@ -31,12 +31,6 @@ MonodromyOptions::Representation parse_representation(const std::string& key,
   throw core::InputError(key, fmt::format("must be fronts or grid (got '{}')", value));
 }
 
-MonodromyOptions::Derivatives parse_derivatives(const std::string& key, const std::string& value) {
-  if (value == "tangent") return MonodromyOptions::Derivatives::tangent;
-  if (value == "differences") return MonodromyOptions::Derivatives::differences;
-  throw core::InputError(key, fmt::format("must be tangent or differences (got '{}')", value));
-}
-
 namespace {
 
 // The orbit x simulated by the exact solver and its state at a time of free flight
@@ -244,7 +238,13 @@ EvalStatus tangent_monodromy(const ContactBarOrbitProblem& problem,
   bar::BarSetup s = problem.setup_template();
   s.u0 = nodal_function(nodes, state.data());
   s.v0 = nodal_function(nodes, state.data() + n);
-  TdbemMarch march(s, dt, ContactMethod::event, TangentDirections{nodes, true});
+  std::optional<TdbemMarch> tangent;
+  try {
+    tangent.emplace(s, dt, ContactMethod::event, TangentDirections{nodes, true});
+  } catch (const core::InputError&) {
+    return EvalStatus::failed;
+  }
+  TdbemMarch& march = *tangent;
   if (!march.advance_to(period)) return EvalStatus::non_finite;
   M.resize(2 * n, 2 * n);
   for (int i = 1; i <= n; ++i)

@@ -66,8 +66,6 @@ struct MonodromyOptions {
 };
 MonodromyOptions::Representation parse_representation(const std::string& key,
                                                       const std::string& value);  // InputError
-MonodromyOptions::Derivatives parse_derivatives(const std::string& key,
-                                                const std::string& value);  // InputError
 
 // The representation's nodes 0 = y_0 < ... < y_N = L: the uniform grid of `elements` intervals,
 // or with elements = 0 the problem's own node grid at x (mapped by its free knots, so that a

@@ -623,9 +623,6 @@ ContactBarOrbitProblem ContactBarOrbitProblem::without_path_rows() const {
   return alone;
 }
 
-// The regular residual r_i = (L/c) / u_s int v(x, T/2) psi_i dx / m_i differentiated through
-// the exact solution (exact_bar, 'Tangent'): the unknowns move u0's knots (the free knots map
-// the grid) and values, and T moves the instant T/2.
 EvalStatus ContactBarOrbitProblem::tdbem_jacobian(const Vector& x, core::Matrix& J) const {
   if (!tdbem_jacobian_applies()) return EvalStatus::failed;
   if (const EvalStatus status = admissible(x); status != EvalStatus::ok) return status;
@@ -664,6 +661,9 @@ EvalStatus ContactBarOrbitProblem::tdbem_jacobian(const Vector& x, core::Matrix&
   return J.allFinite() ? EvalStatus::ok : EvalStatus::non_finite;
 }
 
+// The regular residual r_i = (L/c) / u_s int v(x, T/2) psi_i dx / m_i differentiated through
+// the exact solution (exact_bar, 'Tangent'): the unknowns move u0's knots (the free knots map
+// the grid) and values, and T moves the instant T/2.
 EvalStatus ContactBarOrbitProblem::compute_jacobian(const Vector& x, core::Matrix& J) const {
   if (tdbem_jacobian_applies()) return tdbem_jacobian(x, J);
   if (!exact_jacobian_applies()) return PeriodicOrbitProblem::compute_jacobian(x, J);

@@ -415,7 +415,8 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
   }
   auto gap_violation = [&](GridTime t) { return n * (2 * r_end(e, t) + c_ * a.s - wall); };
   const double pb = n * (u_b - wall);
-  if (tangent_ && std::abs(pb) <= kink_margin()) tangent_->on_kink = true;  // a grazing at tb
+  // The free displacement at the wall at tb, a kink of R: a grazing (of one sign it touches).
+  if (tangent_ && kink_at_end && std::abs(pb) <= kink_margin()) tangent_->on_kink = true;
   if (!(pb > 0)) {
     E.force = 0;
     if (tangent_) set_next_tangent(tangent_->end_dt, du_b, ga.ds);

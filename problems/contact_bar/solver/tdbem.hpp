@@ -81,8 +81,10 @@ class TdbemMarch {
   // Throws InputError for a bad setup or dt (dt must be finite, > 0 and <= L / c).
   TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod method);
   // With the tangent in `directions`: the event method, no body force, u0 and v0 without
-  // jumps (InputError "tangent" otherwise). The data's knots gain the nodes (a hat's kink is a
-  // kink of the perturbed data): the march's values are the plain march's when they hold them.
+  // jumps, no fixed end at x = L (InputError "tangent" otherwise). The data's knots gain the
+  // nodes (a hat's kink is a kink of the perturbed data), and every echo of a kink is kept: the
+  // values agree with the plain march's to round-off, and the window grows with each contact
+  // event, so the tangent suits marches of a period or a few.
   TdbemMarch(const bar::BarSetup& setup, double dt, ContactMethod method,
              const TangentDirections& directions);
 
@@ -121,10 +123,10 @@ class TdbemMarch {
   int tangent_size() const { return tangent_ ? tangent_->size : 0; }
   Eigen::VectorXd tangent_displacement(double x) const;
   Eigen::MatrixXd tangent_projected_velocity(const std::vector<double>& nodes) const;
-  // Whether the march made a contact decision on a kink of its map: a held or released end, or
-  // a free one at a wall, whose gap or force test came within round-off (1e-12 of the scene's
-  // displacement scale) of the other outcome, or a closing on a kink of R. The tangent is then
-  // the side of the march's own decisions, and the other side's derivative differs.
+  // Whether a contact decision of the march came within round-off (1e-12 of the scene's
+  // displacement scale) of the other outcome: a held or released end whose force test was
+  // round-off, a grazing at a kink of R, a closing on a kink of R. The map may have a kink
+  // there (it does at a grazing); the tangent is the side of the march's own decisions.
   bool tangent_on_kink() const { return tangent_ && tangent_->on_kink; }
 
  private:
@@ -200,6 +202,10 @@ class TdbemMarch {
     void push_back(const T& value) {
       if (data_.size() == data_.capacity() && head_ >= size()) drop_dead();
       data_.push_back(value);
+    }
+    void push_back(T&& value) {
+      if (data_.size() == data_.capacity() && head_ >= size()) drop_dead();
+      data_.push_back(std::move(value));
     }
     void pop_front() {
       if (++head_ == data_.size()) {

@@ -35,7 +35,7 @@ constexpr double readout_snap_steps = 1e-6;
 
 bar::BarSetup TdbemMarch::with_node_knots(const bar::BarSetup& setup,
                                           const TangentDirections& directions) {
-  const std::vector<double>& y = directions.nodes;
+  std::vector<double> y = directions.nodes;
   const double length = setup.material.length;
   if (y.size() < 2 || y.front() != 0 || std::abs(y.back() - length) > 1e-12 * length)
     throw InputError("tangent", fmt::format("the nodes must run from 0 to the length {} (got {} "
@@ -43,6 +43,9 @@ bar::BarSetup TdbemMarch::with_node_knots(const bar::BarSetup& setup,
                                             length, y.size()));
   for (std::size_t i = 1; i < y.size(); ++i)
     if (!(y[i] > y[i - 1])) throw InputError("tangent", "the nodes must increase strictly");
+  y.back() = length;
+  if (setup.right.type == bar::EndType::fixed)
+    throw InputError("tangent", "a fixed end at x = L holds u0(L), the last hat's direction");
   bar::BarSetup out = setup;
   for (bar::PiecewiseLinear* f : {&out.u0, &out.v0}) {
     const std::vector<double>& k = f->knots();
@@ -156,8 +159,9 @@ VectorXd TdbemMarch::q_tangent(int e, GridTime s, const VectorXd* ds) const {
     // On a knot: an event time s moves along the left interval (its values are that
     // interval's end); a fixed time (a readout) on a moving knot sits on a kink of the map, and
     // takes the mean of the two sides, as central differences do.
+    // Knot 0 may be the window's first, at t - tau: its stored slope is still the interval's
+    // before it (0 for the knot at t = 0, which does not move).
     VectorXd d = g[i].dq;
-    if (i == 0) return d;
     if (ds) return d + k[i].slope * (*ds - g[i].dt);
     if (!g[i].moving) return d + pending;
     const double after = slope_after(e, i);

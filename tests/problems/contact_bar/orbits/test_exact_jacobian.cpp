@@ -173,7 +173,6 @@ TEST(ExactJacobian, AnnihilatesTheAttachedWarpsAtABranchPoint) {
   EXPECT_GT(sv[n - 5] / sv[0], 1e-2);
 }
 
-}  // namespace
 // Two tangents of one map: the TD-BEM march's own (OrbitOptions::tdbem_jacobian: the march's
 // derivative in the grid's hats, the period column from the field's time derivative) and the
 // exact solution's. The event march reproduces the exact solution on shooting states, so off
@@ -209,4 +208,5 @@ TEST(ExactJacobian, TheTdbemTangentGivesTheSameJacobian) {
   }
 }
 
+}  // namespace
 }  // namespace backbone::contact_bar
