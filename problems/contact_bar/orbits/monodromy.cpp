@@ -138,6 +138,16 @@ bar::PiecewiseLinear nodal_function(const std::vector<double>& nodes, const doub
   return bar::PiecewiseLinear(nodes, std::move(y));
 }
 
+// The problem's bar started from the state s = [u_1..u_N | v_1..v_N] on the nodes.
+bar::BarSetup state_setup(const ContactBarOrbitProblem& problem, const std::vector<double>& nodes,
+                          const Vector& state) {
+  const auto n = static_cast<Eigen::Index>(nodes.size()) - 1;
+  bar::BarSetup s = problem.setup_template();
+  s.u0 = nodal_function(nodes, state.data());
+  s.v0 = nodal_function(nodes, state.data() + n);
+  return s;
+}
+
 // Solves M v = b for the P1 mass matrix of nodes 1..N (node 0 fixed): row i has
 // (h_i + h_{i+1}) / 3 on the diagonal and h / 6 beside it, the last row h_N / 3; symmetric
 // positive definite and tridiagonal (Thomas).
@@ -199,9 +209,7 @@ EvalStatus full_state_map(const ContactBarOrbitProblem& problem, const std::vect
                           double period, double dt, const Vector& state, Vector& mapped) {
   const int n = static_cast<int>(nodes.size()) - 1;
   if (n < 1 || state.size() != 2 * n || !(period > 0)) return EvalStatus::failed;
-  bar::BarSetup s = problem.setup_template();
-  s.u0 = nodal_function(nodes, state.data());
-  s.v0 = nodal_function(nodes, state.data() + n);
+  const bar::BarSetup s = state_setup(problem, nodes, state);
   bar::SnapshotRequest request;
   request.dt = dt;
   request.elements = n;
@@ -235,9 +243,7 @@ EvalStatus tangent_monodromy(const ContactBarOrbitProblem& problem,
                              const std::vector<double>& nodes, double period, double dt,
                              const Vector& state, Matrix& M) {
   const int n = static_cast<int>(nodes.size()) - 1;
-  bar::BarSetup s = problem.setup_template();
-  s.u0 = nodal_function(nodes, state.data());
-  s.v0 = nodal_function(nodes, state.data() + n);
+  const bar::BarSetup s = state_setup(problem, nodes, state);
   std::optional<TdbemMarch> tangent;
   try {
     tangent.emplace(s, dt, ContactMethod::event, TangentDirections{nodes, true});

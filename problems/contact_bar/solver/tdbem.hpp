@@ -308,6 +308,10 @@ class TdbemMarch {
   double slope_after(int e, std::size_t i) const;
   // d of the slope q_slope(e, s) reads, s fixed.
   Eigen::VectorXd q_slope_tangent(int e, GridTime s) const;
+  // Before tau, R_e reads the data at x = L - c t (e = 1) or c t (e = 0): that point, and
+  // dR_e/dt there.
+  double data_point(int e, GridTime t) const;
+  double data_rate(int e, GridTime t) const;
   // dR_e(t), t moving by dt.
   Eigen::VectorXd r_tangent(int e, GridTime t, const Eigen::VectorXd& dt) const;
   // The time derivative of a kink of R_e arriving at p: its source knot's on the other end

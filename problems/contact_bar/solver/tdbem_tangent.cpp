@@ -191,10 +191,7 @@ double TdbemMarch::next_slope(int e, GridTime t) const {
   const GridTime source = minus(t, tau_grid_);
   double rate;
   if (source <= GridTime{}) {
-    const double ct = c_ * seconds(t);
-    const double x = e == 1 ? std::max(L_ - ct, 0.0) : std::min(ct, L_);
-    rate = e == 1 ? -0.5 * c_ * setup_.u0.slope(x, -1) + 0.5 * setup_.v0(x)
-                  : 0.5 * c_ * setup_.u0.slope(x, +1) + 0.5 * setup_.v0(x);
+    rate = data_rate(e, t);
   } else {
     const auto& k = ends_[1 - e].knots;
     std::size_t i = knot_index(1 - e, later(source, -merge_steps_), nullptr);
@@ -217,21 +214,27 @@ VectorXd TdbemMarch::q_slope_tangent(int e, GridTime s) const {
   return d / seconds_between(k[i].t, k[i - 1].t);
 }
 
+double TdbemMarch::data_point(int e, GridTime t) const {
+  const double ct = c_ * seconds(t);
+  return e == 1 ? std::max(L_ - ct, 0.0) : std::min(ct, L_);
+}
+
+double TdbemMarch::data_rate(int e, GridTime t) const {
+  const double x = data_point(e, t);
+  return e == 1 ? -0.5 * c_ * setup_.u0.slope(x, -1) + 0.5 * setup_.v0(x)
+                : 0.5 * c_ * setup_.u0.slope(x, +1) + 0.5 * setup_.v0(x);
+}
+
 VectorXd TdbemMarch::r_tangent(int e, GridTime t, const VectorXd& dt) const {
   VectorXd d = tangent_->zero;
   const GridTime retarded_time = minus(t, tau_grid_);
   const bool v = tangent_->velocity;
   if (retarded_time <= GridTime{}) {
     // R_1 = u0(L - ct) / 2 + int_{L - ct}^L v0 / (2c), R_0 = u0(ct) / 2 + int_0^ct v0 / (2c).
-    const double ct = c_ * seconds(t);
-    const double x = e == 1 ? std::max(L_ - ct, 0.0) : std::min(ct, L_);
+    const double x = data_point(e, t);
     add_hat_values(d, false, x, 0.5);
     if (v) add_hat_integrals(d, true, e == 1 ? x : 0.0, e == 1 ? L_ : x, 0.5 / c_);
-    if ((dt.array() != 0).any()) {
-      const double rate = e == 1 ? -0.5 * c_ * setup_.u0.slope(x, -1) + 0.5 * setup_.v0(x)
-                                 : 0.5 * c_ * setup_.u0.slope(x, +1) + 0.5 * setup_.v0(x);
-      d += rate * dt;
-    }
+    if ((dt.array() != 0).any()) d += data_rate(e, t) * dt;
     return d;
   }
   if (v) add_hat_integrals(d, true, 0.0, L_, 0.5 / c_);
