@@ -18,10 +18,11 @@
 // are off by 0.46 (c dt / dx)^2, the u columns by round-off.
 // M = d(map)/ds from the march's own tangent, one march carrying 2N directions
 // (solver/tdbem.hpp, 'Tangent'), when the problem's solver is the TD-BEM's event march and the
-// state is off the wall: on a kink of the map, the side of the march's own contact decisions.
-// Otherwise by central differences, 4N simulations of one period (on `threads` threads), the
-// mean of the two sides at a kink; for a state on the wall, the columns of u(L) and v(L) are
-// the one-sided differences away from it.
+// state is off a contact end's wall: on a kink of the map, the side of the march's own contact
+// decisions (on a clearance end's walls, the side away from the wall). Otherwise by central
+// differences, 4N simulations of one period (on `threads` threads), the mean of the two sides at
+// a kink; for a state on a contact end's wall, the columns of u(L) and v(L) are the one-sided
+// differences away from it.
 // The period map is affine while the contact sequence and the grid cells holding its instants'
 // fronts stay the same, except where a front's characteristic moves with the state: its
 // projection is quadratic in the motion, and differences carry an error linear in the step

@@ -364,9 +364,7 @@ void TdbemMarch::substep_event(int e, GridTime ta, GridTime tb, bool kink_at_end
     case bar::EndType::fixed: {
       const double s = -2 * r_end(e, tb) / c_;
       E.force = -ea_ * E.normal * (s - a.s) / seconds_between(tb, ta);
-      if (tangent_)
-        set_next_tangent(tangent_->end_dt, tangent_->zero,
-                         -2 / c_ * r_tangent(e, tb, tangent_->end_dt));
+      if (tangent_) set_next_tangent_holding(e, tb);
       push_knot(e, tb, 0.0, s, kink_at_end);
       return;
     }
@@ -473,9 +471,7 @@ void TdbemMarch::solve_open(int e, GridTime ta, GridTime tb, bool kink_at_end) {
     events_.push_back({seconds(ta), e == 1, true, back});
     const double s = (E.contact_u - 2 * r_b) / c_;
     E.force = -ea_ * E.normal * (s - a.s) / seconds_between(tb, ta);
-    if (tangent_)
-      set_next_tangent(tangent_->end_dt, tangent_->zero,
-                       -2 / c_ * r_tangent(e, tb, tangent_->end_dt));
+    if (tangent_) set_next_tangent_holding(e, tb);
     push_knot(e, tb, E.contact_u, s, kink_at_end);
     return;
   }
@@ -517,9 +513,7 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
     const double s = (E.contact_u - 2 * (t_end == tb ? r_b : r_end(e, t_end))) / c_;
     E.force = -ea_ * E.normal * (s - a.s) / seconds_between(t_end, ta);
     // A release inside the sub-step needs a body force, which the tangent refuses: t_end is tb.
-    if (tangent_)
-      set_next_tangent(tangent_->end_dt, tangent_->zero,
-                       -2 / c_ * r_tangent(e, t_end, tangent_->end_dt));
+    if (tangent_) set_next_tangent_holding(e, t_end);
     push_knot(e, t_end, E.contact_u, s, kink);
   };
   if (alpha < 0 && pb < 0) {
@@ -558,6 +552,7 @@ void TdbemMarch::solve_closed_to(int e, GridTime ta, GridTime tb, bool kink_at_e
 // size of u again: O(window), once every many steps.
 void TdbemMarch::regauge() {
   const double shift = 0.5 * (ends_[0].knots.back().q - ends_[1].knots.back().q);
+  ++regauges_;
   if (tangent_) {
     const Eigen::VectorXd d_shift =
         0.5 * (ends_[0].tangents.back().dq - ends_[1].tangents.back().dq);

@@ -99,6 +99,7 @@ class TdbemMarch {
   double end_force(bool right) const;  // compressive end force -EA u_x over the last sub-step [N]
   bool in_contact(bool right) const;
   const std::vector<ContactEvent>& events() const { return events_; }
+  int regauges() const { return regauges_; }  // shifts of the gauge so far (regauge() below)
 
   // Field at the current time, x in [0, L]. On a front (jump of v or u_x) the value is one of
   // the one-sided limits; projections below are exact and unambiguous.
@@ -322,6 +323,8 @@ class TdbemMarch {
   double kink_margin() const { return 1e-12 * gauge_scale_; }
   void set_next_tangent(const Eigen::VectorXd& dt, const Eigen::VectorXd& du,
                         const Eigen::VectorXd& ds);
+  // The next knot holds U at t (a fixed end, a closed one): du = 0, ds = -2 dR_e(t) / c.
+  void set_next_tangent_holding(int e, GridTime t);
 
   bar::BarSetup setup_;
   ContactMethod method_;
@@ -334,6 +337,7 @@ class TdbemMarch {
   double t_ = 0;             // time() [s]: the last target reached
   GridTime now_;             // the current time on the grid
   bool ok_ = true;
+  int regauges_ = 0;
   EndState ends_[2];  // 0: x = 0, 1: x = L
   // Knot index of the last retarded-time query of each end's R (r_end reads the OTHER end's
   // history at t - tau, increasing over the march). Only the march itself updates it.

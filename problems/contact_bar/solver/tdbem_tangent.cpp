@@ -272,6 +272,10 @@ void TdbemMarch::set_next_tangent(const VectorXd& dt, const VectorXd& du, const 
   tangent_->next.ds = ds;
 }
 
+void TdbemMarch::set_next_tangent_holding(int e, GridTime t) {
+  set_next_tangent(tangent_->end_dt, tangent_->zero, -2 / c_ * r_tangent(e, t, tangent_->end_dt));
+}
+
 VectorXd TdbemMarch::tangent_displacement(double x) const {
   if (!tangent_) throw InputError("tangent", "this march carries no tangent");
   const GridTime s0 = retarded(x / c_), sL = retarded((L_ - x) / c_);

@@ -388,4 +388,118 @@ TEST(ContactBarMonodromy, AKinkARoundOffFromTheReadoutIsOnIt) {
   }
 }
 
+// The tangent's rarer branches against differences of the same march (the criterion of
+// TheTangentIsTheMarchsDerivative: no front moves in these cases, measured as a tenth of the step
+// leaving the gap as it is, so the differences' error is their round-off, 1e-16 of the state over
+// the step's 1e-6 of it times the v rows' c / dx and the growth of |M| over long horizons,
+// measured 2.1e-8 of |M| in both: 1e-7 asserted):
+// - a clearance end (walls 0.5 g0 either side) that closes on both walls within the period;
+// - a contact end over 41.7 L/c, long enough for the fixed end's mean strain to move the gauge
+//   (regauge() shifts Q of both ends, and with it their tangents).
+// Each case checks that it reaches the branch it is for.
+TEST(ContactBarMonodromy, TheTangentFollowsTheBackWallAndTheGauge) {
+  const contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
+  struct Case {
+    const char* name;
+    bool clearance;
+    double period;
+  };
+  for (const Case& c : {Case{"clearance", true, 3.0}, Case{"long contact", false, 41.7}}) {
+    bar::BarSetup setup = test_support::paper_setup();
+    if (c.clearance)
+      setup.right = {bar::EndType::clearance, 0.5 * test_support::kGap, 0.5 * test_support::kGap};
+    contact_bar::OrbitOptions o;
+    o.elements = 10;
+    const int n = o.elements;
+    const contact_bar::ContactBarOrbitProblem orbit(setup, tdbem, o);
+    core::Vector x = core::Vector::Zero(n + 1);
+    for (int i = 0; i < n; ++i)
+      x[i] = 2 * test_support::kGap * std::sin(M_PI * (i + 1) / n) +
+             0.1 * test_support::kGap * std::sin(0.7 * (i + 1));
+    if (!c.clearance) x[n - 1] = -test_support::kGap;
+    x[orbit.period_index()] = c.period;
+
+    // The plain march of the same state: the branch is reached.
+    const std::vector<double> nodes = contact_bar::full_state_nodes(orbit, x, 0);
+    const core::Vector s = contact_bar::full_state(orbit, x, nodes);
+    std::vector<double> u(nodes.size(), 0.0);
+    for (int i = 1; i <= n; ++i) u[static_cast<std::size_t>(i)] = s[i - 1];
+    bar::BarSetup b = setup;
+    b.u0 = bar::PiecewiseLinear(nodes, u);
+    b.v0 = bar::PiecewiseLinear(nodes, std::vector<double>(nodes.size(), 0.0));
+    contact_bar::TdbemMarch march(
+        b, contact_bar::full_state_time_step(orbit, c.period, nodes, 1.0 / 32),
+        contact_bar::ContactMethod::event);
+    ASSERT_TRUE(march.advance_to(c.period)) << c.name;
+    if (c.clearance) {
+      const auto& events = march.events();
+      const auto closes = [&](bool back) {
+        return std::count_if(events.begin(), events.end(), [&](const contact_bar::ContactEvent& e) {
+          return e.closing && e.back_wall == back;
+        });
+      };
+      EXPECT_GE(closes(false), 1) << "the front wall is never reached";
+      EXPECT_GE(closes(true), 1) << "the back wall is never reached";
+    } else {
+      EXPECT_GE(march.regauges(), 1) << "the gauge never moves";
+    }
+
+    contact_bar::MonodromyOptions by_tangent, by_differences;
+    by_tangent.derivatives = contact_bar::MonodromyOptions::Derivatives::tangent;
+    by_differences.derivatives = contact_bar::MonodromyOptions::Derivatives::differences;
+    core::Matrix M, D;
+    ASSERT_EQ(contact_bar::full_state_monodromy(orbit, x, by_tangent, M), core::EvalStatus::ok);
+    ASSERT_EQ(contact_bar::full_state_monodromy(orbit, x, by_differences, D), core::EvalStatus::ok);
+    EXPECT_LE((M - D).lpNorm<Eigen::Infinity>(), 1e-7 * M.lpNorm<Eigen::Infinity>()) << c.name;
+  }
+}
+
+// A clearance end's state on either wall, by the march's tangent (the grid monodromy's default
+// there). The map has a kink in u(L): a step towards the wall leaves the admissible set (the march
+// refuses it). Oracle: the one-sided difference away from the wall at a tenth of the
+// monodromy's step, for the u(L) and v(L) columns (the map is affine on that side, so the two
+// agree to the differences' round-off: 1e-16 of the state over 1e-7 of it, times the growth of
+// the column; measured 9.7e-10 to 2.0e-8 of the column, 1e-7 asserted).
+TEST(ContactBarMonodromy, OnEitherWallOfAClearanceTheTangentIsTheSideAwayFromIt) {
+  const contact_bar::TdbemSolver tdbem(contact_bar::ContactMethod::event);
+  bar::BarSetup setup = test_support::paper_setup();
+  const double gap = 0.5 * test_support::kGap;
+  setup.right = {bar::EndType::clearance, gap, gap};
+  contact_bar::OrbitOptions o;
+  o.elements = 10;
+  const int n = o.elements;
+  const contact_bar::ContactBarOrbitProblem orbit(setup, tdbem, o);
+  for (double side : {1.0, -1.0}) {  // the front wall (u(L) = gap), the back one (-gap_back)
+    core::Vector x = core::Vector::Zero(n + 1);
+    for (int i = 0; i < n; ++i)
+      x[i] = side * gap * (i + 1) / n + 0.3 * gap * std::sin(0.7 * (i + 1));
+    x[n - 1] = side * gap;
+    x[orbit.period_index()] = 2.9;
+    core::Matrix M;
+    ASSERT_EQ(contact_bar::full_state_monodromy(orbit, x, {}, M), core::EvalStatus::ok);
+    const std::vector<double> nodes = contact_bar::full_state_nodes(orbit, x, 0);
+    const core::Vector s = contact_bar::full_state(orbit, x, nodes);
+    const double dt = contact_bar::full_state_time_step(orbit, 2.9, nodes, 1.0 / 32);
+    for (int j : {n - 1, 2 * n - 1}) {  // u(L), v(L)
+      // a tenth of the monodromy's step (1e-6 of max |u0| = gap, times c / L for v)
+      const double h = 1e-7 * gap;
+      const auto map = [&](double d, core::Vector& f) {
+        core::Vector moved = s;
+        moved[j] += d;
+        return contact_bar::full_state_map(orbit, nodes, 2.9, dt, moved, f);
+      };
+      core::Vector f0, f_away, f_towards;
+      ASSERT_EQ(map(0, f0), core::EvalStatus::ok);
+      ASSERT_EQ(map(-side * h, f_away), core::EvalStatus::ok);
+      const core::Vector away = side * (f0 - f_away) / h;  // d map / d s_j on the free side
+      const double scale = away.lpNorm<Eigen::Infinity>();
+      if (j == n - 1) {
+        EXPECT_NE(map(side * h, f_towards), core::EvalStatus::ok) << side << ": not on the wall";
+      }
+      EXPECT_LE((M.col(j) - away).lpNorm<Eigen::Infinity>(), 1e-7 * scale)
+          << "side " << side << " column " << j;
+    }
+  }
+}
+
 }  // namespace
