@@ -26,10 +26,11 @@ std::string DimensionEvidence::text() const {
   for (Eigen::Index i = std::max<Eigen::Index>(0, report.rank - 3); i < n; ++i)
     s += fmt::format("  sigma_{:<3d} {:.6e}  {:.3e}  {}\n", i + 1, report.singular_values[i],
                      report.singular_values[i] / top, i < report.rank ? "kept" : "dropped");
-  s +=
-      fmt::format("probes (step {:g} scaled units, real when drift <= {:g}):\n", step, drift_ratio);
+  s += fmt::format("probes (step {:g} scaled units along +d, else -d; real when drift <= {:g}):\n",
+                   step, drift_ratio);
   for (std::size_t i = 0; i < probes.size(); ++i)
-    s += fmt::format("  direction {}: {}, residual {:.2e}, drift {:.3e}: {}\n", i + 1,
+    s += fmt::format("  direction {} ({}): {}, residual {:.2e}, drift {:.3e}: {}\n", i + 1,
+                     probes[i].side > 0 ? "+" : "-",
                      probes[i].converged ? "re-corrected" : "not re-corrected", probes[i].residual,
                      probes[i].drift, probes[i].real ? "neighbour found" : "no neighbour");
   s += fmt::format("{:.2f} s\n", seconds);
@@ -62,14 +63,16 @@ DimensionEvidence dimension_evidence(const core::Problem& problem, const core::V
       }
     }
   }
-  // The distances along the final (possibly rotated) basis: the probe verify ran, repeated.
-  for (Eigen::Index i = 0; i < e.report.null_directions.cols(); ++i) {
-    const core::Vector d = e.report.null_directions.col(i);
-    const core::Vector stepped = z + verify.step * d;
+  // The distances along the final (possibly rotated) basis: the probes verify ran, repeated, on
+  // the same sides: +d, then -d when +d finds no neighbour (at a point on the boundary of the
+  // solution set only one side holds solutions).
+  const auto probe = [&](const core::Vector& d, double side) {
+    const core::Vector stepped = z + side * verify.step * d;
     const core::BorderedSystem on_plane(scaled, {core::BorderRow::hyperplane(d, stepped)});
     core::Vector y = stepped;
     verifier->solve(on_plane, y);
     NullProbe p;
+    p.side = side;
     core::Vector f;
     if (y.allFinite() && scaled.residual(y, f) == core::EvalStatus::ok) {
       p.residual = f.lpNorm<Eigen::Infinity>();
@@ -77,6 +80,18 @@ DimensionEvidence dimension_evidence(const core::Problem& problem, const core::V
       p.drift = (y - stepped).norm() / verify.step;
     } else {
       p.residual = p.drift = std::nan("");
+    }
+    return p;
+  };
+  const auto found = [&](const NullProbe& p) {
+    return p.converged && p.drift <= verify.drift_ratio;
+  };
+  for (Eigen::Index i = 0; i < e.report.null_directions.cols(); ++i) {
+    const core::Vector d = e.report.null_directions.col(i);
+    NullProbe p = probe(d, 1);
+    if (!found(p)) {
+      NullProbe back = probe(d, -1);
+      if (found(back)) p = back;
     }
     p.real = e.report.direction_verified[static_cast<std::size_t>(i)];
     e.probes.push_back(p);

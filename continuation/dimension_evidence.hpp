@@ -23,6 +23,7 @@ struct NullProbe {
   double residual = 0;     // ||F||_inf there
   double drift = 0;        // |corrected - stepped| / step, scaled units (real if <= drift_ratio)
   bool real = false;       // verified: a neighbour exists along this direction
+  double side = 1;         // the side shown: +1, or -1 when +d found no neighbour
 };
 
 struct DimensionEvidence {
