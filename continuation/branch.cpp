@@ -50,6 +50,11 @@ std::string dimension_warning(const BranchPoint& p) {
           "probe along its tangent failed too (dimension_flag 2: not to be "
           "trusted)",
           p.dimension, candidates);
+    case DimensionFlag::inside:
+      return fmt::format(
+          "on the boundary of its solution set, where J is one side's: dimension {} verified at "
+          "a neighbour a probe step inside (dimension_flag 3)",
+          p.dimension);
   }
   return {};
 }

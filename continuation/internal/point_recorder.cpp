@@ -7,6 +7,7 @@
 
 #include "continuation/scaled_problem.hpp"
 #include "core/rank/rank_report.hpp"
+#include "core/solvers/bordered_system.hpp"
 #include "core/stability/floquet.hpp"
 
 namespace backbone::continuation {
@@ -50,6 +51,7 @@ void PointRecorder::check_rank(BranchPoint& point, const core::Vector& curve_dir
   }
   point.rank = std::move(report);
   recheck_dimension(point, curve_direction, nearby, previous);
+  recheck_inside(point);
 }
 
 void PointRecorder::verify_deferred(BranchPoint& point, const core::Vector& curve_direction,
@@ -59,6 +61,84 @@ void PointRecorder::verify_deferred(BranchPoint& point, const core::Vector& curv
                                nullptr, neighbour, known_residual(neighbour));
   point.dimension = point.rank->verified_dimension;
   recheck_dimension(point, curve_direction, nullptr, neighbour);
+  recheck_inside(point);
+}
+
+// The loops record points in scaled unknowns whose units may follow the point
+// (ScaledProblem::set_factor): the anchor is kept in the base problem's unknowns.
+core::Vector PointRecorder::to_unknowns(const core::Vector& x) const {
+  const auto* scaled = dynamic_cast<const ScaledProblem*>(&problem_);
+  return scaled ? scaled->to_unknowns(x) : x;
+}
+
+core::Vector PointRecorder::from_unknowns(const core::Vector& unknowns) const {
+  const auto* scaled = dynamic_cast<const ScaledProblem*>(&problem_);
+  return scaled ? scaled->to_scaled(unknowns) : unknowns;
+}
+
+void PointRecorder::set_anchor(const core::Vector& unknowns) {
+  const Boundary& boundary = options_.boundary;
+  anchor_.resize(0);
+  if (boundary.observable.empty() || unknowns.size() != problem_.num_unknowns()) return;
+  const core::Observables seen = problem_.observables(from_unknowns(unknowns));
+  if (core::observable_value(seen, boundary.observable) > boundary.within) anchor_ = unknowns;
+}
+
+void PointRecorder::recheck_inside(BranchPoint& point) {
+  const Boundary& boundary = options_.boundary;
+  if (!verifier_ || boundary.observable.empty() || !point.rank || point.dimension < 1) return;
+  const double at = point.observable(boundary.observable);
+  if (!(at <= boundary.within)) return;
+  const core::VerifyOptions& verify = options_.verification;
+  // The directions to probe: the chord towards the anchor, then the candidates.
+  const core::Matrix& D = point.rank->null_directions;
+  core::Matrix directions(point.x.size(), D.cols() + 1);
+  Eigen::Index count = 0;
+  if (anchor_.size() == point.x.size()) {
+    const core::Vector chord = from_unknowns(anchor_) - point.x;
+    if (chord.norm() > 0) directions.col(count++) = chord.normalized();
+  }
+  for (Eigen::Index i = 0; i < D.cols(); ++i) directions.col(count++) = D.col(i);
+  const core::Vector scale = problem_.typical_scale().cwiseAbs();
+  // The neighbour deepest inside: of every direction's probes on either side (the
+  // verification's, core/rank/probes.cpp: a step of `step` times the typical scale seen along
+  // d, re-corrected on the hyperplane through the stepped point), the one with the largest
+  // observable. A direction along the boundary moves it by round-off, one across it by the step.
+  core::Vector inside;
+  double deepest = at;
+  for (Eigen::Index i = 0; i < count; ++i)
+    for (const double side : {1.0, -1.0}) {
+      const core::Vector d = directions.col(i);
+      const double seen = d.cwiseProduct(scale).norm();
+      const double h = side * verify.step * (seen > 0 ? seen : 1.0);
+      const core::Vector stepped = point.x + h * d;
+      const core::BorderedSystem on_plane(problem_, {core::BorderRow::hyperplane(d, stepped)});
+      core::Vector y = stepped;
+      verifier_->solve(on_plane, y);
+      if (!y.allFinite() || !((y - stepped).norm() <= verify.drift_ratio * std::abs(h)) ||
+          !(residual_norm(y) <= verify.residual_tolerance))
+        continue;
+      const double value = core::observable_value(problem_.observables(y), boundary.observable);
+      if (value > deepest) {
+        deepest = value;
+        inside = y;
+      }
+    }
+  if (inside.size() == 0) return;
+  // J there is the solution set's own.
+  core::Matrix J;
+  if (problem_.jacobian(inside, J) != core::EvalStatus::ok) return;
+  core::RankOptions rank = options_.rank;
+  rank.full_spectrum = false;
+  core::RankReport there = core::rank_report(J, rank);
+  if (there.nullity <= point.dimension) return;
+  core::verify_null_directions(problem_, inside, *verifier_, verify, there,
+                               options_.chord_corrections ? &J : nullptr, &point.x, point.residual);
+  if (there.verified_dimension > point.dimension) {
+    point.dimension = there.verified_dimension;
+    point.rank = std::move(there);
+    point.dimension_flag = DimensionFlag::inside;
+  }
 }
 
 void PointRecorder::recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,
@@ -99,6 +179,7 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   p.index = index;
   p.x = x;
   p.observables = problem_.observables(x);
+  if (index == 0) set_anchor(to_unknowns(x));
   p.residual = residual_norm(x);
   p.newton_iterations = newton_iterations;
   p.step_size = ds;
@@ -136,9 +217,7 @@ double PointRecorder::known_residual(const core::Vector* x) const {
 void PointRecorder::add_floquet(BranchPoint& point) const {
   if (!options_.stability) return;
   // The point's unknowns in the base's units (the loops record points in scaled unknowns).
-  const auto* scaled = dynamic_cast<const ScaledProblem*>(&problem_);
-  const core::Vector x = scaled ? scaled->to_unknowns(point.x) : point.x;
-  point.floquet = core::floquet_at(counted_, x, options_.floquet);
+  point.floquet = core::floquet_at(counted_, to_unknowns(point.x), options_.floquet);
 }
 
 const Bound* PointRecorder::violated_bound(const BranchPoint& point, double& value) const {

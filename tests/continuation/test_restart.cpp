@@ -393,3 +393,66 @@ TEST(LoopState, MismatchIsNamed) {
   EXPECT_THROW(continuation::pseudo_arclength(unit_fold, state, false, *newton, opt),
                core::InputError);
 }
+
+namespace {
+
+// The half plane {z = 0, x >= 0} of R^3 as the zero set of F = (z, min(x, 0)), whose J on the
+// edge (x within 1e-12 of 0, as a march's decision within round-off) is the side without
+// solutions: there its null space is the edge alone. Observable "inside" = x.
+class HalfPlaneEdge : public core::Problem {
+ public:
+  int num_unknowns() const override { return 3; }
+  int num_equations() const override { return 2; }
+  core::Observables observables(const core::Vector& x) const override { return {{"inside", x[0]}}; }
+
+ protected:
+  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
+    r.resize(2);
+    r << x[2], std::min(x[0], 0.0);
+    return core::EvalStatus::ok;
+  }
+  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override {
+    J = core::Matrix::Zero(2, 3);
+    J(0, 2) = 1;
+    J(1, 0) = x[0] <= 1e-12 ? 1.0 : 0.0;
+    return core::EvalStatus::ok;
+  }
+};
+
+}  // namespace
+
+// A branch that reaches the edge of the half plane and slides along it: its rank checks there
+// verify the dimension a probe step inside, along the chord towards point 0 (flag inside: 2,
+// where J counts 1). A loop resumed on the edge takes point 0 from the files
+// (LoopState::first_point, filled by take_up) and records the same dimensions; without it the
+// count would be the edge's 1 (checked, so the case tests the plumbing).
+TEST(PseudoArclength, AResumeOnABoundaryVerifiesInsideAsTheUninterruptedRun) {
+  HalfPlaneEdge edge;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = options(16);
+  opt.rank_check_every = 1;
+  opt.verify = true;
+  opt.boundary = {"inside", 1e-3};
+  opt.branch_points.max_turn_degrees = 0;  // the branch turns onto the edge
+  const Branch full = continuation::pseudo_arclength(
+      edge, vec({1.0, 0.0, 0.0}), vec({-1.0, 1.0, 0.0}).normalized(), *newton, opt);
+  ASSERT_EQ(full.points.size(), 16u) << full.message;
+  const int k = 12;
+  ASSERT_LE(full.points[k].x[0], 1e-12) << "point 12 is not on the edge";
+  for (int i = k; i < 16; ++i) {
+    EXPECT_EQ(full.points[i].dimension, 2) << i;
+    EXPECT_EQ(full.points[i].dimension_flag, continuation::DimensionFlag::inside) << i;
+  }
+  LoopState state = through_text(full.points[k]);
+  LoopState without = state;
+  state.first_point = full.points.front().x;
+  const Branch rest = continuation::pseudo_arclength(edge, state, false, *newton, opt);
+  expect_same_tail(full, rest, k);
+  for (std::size_t i = 0; i < rest.points.size(); ++i) {
+    EXPECT_EQ(rest.points[i].dimension, 2) << i;
+    EXPECT_EQ(rest.points[i].dimension_flag, continuation::DimensionFlag::inside) << i;
+  }
+  const Branch alone = continuation::pseudo_arclength(edge, without, false, *newton, opt);
+  ASSERT_FALSE(alone.points.empty());
+  EXPECT_EQ(alone.points.front().dimension, 1);
+}
