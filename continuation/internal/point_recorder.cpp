@@ -100,17 +100,19 @@ void PointRecorder::recheck_inside(BranchPoint& point) {
   }
   for (Eigen::Index i = 0; i < D.cols(); ++i) directions.col(count++) = D.col(i);
   const core::Vector scale = problem_.typical_scale().cwiseAbs();
-  // The neighbour deepest inside: of every direction's probes on either side (the
-  // verification's, core/rank/probes.cpp: a step of `step` times the typical scale seen along
-  // d, re-corrected on the hyperplane through the stepped point), the one with the largest
-  // observable. A direction along the boundary moves it by round-off, one across it by the step.
+  // The neighbour deepest inside: of every direction's probes on either side (as the
+  // verification's, core/rank/probes.cpp, re-corrected on the hyperplane through the stepped
+  // point, with `reach` times its step, so that the verification's own probes from the neighbour
+  // stay inside), the one with the largest observable. A direction along the boundary moves it by
+  // round-off, one across it by the step.
+  constexpr double reach = 10;
   core::Vector inside;
   double deepest = at;
   for (Eigen::Index i = 0; i < count; ++i)
     for (const double side : {1.0, -1.0}) {
       const core::Vector d = directions.col(i);
       const double seen = d.cwiseProduct(scale).norm();
-      const double h = side * verify.step * (seen > 0 ? seen : 1.0);
+      const double h = side * reach * verify.step * (seen > 0 ? seen : 1.0);
       const core::Vector stepped = point.x + h * d;
       const core::BorderedSystem on_plane(problem_, {core::BorderRow::hyperplane(d, stepped)});
       core::Vector y = stepped;
