@@ -149,6 +149,40 @@ TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
   EXPECT_EQ(followed, 1);
 }
 
+// Along a followed family every rank check reads the law's dimension ceil(N/p) - 1, on its
+// faces too (min_slope 0 on an interval: J there is the outside's, orbits/README.md 'Attached
+// families: the law', verified a step inside with dimension_flag 3). Mode 1 at 40 intervals up
+// to 3e-5 J, every verified family followed for 21 points (rank checks at points 0, 10, 20);
+// the case holds face points (checked), where J alone reads 2 for 4 and 5 for 7.
+TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
+  const auto out = cli::scratch("modes_cli", "follow_dimension");
+  const int n = 40;
+  const cli::Run r = trace_paper(
+      "--branch mode1 --shooting_elements 40 --detect_branch_points true --ds 0.05 --ds_max 0.05 "
+      "--energy_max 3e-5 --follow all --follow_max_points 21",
+      out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Table points = Table::read_csv(out / "branch_points.csv");
+  const auto period = points.column("period"), verified = points.column("verified");
+  int on_faces = 0, followed = 0;
+  for (std::size_t i = 0; i < period.size(); ++i) {
+    if (verified[i] != 1) continue;
+    int p = 1;  // 2/T = p/q in lowest terms, p <= 60 (c = L = 1)
+    while (p < 60 && std::abs(period[i] * p / 2 - std::round(period[i] * p / 2)) > 1e-6) ++p;
+    const int law = (n + p - 1) / p - 1;
+    const Table b = Table::read_csv(out / ("branch_point_" + std::to_string(i + 1)) / "branch.csv");
+    const auto dimension = b.column("dimension"), slope = b.column("min_slope");
+    for (std::size_t k = 0; k < dimension.size(); ++k) {
+      if (dimension[k] < 0) continue;  // no rank check at this point
+      EXPECT_EQ(dimension[k], law) << "T " << period[i] << " point " << k;
+      if (slope[k] <= 1e-9) ++on_faces;
+    }
+    ++followed;
+  }
+  EXPECT_GE(followed, 2);
+  EXPECT_GE(on_faces, 2) << "no rank check on a face: the case tests nothing";
+}
+
 // The law on modes 2 and 3 (orbits/README.md, 'Attached families: the law'): mode J's branch
 // points lie at T = 2q/p with strain s = g0 p / (2 J^2 q - (2J + 1) p) and kinks at multiples
 // of L/p; a grid of N intervals with p | 2N whose knots' reference nodes sit on the kinks
