@@ -53,7 +53,7 @@ std::string dimension_warning(const BranchPoint& p) {
     case DimensionFlag::inside:
       return fmt::format(
           "on the boundary of its solution set, where J is one side's: dimension {} verified at "
-          "a neighbour a probe step inside (dimension_flag 3)",
+          "a neighbour just inside (dimension_flag 3)",
           p.dimension);
   }
   return {};

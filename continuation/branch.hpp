@@ -44,7 +44,7 @@ enum class DimensionFlag {
   unconfirmed = 2,  // below 1 and the tangent probe failed too: dimension as verified (0), not
                     // to be trusted
   inside = 3,       // on the boundary of its solution set (ContinuationOptions::boundary), where
-                    // J is one side's: the dimension verified at a neighbour a probe step inside
+                    // J is one side's: the dimension verified at a neighbour just inside
 };
 
 struct BranchPoint {

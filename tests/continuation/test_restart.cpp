@@ -394,40 +394,14 @@ TEST(LoopState, MismatchIsNamed) {
                core::InputError);
 }
 
-namespace {
-
-// The half plane {z = 0, x >= 0} of R^3 as the zero set of F = (z, min(x, 0)), whose J on the
-// edge (x within 1e-12 of 0, as a march's decision within round-off) is the side without
-// solutions: there its null space is the edge alone. Observable "inside" = x.
-class HalfPlaneEdge : public core::Problem {
- public:
-  int num_unknowns() const override { return 3; }
-  int num_equations() const override { return 2; }
-  core::Observables observables(const core::Vector& x) const override { return {{"inside", x[0]}}; }
-
- protected:
-  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
-    r.resize(2);
-    r << x[2], std::min(x[0], 0.0);
-    return core::EvalStatus::ok;
-  }
-  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override {
-    J = core::Matrix::Zero(2, 3);
-    J(0, 2) = 1;
-    J(1, 0) = x[0] <= 1e-12 ? 1.0 : 0.0;
-    return core::EvalStatus::ok;
-  }
-};
-
-}  // namespace
-
-// A branch that reaches the edge of the half plane and slides along it: its rank checks there
-// verify the dimension a probe step inside, along the chord towards point 0 (flag inside: 2,
+// A branch that reaches the edge of the half plane (test_support.hpp, J on its edge the
+// outside's) and slides along it: its rank checks there
+// verify the dimension just inside, along the chord towards point 0 (flag inside: 2,
 // where J counts 1). A loop resumed on the edge takes point 0 from the files
 // (LoopState::first_point, filled by take_up) and records the same dimensions; without it the
 // count would be the edge's 1 (checked, so the case tests the plumbing).
 TEST(PseudoArclength, AResumeOnABoundaryVerifiesInsideAsTheUninterruptedRun) {
-  HalfPlaneEdge edge;
+  const continuation_tests::HalfPlane edge;  // J on the edge is the outside's
   auto newton = core::make_corrector("eigen", core::NewtonOptions{});
   auto opt = options(16);
   opt.rank_check_every = 1;

@@ -7,6 +7,7 @@
 
 #include "continuation/internal/point_recorder.hpp"
 #include "core/rank/rank_report.hpp"
+#include "tests/continuation/test_support.hpp"
 
 using namespace backbone;
 
@@ -98,41 +99,14 @@ TEST(PointRecorder, DimensionZeroOnACurveIsRecheckedAlongTheTangent) {
   EXPECT_TRUE(continuation::dimension_warning(s).empty());
 }
 
-namespace {
-
-// The half plane {z = 0, x >= 0} of R^3 as the zero set of F = (z, min(x, 0)), with J on its
-// edge x = 0 from the side without solutions (d/dx of the second row 1): there J's null space
-// is the y axis alone, the edge, though the set is two-dimensional up to it. Observable
-// "inside" = x, 0 on the edge (the boundary observable of ContinuationOptions::boundary).
-class HalfPlaneWithOutsideJacobian : public core::Problem {
- public:
-  int num_unknowns() const override { return 3; }
-  int num_equations() const override { return 2; }
-  core::Observables observables(const core::Vector& x) const override { return {{"inside", x[0]}}; }
-
- protected:
-  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
-    r.resize(2);
-    r << x[2], std::min(x[0], 0.0);
-    return core::EvalStatus::ok;
-  }
-  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override {
-    J = core::Matrix::Zero(2, 3);
-    J(0, 2) = 1;
-    J(1, 0) = x[0] <= 0 ? 1.0 : 0.0;
-    return core::EvalStatus::ok;
-  }
-};
-
-}  // namespace
-
-// On the edge of the half plane J counts 1 (the edge). With the boundary observable the point's
-// dimension is verified at a neighbour a probe step inside, found along the chord towards the
+// On the edge of the half plane (tests/continuation/test_support.hpp, J on its edge the
+// outside's) J counts 1 (the edge). With the boundary observable the point's
+// dimension is verified at a neighbour just inside, found along the chord towards the
 // branch's point 0 (the anchor, x = 1): 2, the half plane's, flagged inside. The edge's own
 // candidate runs along the edge and finds no neighbour inside, so without the anchor the count
 // stays 1; without a boundary observable nothing is re-checked.
 TEST(PointRecorder, OnTheBoundaryOfItsSetTheDimensionIsVerifiedInside) {
-  const HalfPlaneWithOutsideJacobian half_plane;
+  const continuation_tests::HalfPlane half_plane;  // J on the edge is the outside's
   const core::Vector anchor = unit(0), edge = 0.3 * unit(1);
   continuation::ContinuationOptions options;
   options.boundary = {"inside", 1e-3};

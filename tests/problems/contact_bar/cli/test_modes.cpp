@@ -151,7 +151,7 @@ TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
 
 // Along a followed family every rank check reads the law's dimension ceil(N/p) - 1, on its
 // faces too (min_slope 0 on an interval: J there is the outside's, orbits/README.md 'Attached
-// families: the law', verified a step inside with dimension_flag 3). Mode 1 at 40 intervals up
+// families: the law', verified just inside with dimension_flag 3). Mode 1 at 40 intervals up
 // to 3e-5 J, every verified family followed for 21 points (rank checks at points 0, 10, 20);
 // the case holds face points (checked), where J alone reads 2 for 4 and 5 for 7.
 TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {

@@ -7,6 +7,7 @@
 #include "problems/algebraic/algebraic.hpp"
 #include "problems/contact_bar/orbits/periodic_bar.hpp"
 #include "problems/contact_bar/solver/tdbem.hpp"
+#include "tests/continuation/test_support.hpp"
 
 namespace backbone::contact_bar {
 using continuation::dimension_evidence;
@@ -31,39 +32,16 @@ TEST(DimensionEvidence, SphereIsTwoDimensional) {
     EXPECT_NE(text.find(word), std::string::npos) << word << "\n" << text;
 }
 
-// The half plane {z = 0, side x >= 0} of R^3, F = (z, min(side x, 0)), with J at x = 0 from
-// the solutions' side (d/dx of the second row 0): at the origin the candidates are the x and y
-// axes in the SVD's basis, and a direction whose x component points out of the half plane finds
-// its neighbour only on its -d side. The report shows each probe on the side the verification
-// found (every "neighbour found" a re-corrected probe within the drift ratio), whichever sign
-// the SVD gives: both half planes are checked, so one of them has a direction pointing out.
-class HalfPlane : public core::Problem {
- public:
-  explicit HalfPlane(double side) : side_(side) {}
-  int num_unknowns() const override { return 3; }
-  int num_equations() const override { return 2; }
-
- protected:
-  core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override {
-    r.resize(2);
-    r << x[2], std::min(side_ * x[0], 0.0);
-    return core::EvalStatus::ok;
-  }
-  core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override {
-    J = core::Matrix::Zero(2, 3);
-    J(0, 2) = 1;
-    J(1, 0) = side_ * x[0] < 0 ? side_ : 0.0;
-    return core::EvalStatus::ok;
-  }
-
- private:
-  double side_;
-};
-
+// The half plane {z = 0, side x >= 0} of R^3 (tests/continuation/test_support.hpp) with J on its
+// edge from the solutions' side: at the origin the candidates are the x and y axes in the SVD's
+// basis, and a direction whose x component points out of the half plane finds its neighbour
+// only on its -d side. The report shows each probe on the side the verification found (every
+// "neighbour found" a re-corrected probe within the drift ratio), whichever sign the SVD gives:
+// both half planes are checked, so one of them has a direction pointing out.
 TEST(DimensionEvidence, OnTheEdgeOfAHalfPlaneEachProbeIsShownOnItsSide) {
   int minus_sides = 0;
   for (const double side : {1.0, -1.0}) {
-    const HalfPlane half_plane(side);
+    const backbone::continuation_tests::HalfPlane half_plane(side, false);
     const DimensionEvidence e = dimension_evidence(half_plane, core::Vector::Zero(3),
                                                    core::RankOptions{}, core::VerifyOptions{});
     EXPECT_EQ(e.report.verified_dimension, 2) << e.text();
