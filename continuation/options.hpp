@@ -32,9 +32,13 @@ namespace backbone::continuation {
 // beyond which no solution exists or F cannot be evaluated). A branch that ends with step_floor
 // or evaluation_failed at a point where the observable is at most `within` has reached that
 // boundary: it ends with StopReason::boundary_reached, a planned end. Empty observable: none.
+// With verify_inside (the followed families, branch_points/follow.hpp: each is traced whole from
+// its point 0, never resumed), a rank check at such a point verifies the dimension just inside
+// (internal/point_recorder.hpp, recheck_inside; DimensionFlag::inside).
 struct Boundary {
   std::string observable;
   double within = 0;
+  bool verify_inside = false;
 };
 
 // natural_then_arclength: natural until it stalls, then pseudo-arclength (switching.hpp).

@@ -273,7 +273,6 @@ RestartPoint restart_point(const std::filesystem::path& dir, int point,
   r.arclength = arclength[i];
   if (r.index > 0) {
     r.previous_x = read_unknowns(dir / "unknowns.csv", r.index - 1, key);
-    if (index.front() == 0) r.first_x = read_unknowns(dir / "unknowns.csv", 0, key);
     r.secant = r.x - r.previous_x;
     const auto before = std::find(index.begin(), index.end(), wanted - 1);
     if (before != index.end())
@@ -332,7 +331,6 @@ void take_up(RestartPoint& restart, const std::string& key, int direction,
     known->known_points = {
         {restart.index - 1, restart.previous_arclength, problem.observables(restart.previous_x)},
         {restart.index, restart.arclength, problem.observables(restart.x)}};
-    if (restart.first_x.size() == restart.x.size()) known->first_point = restart.first_x;
     restart.state = known;
   }
   if (restart.state && direction < 0) {

@@ -79,10 +79,6 @@ struct LoopState {
   // resumed loop looks back on where an uninterrupted one has its last two points (the chord
   // that aims a step at a bound ahead, LoopSteps::bound_within). Filled by take_up.
   std::vector<KnownPoint> known_points;
-  // Not in the text form either: the branch's point 0 as the files hold them (the problem's
-  // unknowns; empty: unknown), the point inside its family that a rank check on the family's
-  // boundary probes towards (point_recorder.hpp, recheck_inside). Filled by take_up.
-  core::Vector first_point;
 
   core::Vector unknowns() const { return z.cwiseProduct(scale); }
 };
@@ -111,7 +107,6 @@ struct RestartPoint {
   std::string note;         // why the state was not used (take_up), empty otherwise
   core::Vector previous_x;  // the point before (empty at point 0) and its arclength
   double previous_arclength = 0;
-  core::Vector first_x;  // the branch's point 0 (empty at point 0, or when the files lack it)
   // Corrections refused on the saved branch up to the point: its state's count, else that of
   // the last state saved before it (0 without one); BranchStart::rejected_corrections of a
   // restart without a state.

@@ -90,6 +90,8 @@ FollowedBranch follow_attached(const core::Problem& problem, const BranchPointRe
   // The followed family's first tangent comes from the Jacobian at its start (nearest the probe's
   // secant), whatever the traced branch's own first step did.
   o.start_along_direction = false;
+  // A family of several dimensions is often followed along a face, where J is one side's.
+  o.boundary.verify_inside = true;
   if (o.branch_points.max_turn_degrees > 0)
     o.branch_points.max_turn_degrees =
         std::max(o.branch_points.max_turn_degrees, follow_max_turn_degrees);

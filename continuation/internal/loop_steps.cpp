@@ -101,7 +101,6 @@ void LoopSteps::resume(const LoopState& state, bool record) {
   switch_index_ = state.switch_index;
   rejected_ = state.rejected_corrections;
   known_points_ = state.known_points;
-  if (state.first_point.size() == state.z.size()) recorder_.set_anchor(state.first_point);
   if (!record) {
     ++first_index_;
     return;

@@ -76,17 +76,11 @@ core::Vector PointRecorder::from_unknowns(const core::Vector& unknowns) const {
   return scaled ? scaled->to_scaled(unknowns) : unknowns;
 }
 
-void PointRecorder::set_anchor(const core::Vector& unknowns) {
-  const Boundary& boundary = options_.boundary;
-  anchor_.resize(0);
-  if (boundary.observable.empty() || unknowns.size() != problem_.num_unknowns()) return;
-  const core::Observables seen = problem_.observables(from_unknowns(unknowns));
-  if (core::observable_value(seen, boundary.observable) > boundary.within) anchor_ = unknowns;
-}
-
 void PointRecorder::recheck_inside(BranchPoint& point) {
   const Boundary& boundary = options_.boundary;
-  if (!verifier_ || boundary.observable.empty() || !point.rank || point.dimension < 1) return;
+  if (!verifier_ || !boundary.verify_inside || boundary.observable.empty() || !point.rank ||
+      point.dimension < 1)
+    return;
   const double at = point.observable(boundary.observable);
   if (!(at <= boundary.within)) return;
   const core::VerifyOptions& verify = options_.verification;
@@ -181,7 +175,10 @@ BranchPoint PointRecorder::finish(const core::Vector& x, int index, int newton_i
   p.index = index;
   p.x = x;
   p.observables = problem_.observables(x);
-  if (index == 0) set_anchor(to_unknowns(x));
+  // The branch's point 0, inside its solution set: the anchor of recheck_inside.
+  if (index == 0 && options_.boundary.verify_inside &&
+      p.observable(options_.boundary.observable) > options_.boundary.within)
+    anchor_ = to_unknowns(x);
   p.residual = residual_norm(x);
   p.newton_iterations = newton_iterations;
   p.step_size = ds;

@@ -62,18 +62,16 @@ class PointRecorder {
   void recheck_dimension(BranchPoint& point, const core::Vector& curve_direction,
                          const core::Matrix* jacobian = nullptr,
                          const core::Vector* previous = nullptr);
-  // At a point on the boundary of its solution set (options.boundary's observable at most
-  // `within`) F may not be differentiable, and J is one side's: its nullity can miss the
-  // directions across the boundary. With a verifier, the chord towards the anchor and the point's
+  // With options.boundary.verify_inside, at a point on the boundary of its solution set (the
+  // boundary observable at most `within`) F may not be differentiable, and J is one side's: its
+  // nullity can miss the directions across the boundary. With a verifier, the chord towards the
+  // anchor (the branch's point 0 when it is inside: a boundary whose candidates all run along it,
+  // a face of a family of several dimensions, is crossed by that chord) and the point's
   // candidates are probed on either side; the neighbour that re-corrects with the largest
-  // observable (above the point's) is inside, and its verified dimension replaces the point's
-  // when larger (flag inside). Nothing happens elsewhere.
+  // observable (above the point's) is inside, and its rank report, verified, replaces the
+  // point's when its dimension is larger (flag inside: nullity and singular values are then the
+  // neighbour's). Nothing happens elsewhere.
   void recheck_inside(BranchPoint& point);
-  // A point of the same solution set inside it (its boundary observable above `within`), in the
-  // base problem's unknowns: the branch's point 0, which finish() takes as it records it, or a
-  // resumed run's (restart.hpp, LoopState::first_point). A boundary whose candidates all run
-  // along it (a face of a family of several dimensions) is crossed by the chord towards it.
-  void set_anchor(const core::Vector& unknowns);
   // The point's multipliers (BranchPoint::floquet) when the problem is a core::FloquetProblem
   // and options.stability holds.
   void add_floquet(BranchPoint& point) const;
@@ -100,7 +98,7 @@ class PointRecorder {
   std::unique_ptr<core::Corrector> verifier_;  // eigen: handles non-square constrained systems
   std::chrono::steady_clock::time_point start_;
   long residuals_at_start_ = 0, jacobians_at_start_ = 0;
-  core::Vector anchor_;  // set_anchor's point (base unknowns), empty when not inside
+  core::Vector anchor_;  // point 0 in the base unknowns when inside, else empty
   core::Vector last_x_;  // the last recorded point and its residual norm
   double last_residual_ = std::numeric_limits<double>::quiet_NaN();
 };

@@ -100,16 +100,16 @@ TEST(PointRecorder, DimensionZeroOnACurveIsRecheckedAlongTheTangent) {
 }
 
 // On the edge of the half plane (tests/continuation/test_support.hpp, J on its edge the
-// outside's) J counts 1 (the edge). With the boundary observable the point's
-// dimension is verified at a neighbour just inside, found along the chord towards the
-// branch's point 0 (the anchor, x = 1): 2, the half plane's, flagged inside. The edge's own
-// candidate runs along the edge and finds no neighbour inside, so without the anchor the count
-// stays 1; without a boundary observable nothing is re-checked.
+// outside's) J counts 1 (the edge). With the boundary observable and verify_inside (the
+// follows' setting) the point's dimension is verified at a neighbour just inside, found along
+// the chord towards the branch's point 0 (the anchor, x = 1): 2, the half plane's, flagged
+// inside. The edge's own candidate runs along the edge and finds no neighbour inside, so without
+// point 0 the count stays 1; without verify_inside nothing is re-checked.
 TEST(PointRecorder, OnTheBoundaryOfItsSetTheDimensionIsVerifiedInside) {
   const continuation_tests::HalfPlane half_plane;  // J on the edge is the outside's
   const core::Vector anchor = unit(0), edge = 0.3 * unit(1);
   continuation::ContinuationOptions options;
-  options.boundary = {"inside", 1e-3};
+  options.boundary = {"inside", 1e-3, true};
 
   continuation::PointRecorder recorder(half_plane, options);
   const continuation::BranchPoint first = recorder.finish(anchor, 0, 0, 0.0, 0.0, true);
@@ -125,8 +125,9 @@ TEST(PointRecorder, OnTheBoundaryOfItsSetTheDimensionIsVerifiedInside) {
   EXPECT_EQ(alone.dimension, 1);
   EXPECT_EQ(alone.dimension_flag, continuation::DimensionFlag::as_verified);
 
-  continuation::ContinuationOptions no_boundary;
-  continuation::PointRecorder unbounded(half_plane, no_boundary);
-  unbounded.finish(anchor, 0, 0, 0.0, 0.0, true);
-  EXPECT_EQ(unbounded.finish(edge, 7, 0, 0.1, 1.0, true).dimension, 1);
+  continuation::ContinuationOptions only_boundary;
+  only_boundary.boundary = {"inside", 1e-3, false};
+  continuation::PointRecorder unchecked(half_plane, only_boundary);
+  unchecked.finish(anchor, 0, 0, 0.0, 0.0, true);
+  EXPECT_EQ(unchecked.finish(edge, 7, 0, 0.1, 1.0, true).dimension, 1);
 }

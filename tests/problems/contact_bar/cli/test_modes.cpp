@@ -153,7 +153,7 @@ TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
 // faces too (min_slope 0 on an interval: J there is the outside's, orbits/README.md 'Attached
 // families: the law', verified just inside with dimension_flag 3). Mode 1 at 40 intervals up
 // to 3e-5 J, every verified family followed for 21 points (rank checks at points 0, 10, 20);
-// the case holds face points (checked), where J alone reads 2 for 4 and 5 for 7.
+// the case holds such points (checked), where J alone reads 2 for 4 and 5 for 7.
 TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
   const auto out = cli::scratch("modes_cli", "follow_dimension");
   const int n = 40;
@@ -164,23 +164,24 @@ TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
   ASSERT_EQ(r.code, 0) << r.err;
   const Table points = Table::read_csv(out / "branch_points.csv");
   const auto period = points.column("period"), verified = points.column("verified");
-  int on_faces = 0, followed = 0;
+  int inside = 0, followed = 0;
   for (std::size_t i = 0; i < period.size(); ++i) {
     if (verified[i] != 1) continue;
-    int p = 1;  // 2/T = p/q in lowest terms, p <= 60 (c = L = 1)
-    while (p < 60 && std::abs(period[i] * p / 2 - std::round(period[i] * p / 2)) > 1e-6) ++p;
+    int p = 1;  // 2/T = p/q in lowest terms (c = L = 1)
+    while (p <= 60 && std::abs(period[i] * p / 2 - std::round(period[i] * p / 2)) > 1e-6) ++p;
+    ASSERT_LE(p, 60) << "T " << period[i] << " is no 2q/p with p <= 60";
     const int law = (n + p - 1) / p - 1;
     const Table b = Table::read_csv(out / ("branch_point_" + std::to_string(i + 1)) / "branch.csv");
-    const auto dimension = b.column("dimension"), slope = b.column("min_slope");
+    const auto dimension = b.column("dimension"), flag = b.column("dimension_flag");
     for (std::size_t k = 0; k < dimension.size(); ++k) {
       if (dimension[k] < 0) continue;  // no rank check at this point
       EXPECT_EQ(dimension[k], law) << "T " << period[i] << " point " << k;
-      if (slope[k] <= 1e-9) ++on_faces;
+      if (flag[k] == 3) ++inside;
     }
     ++followed;
   }
   EXPECT_GE(followed, 2);
-  EXPECT_GE(on_faces, 2) << "no rank check on a face: the case tests nothing";
+  EXPECT_GE(inside, 2) << "no rank check verified inside: the case tests nothing";
 }
 
 // The law on modes 2 and 3 (orbits/README.md, 'Attached families: the law'): mode J's branch
