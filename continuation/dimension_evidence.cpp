@@ -5,7 +5,6 @@
 #include <chrono>
 
 #include "continuation/scaled_problem.hpp"
-#include "core/solvers/bordered_system.hpp"
 
 namespace backbone::continuation {
 
@@ -66,33 +65,21 @@ DimensionEvidence dimension_evidence(const core::Problem& problem, const core::V
   // The distances along the final (possibly rotated) basis: the probes verify ran, repeated, on
   // the same sides: +d, then -d when +d finds no neighbour (at a point on the boundary of the
   // solution set only one side holds solutions).
-  const auto probe = [&](const core::Vector& d, double side) {
-    const core::Vector stepped = z + side * verify.step * d;
-    const core::BorderedSystem on_plane(scaled, {core::BorderRow::hyperplane(d, stepped)});
-    core::Vector y = stepped;
-    verifier->solve(on_plane, y);
-    NullProbe p;
-    p.side = side;
-    core::Vector f;
-    if (y.allFinite() && scaled.residual(y, f) == core::EvalStatus::ok) {
-      p.residual = f.lpNorm<Eigen::Infinity>();
-      p.converged = p.residual <= verify.residual_tolerance;
-      p.drift = (y - stepped).norm() / verify.step;
-    } else {
-      p.residual = p.drift = std::nan("");
-    }
-    return p;
-  };
-  const auto found = [&](const NullProbe& p) {
-    return p.converged && p.drift <= verify.drift_ratio;
-  };
   for (Eigen::Index i = 0; i < e.report.null_directions.cols(); ++i) {
     const core::Vector d = e.report.null_directions.col(i);
-    NullProbe p = probe(d, 1);
-    if (!found(p)) {
-      NullProbe back = probe(d, -1);
-      if (found(back)) p = back;
+    core::NeighbourProbe found =
+        core::probe_neighbour(scaled, z, d, verify.step, *verifier, verify);
+    double side = 1;
+    if (!found.found) {
+      core::NeighbourProbe back =
+          core::probe_neighbour(scaled, z, d, -verify.step, *verifier, verify);
+      if (back.found) found = back, side = -1;
     }
+    NullProbe p;
+    p.converged = found.converged;
+    p.residual = found.residual;
+    p.drift = found.drift;
+    p.side = side;
     p.real = e.report.direction_verified[static_cast<std::size_t>(i)];
     e.probes.push_back(p);
   }

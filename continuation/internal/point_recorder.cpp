@@ -7,7 +7,6 @@
 
 #include "continuation/scaled_problem.hpp"
 #include "core/rank/rank_report.hpp"
-#include "core/solvers/bordered_system.hpp"
 #include "core/stability/floquet.hpp"
 
 namespace backbone::continuation {
@@ -94,32 +93,29 @@ void PointRecorder::recheck_inside(BranchPoint& point) {
   }
   for (Eigen::Index i = 0; i < D.cols(); ++i) directions.col(count++) = D.col(i);
   const core::Vector scale = problem_.typical_scale().cwiseAbs();
-  // The neighbour deepest inside: of every direction's probes on either side (as the
-  // verification's, core/rank/probes.cpp, re-corrected on the hyperplane through the stepped
-  // point, with `reach` times its step, so that the verification's own probes from the neighbour
-  // stay inside), the one with the largest observable. A direction along the boundary moves it by
-  // round-off, one across it by the step.
+  // The neighbour deepest inside: of every direction's verification probes on either side
+  // (core::probe_neighbour, `reach` times the verification's step along d, so that the
+  // verification's own probes from the neighbour stay inside), the one with the largest
+  // observable. A direction along the boundary moves it by round-off, one across it by the step.
   constexpr double reach = 10;
   core::Vector inside;
   double deepest = at;
-  for (Eigen::Index i = 0; i < count; ++i)
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const core::Vector d = directions.col(i);
+    const double seen = d.cwiseProduct(scale).norm();
     for (const double side : {1.0, -1.0}) {
-      const core::Vector d = directions.col(i);
-      const double seen = d.cwiseProduct(scale).norm();
-      const double h = side * reach * verify.step * (seen > 0 ? seen : 1.0);
-      const core::Vector stepped = point.x + h * d;
-      const core::BorderedSystem on_plane(problem_, {core::BorderRow::hyperplane(d, stepped)});
-      core::Vector y = stepped;
-      verifier_->solve(on_plane, y);
-      if (!y.allFinite() || !((y - stepped).norm() <= verify.drift_ratio * std::abs(h)) ||
-          !(residual_norm(y) <= verify.residual_tolerance))
-        continue;
-      const double value = core::observable_value(problem_.observables(y), boundary.observable);
+      const core::NeighbourProbe p = core::probe_neighbour(
+          problem_, point.x, d, side * reach * verify.step * (seen > 0 ? seen : 1.0), *verifier_,
+          verify);
+      if (!p.found) continue;
+      const double value =
+          core::observable_value(problem_.observables(p.point), boundary.observable);
       if (value > deepest) {
         deepest = value;
-        inside = y;
+        inside = p.point;
       }
     }
+  }
   if (inside.size() == 0) return;
   // J there is the solution set's own.
   core::Matrix J;

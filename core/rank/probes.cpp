@@ -54,8 +54,10 @@ namespace {
 
 struct Probe {
   bool converged = false;
-  Vector secant;                                           // (corrected point - x) / h
-  double drift = std::numeric_limits<double>::infinity();  // |corrected - stepped| / h
+  Vector secant;                                               // (corrected point - x) / h
+  double drift = std::numeric_limits<double>::infinity();      // |corrected - stepped| / h
+  double residual = std::numeric_limits<double>::quiet_NaN();  // ||F||_inf there
+  Vector point;                                                // the corrected point
 };
 
 // The probe's constrained system, whose Jacobian is refused (EvalStatus::failed, which ends
@@ -122,12 +124,14 @@ Probe probe(const Problem& problem, const Vector& x, const Vector& d, double h,
       chord ? corrector.solve(constrained, y, nearby) : corrector.solve(constrained, y);
   if (chord) start.record(s);
   if (!y.allFinite()) return result;
+  result.point = y;
   Vector f;
   // Judge the corrected point by F itself (the corrector's own tolerance may be looser).
   if (problem.residual(y, f) != EvalStatus::ok) return result;
+  result.residual = f.lpNorm<Eigen::Infinity>();
   result.converged =
       (s.converged() || s.status == NewtonStatus::stalled) &&
-      f.lpNorm<Eigen::Infinity>() <= options.residual_tolerance &&
+      result.residual <= options.residual_tolerance &&
       std::abs(d.dot(y - stepped)) <= options.residual_tolerance + 1e-12 * std::abs(h);
   result.secant = (y - x) / h;
   result.drift = (y - stepped).norm() / std::abs(h);
@@ -259,6 +263,19 @@ Matrix passed_then_rotated(const Matrix& D, const std::vector<Probe>& first,
 }
 
 }  // namespace
+
+NeighbourProbe probe_neighbour(const Problem& problem, const Vector& x, const Vector& d, double h,
+                               Corrector& corrector, const VerifyOptions& options) {
+  ChordStart fresh;
+  const Probe p = probe(problem, x, d, h, corrector, options, fresh);
+  NeighbourProbe out;
+  out.converged = p.converged;
+  out.found = found_neighbour(p, options);
+  out.residual = p.residual;
+  out.drift = p.drift;
+  out.point = p.point;
+  return out;
+}
 
 void verify_null_directions(const Problem& problem, const Vector& x, Corrector& corrector,
                             const VerifyOptions& options, RankReport& report,

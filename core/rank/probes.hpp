@@ -59,6 +59,20 @@ struct VerifyOptions {
 // differences) then decide where the probe lands (core/README.md, 'Rank reports').
 std::unique_ptr<Corrector> make_verifier(const VerifyOptions& options, const RankOptions& rank);
 
+// One probe of the verification from x (as verify_null_directions runs it for a direction): a
+// step of h along d, re-corrected on the hyperplane through the stepped point, its Jacobians
+// refused beyond |h| / drift_ratio of x. found: converged (F within residual_tolerance, on the
+// hyperplane) within drift_ratio |h| of the stepped point.
+struct NeighbourProbe {
+  bool converged = false;
+  bool found = false;
+  double residual = std::numeric_limits<double>::quiet_NaN();  // ||F||_inf at the end
+  double drift = std::numeric_limits<double>::infinity();      // |end - stepped| / |h|
+  Vector point;  // the corrected point (empty when not finite)
+};
+NeighbourProbe probe_neighbour(const Problem& problem, const Vector& x, const Vector& d, double h,
+                               Corrector& corrector, const VerifyOptions& options);
+
 // Fills verified_dimension and direction_verified. Evaluates the problem; never throws on
 // numerical failure (a direction that fails to re-correct is simply not verified).
 // Each direction d is probed at +h, and at -h when +h finds no neighbour: at a point on the
