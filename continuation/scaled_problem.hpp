@@ -70,6 +70,7 @@ class ScaledProblem : public core::Problem {
   int num_equations() const override { return base_.num_equations(); }
   std::string name() const override { return base_.name(); }
   std::string jacobian_description() const override { return base_.jacobian_description(); }
+  bool jacobian_exact() const override { return base_.jacobian_exact(); }
   core::Observables observables(const core::Vector& z) const override {
     return base_.observables(to_unknowns(z));
   }

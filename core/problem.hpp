@@ -131,6 +131,10 @@ class Problem {
   // Where compute_jacobian's matrix comes from, for the reports (the trace's header and
   // summary.txt's `jacobian`): "differences" (the default's), or the override's own words.
   virtual std::string jacobian_description() const { return "differences"; }
+  // Whether compute_jacobian's matrix is the derivative to round-off (analytic or an exact
+  // tangent), not a difference quotient or an integration's: the branch-point location then
+  // runs its test function down to round-off (continuation/README.md, 'Branch points').
+  virtual bool jacobian_exact() const { return false; }
 
   const EvaluationCounters& counters() const { return counters_; }
   void reset_counters() const { counters_.reset(); }

@@ -91,8 +91,8 @@ core::Vector SecantUpdates::step(const Chord& chord, const core::Vector& w,
 }  // namespace
 
 bool Locator::chord_correct(const Chord& chord, const core::Vector& normal,
-                            const core::Vector& anchor, core::Vector& y,
-                            const core::Matrix* kinks) const {
+                            const core::Vector& anchor, core::Vector& y, const core::Matrix* kinks,
+                            bool polish) const {
   const core::Matrix& J = chord.jacobian;
   const core::Matrix& N = chord.null_space;
   const core::Vector w = N.transpose() * normal;
@@ -106,13 +106,30 @@ bool Locator::chord_correct(const Chord& chord, const core::Vector& normal,
   core::Vector best = y;
   double best_norm = std::numeric_limits<double>::infinity();
   int without_progress = 0;
+  // Polishing: the converged iterate with the smallest residual, and the last norm.
+  bool converged = false;
+  core::Vector polished;
+  double polished_norm = std::numeric_limits<double>::infinity();
   core::Vector r_previous, dx;
   for (int iteration = 0; iteration < 30; ++iteration) {
     core::Vector r;
     if (problem_.residual(y.cwiseQuotient(f), r) != core::EvalStatus::ok) break;
     const double plane = normal.dot(y - anchor);
-    if (r.lpNorm<Eigen::Infinity>() <= tolerance && std::abs(plane) <= tolerance) return true;
+    const bool within = r.lpNorm<Eigen::Infinity>() <= tolerance && std::abs(plane) <= tolerance;
+    if (within && !polish) return true;
     if (rf.size() > 0) r = r.cwiseProduct(rf);
+    if (within) {
+      // Past the tolerance, steps go on while each cuts the residual tenfold.
+      const double norm = r.norm();
+      if (converged && !(norm <= 0.1 * polished_norm)) break;
+      if (norm < polished_norm) {
+        polished = y;
+        polished_norm = norm;
+      }
+      converged = true;
+    } else if (converged) {
+      break;
+    }
     // Linear convergence or none: two steps in a row that do not shrink the smallest residual
     // by 0.7 end it (the first step on a crossed piece does not; the update after it does).
     const double norm = r.norm();
@@ -138,8 +155,8 @@ bool Locator::chord_correct(const Chord& chord, const core::Vector& normal,
     y += dx;
     if (!y.allFinite()) break;
   }
-  y = best;
-  return false;
+  y = converged ? polished : best;
+  return converged;
 }
 
 bool Locator::difference_kinks(const Chord& chord, const core::Matrix& kinks, const core::Vector& y,

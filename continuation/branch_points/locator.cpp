@@ -86,7 +86,10 @@ Evaluation Locator::evaluate(const std::vector<Sample>& polyline, double s,
     }
   }
   if (!chord) chord = last ? &chord_of(*last) : initial;
-  if (!chord || !chord_correct(*chord, normal, through, e.z)) {
+  // With an exact Jacobian the chord steps go on past the tolerance while they contract: the
+  // period of a located point to round-off (locate()).
+  if (!chord ||
+      !chord_correct(*chord, normal, through, e.z, nullptr, problem_.base().jacobian_exact())) {
     // From where the chord steps got to, in the loop's units (fresh Jacobians).
     const core::BorderedSystem on_plane(
         problem_, {core::BorderRow::hyperplane(normal.cwiseProduct(f).normalized(),
@@ -213,13 +216,21 @@ void Locator::locate(const std::vector<Sample>& polyline, bool sign_change) {
   const auto started = std::chrono::steady_clock::now();
   const core::EvaluationCounters& counters = problem_.base().counters();
   const long jacobians_before = counters.jacobians, residuals_before = counters.residuals;
-  // Located when |tau| is 1e-3 of the rank report's relative threshold: J is singular there at
-  // the resolution the verification uses, with a margin, and the period of a contact-bar point
-  // within ~3e-8 (at 100 intervals: 3.6 + 2.8e-9, 3.5 - 3.9e-10, 3.2 - 2.8e-8). Below that the
-  // finite-difference noise of the test function (4e-9..8e-9 at T = 3.6) stalls the iteration:
-  // at 1e-4 of it the location spends 6 more evaluations there for nothing. Near the root a
-  // step costs one Jacobian and a few residuals (tangent predictor from the nearest evaluation).
-  const double located_value = 1e-3 * options_.rank.relative_threshold;
+  // With a Jacobian that is the derivative to round-off (core::Problem::jacobian_exact), the
+  // iteration runs until the bracket is below location_tolerance or |tau| stops falling, at
+  // round-off. Mode 1 at 40 intervals on steps of 0.001 of the amplitude: every period is the
+  // law's 2q/p to 9.2e-13 relative, where a stop at 1e-3 of the threshold leaves up to 5.9e-10
+  // (T = 3.75), at one or two more evaluations per branch point. On steps of 0.05 the test
+  // function's zero itself lies up to 1.7e-10 off in period (T = 3.2 + 5.4e-10: |tau| 1.7e-16,
+  // energy on mode 1's closed form to 5e-14), and location_tolerance 1e-12 does not move it.
+  // With differences it stops when |tau| is 1e-3 of the rank report's relative threshold: J is
+  // singular there at the resolution the verification uses, with a margin. Below that the
+  // finite-difference noise of the test function (4e-9..8e-9 at T = 3.6 on 100 intervals)
+  // stalls the iteration: at 70 intervals, going on costs 6 more evaluations at T = 3.6 and
+  // 3.5 for nothing. Near the root a step costs one Jacobian and a few residuals (tangent
+  // predictor from the nearest evaluation).
+  const double located_value =
+      problem_.base().jacobian_exact() ? 0.0 : 1e-3 * options_.rank.relative_threshold;
   BranchPointReport report;
   report.sign_change = sign_change;
   std::shared_ptr<const Chord> chord;

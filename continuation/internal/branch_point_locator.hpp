@@ -109,9 +109,12 @@ class Locator {
   // Chord steps (one residual each) onto F = 0 and normal . (y - anchor) = 0, unit scale, with
   // secant (good Broyden) updates of the chord's J; kinks (n x q, orthonormal): directions along
   // which J is re-differenced at the start (q residuals). False when they do not converge to the
-  // verifier's corrector tolerance.
+  // verifier's corrector tolerance. polish: once within it, the steps go on while each cuts
+  // |F| tenfold, and y is the converged iterate with the smallest |F| (a located point's period
+  // to round-off: continuation/README.md, 'Branch points').
   bool chord_correct(const Chord& chord, const core::Vector& normal, const core::Vector& anchor,
-                     core::Vector& y, const core::Matrix* kinks = nullptr) const;
+                     core::Vector& y, const core::Matrix* kinks = nullptr,
+                     bool polish = false) const;
   // A = J's columns along the kinks, differenced at y (F(y) = r in the unit scale), less J's
   // own: the start of chord_correct's secant updates. False when a residual fails.
   bool difference_kinks(const Chord& chord, const core::Matrix& kinks, const core::Vector& y,

@@ -42,6 +42,7 @@ class FoldCurve : public core::Problem {
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
   std::string jacobian_description() const override { return "analytic"; }
+  bool jacobian_exact() const override { return true; }
 };
 
 // |x|^2 - radius^2 = 0 in R^dimension (dimension 2: circle, 3: sphere).
@@ -58,6 +59,7 @@ class QuadricSurface : public core::Problem {
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
   std::string jacobian_description() const override { return "analytic"; }
+  bool jacobian_exact() const override { return true; }
 
  private:
   int ambient_dimension_;
@@ -86,6 +88,7 @@ class RepeatedRows : public core::Problem {
   core::EvalStatus compute_residual(const core::Vector& x, core::Vector& r) const override;
   core::EvalStatus compute_jacobian(const core::Vector& x, core::Matrix& J) const override;
   std::string jacobian_description() const override { return "analytic"; }
+  bool jacobian_exact() const override { return true; }
   // The `rows` equations and their Jacobian once.
   virtual void rows(const core::Vector& x, core::Vector& r) const = 0;
   virtual void rows_jacobian(const core::Vector& x, core::Matrix& J) const = 0;

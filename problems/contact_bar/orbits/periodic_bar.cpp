@@ -604,6 +604,10 @@ std::string ContactBarOrbitProblem::jacobian_description() const {
   return exact_description();
 }
 
+bool ContactBarOrbitProblem::jacobian_exact() const {
+  return tdbem_jacobian_applies() || exact_jacobian_applies();
+}
+
 std::string ContactBarOrbitProblem::exact_description() const {
   if (exact_jacobian_applies()) return "exact";
   if (!options_.exact_jacobian) return "differences";

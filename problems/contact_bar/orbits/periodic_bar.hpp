@@ -186,6 +186,8 @@ class ContactBarOrbitProblem : public core::PeriodicOrbitProblem,
   // "differences", "differences (...)" saying why the exact one does not apply, or, when only
   // the path rows stand in the way, that F alone (rank reports, the atlas) takes the exact one.
   std::string jacobian_description() const override;
+  // exact or tdbem applies (the regular formulation, no path rows).
+  bool jacobian_exact() const override;
   // u_s: the gap g0 (1e-3 L when there is none); the residual is in these units.
   double displacement_scale() const;
 

@@ -69,8 +69,8 @@ namespace {
 // terms, at E = EA p^2 g0^2 / (2L (2q - 3p)^2); a grid of N intervals verifies it iff p divides
 // 2N (and 2N/p >= 3), with attached dimension ceil(N/p) - 1. Every candidate the detection
 // locates on mode 1 at 40 intervals up to 3e-5 J is checked against it: located to 1e-7 in
-// period (the location's tolerance is 1e-8 of T; measured about 4e-9), and verified exactly
-// when p divides 80.
+// period (measured at most 5.6e-10, at T = 3.2, on these steps of 0.05 of the amplitude; the
+// next test's fine steps give 3.3e-12), and verified exactly when p divides 80.
 TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
   const auto out = cli::scratch("modes", "law");
   const cli::Run r = trace_paper(
@@ -112,6 +112,32 @@ TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
     }
   }
   EXPECT_GE(checked, 2);
+}
+
+// With the exact Jacobian the location runs its test function down to round-off
+// (continuation/README.md, 'Branch points'): on steps of 0.1 % of the amplitude every verified
+// branch point of mode 1 at 40 intervals up to 1.3e-5 J (T = 3.9 to 3.2, 13 families) lies at
+// the law's 2q/p. Measured: at most 9.2e-13 relative (T = 3.625). A stop at 1e-3 of the rank
+// threshold leaves 5.9e-10 (T = 3.75); points corrected to the tolerance only, without the
+// polishing chord steps, 8.9e-12 (T = 3.7). The bound 5e-12 tells them apart with a margin.
+TEST(ModesCli, WithTheExactJacobianTheBranchPointsSitAtTheLawsPeriods) {
+  const auto out = cli::scratch("modes", "law_located");
+  const cli::Run r = trace_paper(
+      "--branch mode1 --shooting_elements 40 --energy_max 1.3e-5 --detect_branch_points true "
+      "--ds 0.001 --ds_max 0.001 --max_points 8000",
+      out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const Table b = Table::read_csv(out / "branch_points.csv");
+  const auto period = b.column("period"), verified = b.column("verified"),
+             wavenumber = b.column("content_wavenumber"), order = b.column("resonance_order");
+  int checked = 0;
+  for (std::size_t i = 0; i < period.size(); ++i) {
+    if (verified[i] != 1) continue;
+    const double law = 2.0 * std::lround(order[i]) / wavenumber[i];
+    EXPECT_LT(std::abs(period[i] / law - 1), 5e-12) << "T " << period[i] << " law " << law;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 13);
 }
 
 // A followed attached family ends at its boundary, and the run says so with exit 0. At 10
