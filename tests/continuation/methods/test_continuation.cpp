@@ -52,6 +52,18 @@ class PoisonedFold : public algebraic::FoldCurve {
   double threshold_;
 };
 
+// The unit circle in units that grow with |y|: 1 + y^2 for both unknowns and the equation
+// (continuation::LocalScale).
+class CircleInGrowingUnits : public algebraic::Circle, public continuation::LocalScale {
+ public:
+  core::Vector local_scale_factor(const core::Vector& x) const override {
+    return core::Vector::Constant(2, 1 + x[1] * x[1]);
+  }
+  core::Vector local_residual_factor(const core::Vector& x) const override {
+    return core::Vector::Constant(1, 1 + x[1] * x[1]);
+  }
+};
+
 }  // namespace
 
 class BothBackends : public ::testing::TestWithParam<const char*> {};
@@ -83,6 +95,25 @@ TEST_P(BothBackends, PassesTheFoldWithoutReversing) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Continuation, BothBackends, ::testing::Values("eigen", "kinsol"));
+
+// The first point's verification waits for the next point, and the loop's units move to the
+// first point's own in between. From the guess (0.5, 2) on the hyperplane x = 0.5 the corrected
+// point is (0.5, sqrt(0.75)): units 5 at the guess, 1.75 there. The first point is verified in
+// the units it was recorded in, so its tangent is found: dimension 1, like every later point.
+TEST(PseudoArclength, AFirstPointThatMovesItsUnitsIsVerifiedInItsOwn) {
+  const CircleInGrowingUnits circle;
+  auto newton = core::make_corrector("eigen", core::NewtonOptions{});
+  auto opt = quick(6);
+  opt.rank_check_every = 1;
+  const Branch b =
+      continuation::pseudo_arclength(circle, vec(0.5, 2.0), vec(1.0, 0.0), *newton, opt);
+  ASSERT_EQ(b.points.size(), 6u) << b.message;
+  EXPECT_NEAR(b.points[0].x[1], std::sqrt(0.75), 1e-12);
+  for (const auto& p : b.points) {
+    EXPECT_NEAR(p.x.norm(), 1.0, 1e-10) << p.index;
+    EXPECT_EQ(p.dimension, 1) << p.index;
+  }
+}
 
 // Along the unit circle from angle 0 to 3 (landing exactly on the bound): the summed chords
 // fall short of the arc by ~ s^3/24 per step of arc s <= 0.1, i.e. < 2e-3 over ~30 steps.
