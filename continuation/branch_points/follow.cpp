@@ -182,10 +182,14 @@ std::vector<FollowedBranch> follow_branch_points(
         dir / "summary.txt",
         fmt::format(
             "branch_point {}\npoints {}\nstart_probe {}\nattempts {}\nstop_reason {}\nmessage "
-            "{}\njacobian {}\n{}",
+            "{}\njacobian {}\ndimension_inside {}\n{}",
             k, f.branch.points.size(), f.start ? f.start->probe : -1, f.attempts,
             f.branch.points.empty() ? "-" : to_string(f.branch.reason), f.message,
-            problem.jacobian_description(), stability_counts(table ? &*table : nullptr)));
+            problem.jacobian_description(),
+            std::count_if(
+                f.branch.points.begin(), f.branch.points.end(),
+                [](const BranchPoint& p) { return p.dimension_flag == DimensionFlag::inside; }),
+            stability_counts(table ? &*table : nullptr)));
     followed.push_back(std::move(f));
   }
   return followed;

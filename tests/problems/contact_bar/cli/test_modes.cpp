@@ -199,11 +199,18 @@ TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
     const int law = (n + p - 1) / p - 1;
     const Table b = Table::read_csv(out / ("branch_point_" + std::to_string(i + 1)) / "branch.csv");
     const auto dimension = b.column("dimension"), flag = b.column("dimension_flag");
+    int flagged = 0;
     for (std::size_t k = 0; k < dimension.size(); ++k) {
       if (dimension[k] < 0) continue;  // no rank check at this point
       EXPECT_EQ(dimension[k], law) << "T " << period[i] << " point " << k;
-      if (flag[k] == 3) ++inside;
+      if (flag[k] == 3) ++flagged;
     }
+    // The follow's summary.txt counts them.
+    std::ifstream summary(out / ("branch_point_" + std::to_string(i + 1)) / "summary.txt");
+    const std::string text{std::istreambuf_iterator<char>(summary), {}};
+    EXPECT_NE(text.find("\ndimension_inside " + std::to_string(flagged) + "\n"), std::string::npos)
+        << text;
+    inside += flagged;
     ++followed;
   }
   EXPECT_GE(followed, 2);
