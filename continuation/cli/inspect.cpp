@@ -11,9 +11,34 @@
 #include "continuation/outputs.hpp"
 #include "core/errors.hpp"
 #include "core/io/scene_ini.hpp"
+#include "core/io/table.hpp"
 #include "core/orbits/periodic_orbit.hpp"
 
 namespace backbone::cli {
+
+namespace {
+// A followed family's rank check on its face reads the dimension at a neighbour just inside
+// (dimension_flag 3, continuation/README.md 'Following attached branches'); J at the point is
+// one side's, so the report above can count less. Says so when branch.csv flags the point.
+void print_inside_flag(const std::filesystem::path& branch_csv, int point) {
+  if (!std::filesystem::exists(branch_csv)) return;
+  const core::Table b = core::Table::read_csv(branch_csv);
+  const auto& names = b.columns();
+  for (const char* name : {"point", "dimension", "dimension_flag"})
+    if (std::find(names.begin(), names.end(), name) == names.end()) return;
+  const auto index = b.column("point"), dimension = b.column("dimension"),
+             flag = b.column("dimension_flag");
+  if (index.empty()) return;
+  const double wanted = point < 0 ? index.back() : point;
+  for (std::size_t i = 0; i < index.size(); ++i)
+    if (index[i] == wanted && flag[i] == 3)
+      fmt::print(
+          "branch.csv: dimension {} at this point, verified at a neighbour just inside "
+          "(dimension_flag 3):\n  the point is on a face of its family, where J is one "
+          "side's\n",
+          dimension[i]);
+}
+}  // namespace
 
 int inspect_command(const ProblemPlugin& plugin, const std::vector<std::string>& args) {
   namespace po = boost::program_options;
@@ -28,9 +53,14 @@ int inspect_command(const ProblemPlugin& plugin, const std::vector<std::string>&
   if (!std::filesystem::exists(dir / "unknowns.csv"))
     throw core::InputError(
         "orbit", fmt::format("'{}' holds no traced branch (no unknowns.csv)", dir.string()));
-  const std::string branch = scene.has("branch")
-                                 ? scene.text("branch")
-                                 : core::read_text_value(dir / "summary.txt", "branch");
+  // A followed family's folder (DIR/branch_point_K) has its parent's branch.
+  const bool followed = !scene.has("branch") && std::filesystem::exists(dir / "summary.txt") &&
+                        std::filesystem::exists(dir.parent_path() / "summary.txt") &&
+                        dir.filename().string().starts_with("branch_point_");
+  const std::string branch =
+      scene.has("branch")
+          ? scene.text("branch")
+          : core::read_text_value((followed ? dir.parent_path() : dir) / "summary.txt", "branch");
   if (!plugin.has_branch(branch))
     throw core::InputError(scene.has("branch") ? "branch" : "orbit",
                            fmt::format("'{}' is not a branch of {} (known: {})", branch,
@@ -57,6 +87,7 @@ int inspect_command(const ProblemPlugin& plugin, const std::vector<std::string>&
       *setup.problem, x, run.options.rank, run.options.verification, neighbour);
   fmt::print("{} / {} point {}: {} equations, {} unknowns\n{}", plugin.name, branch, point,
              setup.problem->num_equations(), x.size(), e.text());
+  print_inside_flag(dir / "branch.csv", point);
   return e.report.verified_dimension >= 0 ? core::exit_ok : core::exit_numerical_failure;
 }
 

@@ -210,6 +210,21 @@ TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
     const std::string text{std::istreambuf_iterator<char>(summary), {}};
     EXPECT_NE(text.find("\ndimension_inside " + std::to_string(flagged) + "\n"), std::string::npos)
         << text;
+    // inspect at the first flagged point says what branch.csv holds there.
+    for (std::size_t k = 0; k < dimension.size() && inside == 0 && flagged > 0; ++k) {
+      if (flag[k] != 3) continue;
+      const auto report = out / ("inspect_" + std::to_string(i + 1) + ".txt");
+      const std::string command =
+          std::string("'") + BACKBONE_BINARY_DIR + "/bin/backbone' inspect '" +
+          (out / "scene.ini").string() + "' --orbit '" +
+          (out / ("branch_point_" + std::to_string(i + 1)) / "orbits.csv").string() + ":" +
+          std::to_string(k) + "' > '" + report.string() + "'";
+      EXPECT_EQ(std::system(command.c_str()), 0) << command;
+      EXPECT_NE(cli::file_text(report).find("branch.csv: dimension " + std::to_string(law) +
+                                            " at this point, verified at a neighbour just inside"),
+                std::string::npos)
+          << cli::file_text(report);
+    }
     inside += flagged;
     ++followed;
   }
