@@ -106,7 +106,7 @@ bool Locator::chord_correct(const Chord& chord, const core::Vector& normal,
   core::Vector best = y;
   double best_norm = std::numeric_limits<double>::infinity();
   int without_progress = 0;
-  // Polishing: the converged iterate with the smallest residual, and the last norm.
+  // Polishing: the converged iterate with the smallest residual, and its norm.
   bool converged = false;
   core::Vector polished;
   double polished_norm = std::numeric_limits<double>::infinity();
