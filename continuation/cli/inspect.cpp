@@ -54,9 +54,8 @@ int inspect_command(const ProblemPlugin& plugin, const std::vector<std::string>&
     throw core::InputError(
         "orbit", fmt::format("'{}' holds no traced branch (no unknowns.csv)", dir.string()));
   // A followed family's folder (DIR/branch_point_K) has its parent's branch.
-  const bool followed = !scene.has("branch") && std::filesystem::exists(dir / "summary.txt") &&
-                        std::filesystem::exists(dir.parent_path() / "summary.txt") &&
-                        dir.filename().string().starts_with("branch_point_");
+  const bool followed = dir.filename().string().starts_with("branch_point_") &&
+                        std::filesystem::exists(dir.parent_path() / "summary.txt");
   const std::string branch =
       scene.has("branch")
           ? scene.text("branch")

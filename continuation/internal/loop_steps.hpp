@@ -166,8 +166,8 @@ class LoopSteps {
   // first point's tangent.
   void verify_first_by_next() { defer_first_ = true; }
   void report_first(std::shared_ptr<LoopState> state);
-  // Verifies and reports a deferred first point now, by probes: before the loop leaves the
-  // units it was recorded in (its verification runs in those).
+  // Verifies and reports a deferred first point now, by probes (nothing when none waits): before
+  // the loop leaves the units it was recorded in (its verification runs in those).
   void verify_first_now() { flush_first(nullptr); }
 
   // In place of start: continues from a saved state (its index and arclength). record: the

@@ -207,6 +207,10 @@ void ArclengthLoop::adopt_units_of(const LoopState& state) {
   if (!follow_scale_) return;
   const core::Vector at = state.z.cwiseProduct(problem_.unit_scale());
   s_.factor = problem_.local_factor_at(at);
+  // A first point whose verification waits for the next point is verified now, in the units it
+  // was recorded in, when they change (a guess that Newton moved: begin_from_guess).
+  if ((problem_.unit_scale().cwiseProduct(s_.factor).array() != problem_.scale().array()).any())
+    steps_.verify_first_now();
   problem_.set_factor(s_.factor, problem_.local_residual_factor_at(at));
   s_.x = state.z.cwiseQuotient(s_.factor);
   s_.tangent = state.tangent.cwiseQuotient(s_.factor).normalized();
@@ -283,14 +287,6 @@ std::optional<Branch> ArclengthLoop::begin_from_guess(const core::Vector& guess,
   const std::shared_ptr<const LoopState> first_state = state;
   steps_.report_first(std::move(state));
   detect(start_.index, s_.x, s_.tangent, start_.arclength);
-  // The next point is recorded in the first point's own units (adopt_units_of). When they are
-  // not the guess's (units that follow the point, a guess that Newton moved), the first point's
-  // deferred verification cannot wait for it.
-  if (follow_scale_) {
-    const core::Vector own =
-        problem_.unit_scale().cwiseProduct(problem_.local_factor_at(problem_.to_unknowns(s_.x)));
-    if ((own.array() != problem_.scale().array()).any()) steps_.verify_first_now();
-  }
   adopt_units_of(*first_state);
   return std::nullopt;
 }
