@@ -22,7 +22,9 @@
 //     fall-back. Each evaluation is a point corrected on the hyperplane orthogonal to the
 //     bracket's polyline (chord steps on the last Jacobian with secant updates first, then
 //     Gauss-Newton that keeps its Jacobian while it contracts); it ends when |tau| is below 1e-3
-//     of the rank threshold, the bracket below location_tolerance, or |tau| stops falling;
+//     of the rank threshold, the bracket below location_tolerance, or |tau| stops falling; with
+//     an exact Jacobian the root is then found again on points whose components along the
+//     attached directions are the branch's (branch_point_locator.hpp, refine_on_branch);
 //   - the located point is verified with the rank report and probes on the located point's
 //     Jacobian, whose columns along the kinks of F that earlier probes crossed are re-differenced
 //     at each probe's start: dimension = verified dimension - 1 (the directions beyond the traced

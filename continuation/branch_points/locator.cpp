@@ -46,33 +46,48 @@ const Chord& Locator::chord_of(const Evaluation& e) const {
   return *e.chord;
 }
 
+namespace {
+
+// The hyperplane through polyline at s, orthogonal to the segment that holds s, and the cubic
+// Hermite interpolant of that segment's samples and their tangents at s (error O(L^4) in the
+// chord length L, where the chord's own is O(L^2)), moved onto the hyperplane.
+struct PlaneAt {
+  PlaneAt(const std::vector<Sample>& polyline, double s) {
+    while (i + 2 < polyline.size() && s > polyline[i + 1].s) ++i;
+    const Sample& a = polyline[i];
+    const Sample& b = polyline[i + 1];
+    const double length = b.s - a.s;
+    const double t = length > 0 ? std::clamp((s - a.s) / length, 0.0, 1.0) : 0.0;
+    segment = b.z - a.z;
+    through = a.z + t * segment;
+    normal = segment.normalized();
+    const double L = segment.norm();
+    const core::Vector ta = a.tangent.dot(segment) < 0 ? core::Vector(-a.tangent) : a.tangent;
+    const core::Vector tb = b.tangent.dot(segment) < 0 ? core::Vector(-b.tangent) : b.tangent;
+    hermite = (2 * t * t * t - 3 * t * t + 1) * a.z + (t * t * t - 2 * t * t + t) * L * ta +
+              (-2 * t * t * t + 3 * t * t) * b.z + (t * t * t - t * t) * L * tb;
+    hermite += normal * normal.dot(through - hermite);
+    if (!hermite.allFinite() || a.tangent.size() != a.z.size() || b.tangent.size() != b.z.size())
+      hermite = through;
+  }
+  std::size_t i = 0;  // the segment's first sample
+  core::Vector segment, through, normal, hermite;
+};
+
+}  // namespace
+
 Evaluation Locator::evaluate(const std::vector<Sample>& polyline, double s,
                              const TestFunctionValue& reference, const Chord* initial,
                              const Evaluation* last, const Evaluation* near) {
   Evaluation e;
-  std::size_t i = 0;
-  while (i + 2 < polyline.size() && s > polyline[i + 1].s) ++i;
-  const Sample& a = polyline[i];
-  const Sample& b = polyline[i + 1];
-  const double length = b.s - a.s;
-  const double fraction = length > 0 ? std::clamp((s - a.s) / length, 0.0, 1.0) : 0.0;
-  const core::Vector segment = b.z - a.z;
-  const core::Vector through = a.z + fraction * segment;
-  const core::Vector normal = segment.normalized();
+  const PlaneAt plane(polyline, s);
+  const core::Vector& segment = plane.segment;
+  const core::Vector& through = plane.through;
+  const core::Vector& normal = plane.normal;
   const core::Vector f = factor();
   e.s = s;
-  // Start: the cubic Hermite interpolant of the two samples and their tangents (error O(L^4) in
-  // the chord length L, where the chord's own is O(L^2)), moved onto the hyperplane.
-  {
-    const double L = segment.norm(), t = fraction;
-    const core::Vector ta = a.tangent.dot(segment) < 0 ? core::Vector(-a.tangent) : a.tangent;
-    const core::Vector tb = b.tangent.dot(segment) < 0 ? core::Vector(-b.tangent) : b.tangent;
-    e.z = (2 * t * t * t - 3 * t * t + 1) * a.z + (t * t * t - 2 * t * t + t) * L * ta +
-          (-2 * t * t * t + 3 * t * t) * b.z + (t * t * t - t * t) * L * tb;
-    e.z += normal * normal.dot(through - e.z);
-    if (!e.z.allFinite() || a.tangent.size() != a.z.size() || b.tangent.size() != b.z.size())
-      e.z = through;
-  }
+  // Start: the cubic Hermite interpolant of the two samples and their tangents.
+  e.z = plane.hermite;
   // From a corrected point of the location nearer than the polyline's samples, a tangent
   // predictor onto the hyperplane and chord steps on that point's Jacobian: the bracket shrinks
   // much faster than the polyline's interpolation error does.
@@ -216,21 +231,16 @@ void Locator::locate(const std::vector<Sample>& polyline, bool sign_change) {
   const auto started = std::chrono::steady_clock::now();
   const core::EvaluationCounters& counters = problem_.base().counters();
   const long jacobians_before = counters.jacobians, residuals_before = counters.residuals;
-  // With a Jacobian that is the derivative to round-off (core::Problem::jacobian_exact), the
-  // iteration runs until the bracket is below location_tolerance or |tau| stops falling, at
-  // round-off. Mode 1 at 40 intervals on steps of 0.001 of the amplitude: every period is the
-  // law's 2q/p to 9.2e-13 relative, where a stop at 1e-3 of the threshold leaves up to 5.9e-10
-  // (T = 3.75), at one or two more evaluations per branch point. On steps of 0.05 the test
-  // function's zero itself lies up to 1.7e-10 off in period (T = 3.2 + 5.4e-10: |tau| 1.7e-16,
-  // energy on mode 1's closed form to 5e-14), and location_tolerance 1e-12 does not move it.
-  // With differences it stops when |tau| is 1e-3 of the rank report's relative threshold: J is
-  // singular there at the resolution the verification uses, with a margin. Below that the
-  // finite-difference noise of the test function (4e-9..8e-9 at T = 3.6 on 100 intervals)
-  // stalls the iteration: at 70 intervals, going on costs 6 more evaluations at T = 3.6 and
-  // 3.5 for nothing. Near the root a step costs one Jacobian and a few residuals (tangent
-  // predictor from the nearest evaluation).
-  const double located_value =
-      problem_.base().jacobian_exact() ? 0.0 : 1e-3 * options_.rank.relative_threshold;
+  // The iteration stops when |tau| is 1e-3 of the rank report's relative threshold: J is
+  // singular there at the resolution the verification uses, with a margin. With differences,
+  // the finite-difference noise of the test function (4e-9..8e-9 at T = 3.6 on 100 intervals)
+  // stalls it below that: at 70 intervals, going on costs 6 more evaluations at T = 3.6 and 3.5
+  // for nothing. With an exact Jacobian (core::Problem::jacobian_exact) refine_on_branch takes
+  // the root to round-off from there: mode 1 at 40 intervals on steps of 0.001 of the amplitude,
+  // up to 1e-3 J, puts every period at the law's 2q/p to 1.2e-14 relative, where going on to
+  // round-off here without it leaves 9.2e-13 (and 18 % more Jacobians with it). Near the root a
+  // step costs one Jacobian and a few residuals (tangent predictor from the nearest evaluation).
+  const double located_value = 1e-3 * options_.rank.relative_threshold;
   BranchPointReport report;
   report.sign_change = sign_change;
   std::shared_ptr<const Chord> chord;
@@ -240,6 +250,7 @@ void Locator::locate(const std::vector<Sample>& polyline, bool sign_change) {
   Secant secant = start_secant(at, sign_change);
   if (secant.root_finding) secant_steps(at, secant, located_value);
   minimise_modulus(at, located_value);
+  refine_on_branch(at);
   verify_best(at, report);
   report.jacobian_evaluations = counters.jacobians - jacobians_before;
   report.residual_evaluations = counters.residuals - residuals_before;
@@ -420,6 +431,190 @@ void Locator::minimise_modulus(Location& at, double located_value) {
     golden = width > 0.7 * previous_width;
     previous_width = width;
   }
+}
+
+// Near the branch point J is singular along the attached family's directions as well as the
+// tangent, so the location's corrections leave a point's component along them at what its start
+// had (the loop's corrector tolerance at the samples, a tangent predictor from a point where J
+// is nearly singular). Where F is not affine in the unknowns that component moves the test
+// function's zero along the branch. Mode 3 of the contact bar at 46 intervals (free knots):
+// 2.9e-10 along the attached direction puts the root 1.6e-11 off the law's period 18/23, and
+// 4.8e-10 with other steps puts it 2.7e-11 off on the other side. So, with an exact Jacobian,
+// the root is found again between two points on either side where |tau| is about 1e-4, each
+// corrected on the Jacobian at its start without a rank cut-off: J is far from singular there,
+// so the component is the branch's to round-off. Secant steps then evaluate the test function
+// at points corrected from the two's cubic Hermite interpolant on the last point's Jacobian with
+// the near-null directions dropped, which leaves that component at the interpolant's. The same
+// runs put 18/23 at the law's period to 7e-16 whatever the steps.
+void Locator::refine_on_branch(Location& at) {
+  // |tau| at the two points; a location that did not bring |tau| far below it found no root.
+  const double end_value = 1e-4;
+  if (!problem_.base().jacobian_exact() || at.best_done < 0 ||
+      !(std::abs(at.best_value) <= 1e-3 * end_value))
+    return;
+  const BranchPointOptions& o = options_.branch_points;
+  const Evaluation& best = at.done[static_cast<std::size_t>(at.best_done)];
+  // |tau| ~ slope |s - s*|: the slope from the known value nearest the root that is well above
+  // round-off.
+  double slope = 0, distance = std::numeric_limits<double>::infinity();
+  const auto consider = [&](double s, double value) {
+    const double d = std::abs(s - at.best_s);
+    if (std::abs(value) >= 1e-9 && d > 0 && d < distance) {
+      distance = d;
+      slope = std::abs(value) / d;
+    }
+  };
+  for (const Sample& p : at.polyline) consider(p.s, p.tau.value);
+  for (const Evaluation& e : at.done) consider(e.s, e.tau.value);
+  if (!(slope > 0)) return;
+  const double delta = end_value / slope;
+  const double s_a = std::max(at.best_s - delta, at.polyline.front().s);
+  const double s_b = std::min(at.best_s + delta, at.polyline.back().s);
+  if (!(s_b - s_a > o.location_tolerance)) return;
+  // Each from the located point along its tangent onto its hyperplane.
+  std::vector<Sample> ends(2);
+  core::Matrix J_a, J_b;
+  const auto end = [&](double s, Sample& out, core::Matrix& J) {
+    const PlaneAt plane(at.polyline, s);
+    const double along = plane.normal.dot(best.tangent);
+    if (!(std::abs(along) >= 0.5)) return false;
+    out.s = s;
+    return correct_on_plane(
+        plane.normal, plane.through,
+        best.z + best.tangent * (plane.normal.dot(plane.through - best.z) / along), 0.0, nullptr,
+        out, J);
+  };
+  if (!end(s_a, ends[0], J_a) || !end(s_b, ends[1], J_b)) return;
+  at.steps += 2;
+  // The test function's border here is the chord of the two, not each point's tangent: where
+  // J's second-smallest singular value is below the rank threshold the tangent is the normal's
+  // component in a two-dimensional null space, so it turns there, and with it the singular
+  // vectors that orient the values. The chord is the branch's tangent to O(delta^2), and the
+  // bordered matrix is singular where J loses rank whatever the border.
+  const core::Vector border = (ends[1].z - ends[0].z).normalized();
+  ends[0].tau = bordered_test_function(J_a, border, jacobian_scale_, nullptr, false);
+  ends[1].tau = bordered_test_function(J_b, border, jacobian_scale_, &ends[0].tau, true);
+  if (!ends[1].tau.continued || !(ends[0].tau.value * ends[1].tau.value < 0)) return;
+  double s_prev = s_a, f_prev = ends[0].tau.value, s_last = s_b, f_last = ends[1].tau.value;
+  std::vector<Evaluation> found;
+  double smallest = std::min(std::abs(f_prev), std::abs(f_last));
+  // A root: |tau| 1e-8 of the ends' (1e-12 here), a period to round-off where tau grows like
+  // 0.1 T or faster.
+  const double root_value = 1e-8 * smallest;
+  int stale = 0;
+  while (found.size() < 8 && std::abs(s_last - s_prev) > 1e-3 * o.location_tolerance && stale < 2) {
+    double s = (s_prev * f_last - s_last * f_prev) / (f_last - f_prev);
+    const double lo = std::min(s_prev, s_last), hi = std::max(s_prev, s_last);
+    if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
+    // From the interpolant, chord steps with the near-null directions dropped: they leave the
+    // point's component along them at the interpolant's.
+    const PlaneAt plane(ends, s);
+    Sample point;
+    Evaluation e;
+    ++at.steps;
+    const core::Matrix& chord = found.empty() ? best.jacobian : found.back().jacobian;
+    if (!correct_on_plane(plane.normal, plane.through, plane.hermite,
+                          options_.rank.relative_threshold, &chord, point, e.jacobian))
+      break;
+    e.ok = true;
+    e.s = s;
+    e.z = std::move(point.z);
+    e.tangent = std::move(point.tangent);
+    e.tau = bordered_test_function(e.jacobian, border, jacobian_scale_, &ends[0].tau, true);
+    if (!e.tau.continued) {
+      // At the root the left vector is the round-off's: a value far below every other is it.
+      if (std::abs(e.tau.value) <= root_value) found.push_back(e);
+      break;
+    }
+    found.push_back(e);
+    if (std::abs(e.tau.value) < 0.5 * smallest) {
+      smallest = std::abs(e.tau.value);
+      stale = 0;
+    } else {
+      ++stale;
+    }
+    if (std::abs(e.tau.value) <= 1e-2 * root_value) break;
+    if (e.tau.value * f_last < 0) {
+      s_prev = s_last;
+      f_prev = f_last;
+    } else {
+      f_prev *= 0.5;
+    }
+    s_last = s;
+    f_last = e.tau.value;
+  }
+  std::size_t root = 0;
+  for (std::size_t k = 1; k < found.size(); ++k)
+    if (std::abs(found[k].tau.value) < std::abs(found[root].tau.value)) root = k;
+  if (found.empty() || !(std::abs(found[root].tau.value) <= root_value)) return;
+  Evaluation& e = found[root];
+  at.best_z = e.z;
+  at.best_tangent = e.tangent;
+  at.best_s = e.s;
+  at.best_value = e.tau.value;
+  at.best_jacobian = e.jacobian;
+  at.best_chord = nullptr;
+  at.best_done = static_cast<int>(at.done.size());
+  at.done.push_back(e);
+}
+
+bool Locator::correct_on_plane(const core::Vector& normal, const core::Vector& through,
+                               core::Vector y, double cutoff, const core::Matrix* chord,
+                               Sample& out, core::Matrix& J_out) const {
+  const core::Vector f = factor();
+  const core::Vector& rf = problem_.residual_factor();
+  const double tolerance = options_.verification.corrector_options().residual_tolerance;
+  const auto jacobian_at = [&](const core::Vector& at, core::Matrix& J) {
+    if (problem_.jacobian(at.cwiseQuotient(f), J) != core::EvalStatus::ok) return false;
+    J = in_unit_scale(J);
+    return J.allFinite();
+  };
+  // The steps' matrix, [J; normal^T], J the chord's or the start's, factorised once.
+  core::Matrix bordered;
+  {
+    core::Matrix J;
+    if (chord) {
+      J = *chord;
+    } else if (!jacobian_at(y, J)) {
+      return false;
+    }
+    bordered.resize(J.rows() + 1, J.cols());
+    bordered.topRows(J.rows()) = J;
+    bordered.row(J.rows()) = normal.transpose();
+  }
+  Eigen::CompleteOrthogonalDecomposition<core::Matrix> cod;
+  if (cutoff > 0) cod.setThreshold(cutoff);  // relative to the largest pivot
+  cod.compute(bordered);
+  // Past the tolerance, the steps go on while each halves |F|: they converge linearly (a chord,
+  // or a Jacobian from across a kink of a piecewise affine F: mode 1 of the contact bar at 40
+  // intervals next to T = 3.2, |F| falls 2.6-fold a step from 1.8e-10, where stopping at the
+  // tolerance leaves T 9e-13 off the law's). The iterate with the smallest |F|.
+  core::Vector best_y;
+  double best_norm = std::numeric_limits<double>::infinity();
+  bool converged = false;
+  for (int iteration = 0; iteration < 16; ++iteration) {
+    core::Vector r;
+    if (problem_.residual(y.cwiseQuotient(f), r) != core::EvalStatus::ok || !r.allFinite()) break;
+    const double plane = normal.dot(y - through);
+    const bool within = r.lpNorm<Eigen::Infinity>() <= tolerance && std::abs(plane) <= tolerance;
+    if (rf.size() > 0) r = r.cwiseProduct(rf);
+    const double norm = std::hypot(r.norm(), plane);
+    if (converged && !(norm <= 0.5 * best_norm)) break;
+    if (norm < best_norm) {
+      best_y = y;
+      best_norm = norm;
+    }
+    converged = converged || within;
+    core::Vector rhs(r.size() + 1);
+    rhs << -r, -plane;
+    const core::Vector dx = cod.solve(rhs);
+    if (!dx.allFinite()) break;
+    y += dx;
+  }
+  if (!converged) return false;
+  out.z = best_y;
+  if (!jacobian_at(out.z, J_out)) return false;
+  return tangent_from_jacobian(J_out, normal, cutoff, out.tangent) == core::EvalStatus::ok;
 }
 
 // The report's location (the best point, the sample it follows) and its verification there.

@@ -149,6 +149,17 @@ class Locator {
   void secant_steps(Location& at, Secant& secant, double located_value);
   // V-fit and golden-section minimisation of |tau| around the smallest value seen.
   void minimise_modulus(Location& at, double located_value);
+  // With an exact Jacobian: the root again, on the interpolant of two points on either side
+  // corrected by Newton where J is far from singular (locator.cpp, refine_on_branch).
+  void refine_on_branch(Location& at);
+  // Chord steps from y onto F = 0 and normal . (y - through) = 0 (unit scale) on one matrix,
+  // chord (unit scale) or else J at y, pivots below cutoff times the largest dropped (0: at
+  // round-off): out.z, and J there (one Jacobian, or two without chord) with its null vector
+  // out.tangent to the same cut-off. False when they do not reach the verifier's corrector
+  // tolerance.
+  bool correct_on_plane(const core::Vector& normal, const core::Vector& through, core::Vector y,
+                        double cutoff, const core::Matrix* chord, Sample& out,
+                        core::Matrix& J) const;
   // The report's location fields, then verify() at the best point.
   void verify_best(Location& at, BranchPointReport& report);
   // Verifies the located point z (its tangent and J, empty: evaluated here) and fills report's
@@ -165,6 +176,9 @@ class Locator {
   // whether the chord steps alone finished it. False when no corrector converged.
   bool probe(const Chord& chord, const core::Vector& d, const core::Vector& stepped,
              Probing& probing, core::Vector& y, bool& by_chord) const;
+  // The probe's last stage: the loop's corrector (fresh Jacobians) from y onto F = 0 and the
+  // hyperplane through stepped orthogonal to d. False when it does not converge.
+  bool finish_probe(const core::Vector& d, const core::Vector& stepped, core::Vector& y) const;
   // Adds to kinks the directions along which J(y) differs from J.
   void learn_kinks(const core::Vector& y, const core::Matrix& J, core::Matrix& kinks) const;
 

@@ -68,9 +68,12 @@ namespace {
 // 'Attached families: the law'): a branch point lies at T = 2q L / (p c) with p/q in lowest
 // terms, at E = EA p^2 g0^2 / (2L (2q - 3p)^2); a grid of N intervals verifies it iff p divides
 // 2N (and 2N/p >= 3), with attached dimension ceil(N/p) - 1. Every candidate the detection
-// locates on mode 1 at 40 intervals up to 3e-5 J is checked against it: located to 1e-7 in
-// period (measured at most 5.6e-10, at T = 3.2, on these steps of 0.05 of the amplitude; the
-// next test's fine steps give 3.3e-12), and verified exactly when p divides 80.
+// locates on mode 1 at 40 intervals up to 3e-5 J is checked against it, and verified exactly
+// when p divides 80. A verified one lies at 2q/p to 1e-12 relative: the location finds the
+// root again on points whose components along the attached directions are the branch's
+// (locator.cpp, refine_on_branch); measured at most 2.5e-14 (T = 3.5), where the root on the
+// points the location corrected lies 2e-9 off (T = 3.6) on these steps of 0.05 of the
+// amplitude.
 TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
   const auto out = cli::scratch("modes", "law");
   const cli::Run r = trace_paper(
@@ -97,7 +100,7 @@ TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
     }
     const bool divides = (2 * n) % best_p == 0 && 2 * n / best_p >= 3;
     if (verified[i] == 1) {
-      EXPECT_LT(best, 1e-7) << "T " << period[i];
+      EXPECT_LT(best / period[i], 1e-12) << "T " << period[i];
       EXPECT_TRUE(divides) << "T " << period[i] << " p " << best_p;
       EXPECT_EQ(dimension[i], (n + best_p - 1) / best_p - 1) << "T " << period[i];
       const double g0 = 1e-3, k = 2.0 * best_q - 3.0 * best_p;
@@ -114,12 +117,12 @@ TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
   EXPECT_GE(checked, 2);
 }
 
-// With the exact Jacobian the location runs its test function down to round-off
+// With the exact Jacobian the location takes its test function down to round-off
 // (continuation/README.md, 'Branch points'): on steps of 0.1 % of the amplitude every verified
 // branch point of mode 1 at 40 intervals up to 1.3e-5 J (T = 3.9 to 3.2, 13 families) lies at
-// the law's 2q/p. Measured: at most 9.2e-13 relative (T = 3.625). A stop at 1e-3 of the rank
-// threshold leaves 5.9e-10 (T = 3.75); points corrected to the tolerance only, without the
-// polishing chord steps, 8.9e-12 (T = 3.7). The bound 5e-12 tells them apart with a margin.
+// the law's 2q/p. Measured: at most 8.9e-15 relative (T = 3.5). Without refine_on_branch the
+// root lies up to 5.9e-10 off (T = 3.75), and as far without the polishing chord steps of the
+// location's evaluations. The bound 5e-12 tells them apart with a margin.
 TEST(ModesCli, WithTheExactJacobianTheBranchPointsSitAtTheLawsPeriods) {
   const auto out = cli::scratch("modes", "law_located");
   const cli::Run r = trace_paper(
@@ -178,14 +181,15 @@ TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
 // Along a followed family every rank check reads the law's dimension ceil(N/p) - 1, on its
 // faces too (min_slope 0 on an interval: J there is the outside's, orbits/README.md 'Attached
 // families: the law', verified just inside with dimension_flag 3). Mode 1 at 40 intervals up
-// to 3e-5 J, every verified family followed for 21 points (rank checks at points 0, 10, 20);
-// the case holds such points (checked), where J alone reads 2 for 4 and 5 for 7.
+// to 3e-5 J, every verified family followed for 61 points (rank checks at points 0, 10, ...,
+// 60); the case holds such points (checked; measured: three, on the family at T = 3.5 of
+// dimension 9).
 TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
   const auto out = cli::scratch("modes_cli", "follow_dimension");
   const int n = 40;
   const cli::Run r = trace_paper(
       "--branch mode1 --shooting_elements 40 --detect_branch_points true --ds 0.05 --ds_max 0.05 "
-      "--energy_max 3e-5 --follow all --follow_max_points 21",
+      "--energy_max 3e-5 --follow all --follow_max_points 61",
       out);
   ASSERT_EQ(r.code, 0) << r.err;
   const Table points = Table::read_csv(out / "branch_points.csv");
@@ -236,9 +240,13 @@ TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
 // points lie at T = 2q/p with strain s = g0 p / (2 J^2 q - (2J + 1) p) and kinks at multiples
 // of L/p; a grid of N intervals with p | 2N whose knots' reference nodes sit on the kinks
 // there (uniform at the branch point) verifies the family, of dimension ceil(N/p) - 1. Mode 2
-// at T = 9/7 (p = 14, q = 9: s = 7 g0, crest at 2/7 L) on 35 intervals, knot node 10;
-// mode 3 at T = 18/23 (p = 23, q = 9: s = 23 g0, kinks at 5/23 and 13/23) on 46, nodes 10
-// and 26. Located to the location's 1e-8 of T (1e-7 here), energy EA L s^2 / 2 to 1e-6.
+// at T = 9/7 (p = 14, q = 9: s = 7 g0, crest at 2/7 L) on 35 intervals, knot node 10, and at
+// T = 14/11 (p = 11, q = 7: s = 11 g0) on 77, knot node 21; mode 3 at T = 18/23 (p = 23,
+// q = 9: s = 23 g0, kinks at 5/23 and 13/23) on 46, nodes 10 and 26. Located at 2q/p to 1e-12
+// relative (measured at most 8.7e-16; the root on the points the location corrected lies
+// 1.1e-11 to 1.6e-10 off: locator.cpp, refine_on_branch), energy EA L s^2 / 2 to 1e-6. At 14/11 one
+// of the six probes' chord steps runs 14 probe steps away, and the loop's corrector from the
+// stepped point brings it back: the law's dimension 6, 5 without it.
 TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
   struct Case {
     const char* branch;
@@ -248,8 +256,10 @@ TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
     int mode, p, q;
   };
   for (const Case& c :
-       {Case{"mode2", 35, "10", "4e-5", 2, 14, 9}, Case{"mode3", 46, "10,26", "4e-4", 3, 23, 9}}) {
-    const auto out = cli::scratch("modes_cli", std::string("law_") + c.branch);
+       {Case{"mode2", 35, "10", "4e-5", 2, 14, 9}, Case{"mode2", 77, "21", "1e-4", 2, 11, 7},
+        Case{"mode3", 46, "10,26", "4e-4", 3, 23, 9}}) {
+    const auto out = cli::scratch(
+        "modes_cli", std::string("law_") + c.branch + "_" + std::to_string(c.elements));
     const cli::Run r = trace_paper(
         std::string("--branch ") + c.branch + " --shooting_elements " + std::to_string(c.elements) +
             " --knot_nodes " + c.knots +
@@ -266,7 +276,7 @@ TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
     int found = 0;
     for (std::size_t i = 0; i < period.size(); ++i) {
       if (verified[i] != 1) continue;
-      EXPECT_NEAR(period[i], t, 1e-7) << c.branch;
+      EXPECT_LT(std::abs(period[i] / t - 1), 1e-12) << c.branch << " " << c.elements;
       EXPECT_NEAR(energy[i] / (0.5 * s * s), 1, 1e-6) << c.branch;
       EXPECT_EQ(dimension[i], (c.elements + c.p - 1) / c.p - 1) << c.branch;
       const Table followed =
