@@ -237,9 +237,10 @@ void Locator::locate(const std::vector<Sample>& polyline, bool sign_change) {
   // stalls it below that: at 70 intervals, going on costs 6 more evaluations at T = 3.6 and 3.5
   // for nothing. With an exact Jacobian (core::Problem::jacobian_exact) refine_on_branch takes
   // the root to round-off from there: mode 1 at 40 intervals on steps of 0.001 of the amplitude,
-  // up to 1e-3 J, puts every period at the law's 2q/p to 1.2e-14 relative, where going on to
-  // round-off here without it leaves 9.2e-13 (and 18 % more Jacobians with it). Near the root a
-  // step costs one Jacobian and a few residuals (tangent predictor from the nearest evaluation).
+  // up to 1e-3 J, puts every period at the law's 2q/p to 1.6e-13 relative. Going on to
+  // round-off here instead leaves 9.2e-13 without it, and with it costs 22 % more Jacobians
+  // (175 against 144 up to 1.3e-5 J). Near the root a step costs one Jacobian and a few
+  // residuals (tangent predictor from the nearest evaluation).
   const double located_value = 1e-3 * options_.rank.relative_threshold;
   BranchPointReport report;
   report.sign_change = sign_change;
@@ -440,15 +441,20 @@ void Locator::minimise_modulus(Location& at, double located_value) {
 // function's zero along the branch. Mode 3 of the contact bar at 46 intervals (free knots):
 // 2.9e-10 along the attached direction puts the root 1.6e-11 off the law's period 18/23, and
 // 4.8e-10 with other steps puts it 2.7e-11 off on the other side. So, with an exact Jacobian,
-// the root is found again between two points on either side where |tau| is about 1e-4, each
-// corrected on the Jacobian at its start without a rank cut-off: J is far from singular there,
-// so the component is the branch's to round-off. Secant steps then evaluate the test function
-// at points corrected from the two's cubic Hermite interpolant on the last point's Jacobian with
+// the root is found again between two points on either side where |tau| is about 3e-5, each
+// corrected on the Jacobian at its start without a rank cut-off: J is not singular there, so
+// the component is the branch's to round-off. Secant steps then evaluate the test function at
+// points corrected from the two's cubic Hermite interpolant on the last point's Jacobian with
 // the near-null directions dropped, which leaves that component at the interpolant's. The same
-// runs put 18/23 at the law's period to 7e-16 whatever the steps.
+// runs put 18/23 at the law's period to 7e-15 whatever the steps (0.05 to 0.002); mode 1 at 40
+// to 200 intervals on steps of 0.05, 0.02 and 0.005, every verified branch point up to 3e-5 J
+// (128) at 2q/p to 6.1e-13 relative and of the law's dimension (or below it where fewer
+// directions were probed than there are candidates).
 void Locator::refine_on_branch(Location& at) {
   // |tau| at the two points; a location that did not bring |tau| far below it found no root.
-  const double end_value = 1e-4;
+  // Farther out the interpolant spans kinks of the branch: ends at 1e-4 put T = 3.5 3e-12 off
+  // at 100 and 140 intervals, at 1e-3 4e-9.
+  const double end_value = 3e-5;
   if (!problem_.base().jacobian_exact() || at.best_done < 0 ||
       !(std::abs(at.best_value) <= 1e-3 * end_value))
     return;
@@ -498,9 +504,9 @@ void Locator::refine_on_branch(Location& at) {
   double s_prev = s_a, f_prev = ends[0].tau.value, s_last = s_b, f_last = ends[1].tau.value;
   std::vector<Evaluation> found;
   double smallest = std::min(std::abs(f_prev), std::abs(f_last));
-  // A root: |tau| 1e-8 of the ends' (1e-12 here), a period to round-off where tau grows like
-  // 0.1 T or faster.
-  const double root_value = 1e-8 * smallest;
+  // A root: |tau| at most 1e-12 (3e-8 of the ends'), a period to 1e-12 where tau grows like T
+  // or faster (on the contact bar it grows like 1..20 T).
+  const double root_value = 1e-12;
   int stale = 0;
   while (found.size() < 8 && std::abs(s_last - s_prev) > 1e-3 * o.location_tolerance && stale < 2) {
     double s = (s_prev * f_last - s_last * f_prev) / (f_last - f_prev);

@@ -59,14 +59,6 @@ void Locator::verify(BranchPointReport& report, const core::Vector& z, const cor
     core::Vector y;
     bool by_chord = false;
     if (!probe(chord, d, stepped, probing, y, by_chord)) continue;
-    // Chord steps on the located point's J can run far along another family (mode 2 at 77
-    // intervals, T = 14/11: one of six probes ended 1.4e-2 from z, 14 h): the loop's corrector
-    // from the stepped point, fresh Jacobians, has the last word.
-    if (by_chord && (y - z).norm() > h / v.drift_ratio) {
-      by_chord = false;
-      y = stepped;
-      if (!finish_probe(d, stepped, y)) continue;
-    }
     if ((y - z).norm() > h / v.drift_ratio) continue;
     ++attached;
     if (!by_chord && probing.learned < 3) {
@@ -126,6 +118,7 @@ core::Matrix Locator::directions_beyond(const core::Matrix& J, const core::Vecto
 // 4-9 residuals.
 bool Locator::probe(const Chord& chord, const core::Vector& d, const core::Vector& stepped,
                     Probing& probing, core::Vector& y, bool& by_chord) const {
+  const core::Vector f = factor();
   y = stepped;
   by_chord = chord_correct(chord, d, stepped, y, &probing.kinks);
   // The subspace stage is skipped once it has failed on at least two of this point's probes
@@ -138,19 +131,15 @@ bool Locator::probe(const Chord& chord, const core::Vector& d, const core::Vecto
       !(jacobian_residuals_ > 0 && jacobian_residuals_ <= chord.null_space.cols() + 1);
   const bool oks = !by_chord && try_subspace && subspace_correct(chord, d, stepped, y, 4);
   if (!by_chord && try_subspace) ++(oks ? probing.subspace_done : probing.subspace_failed);
-  return by_chord || oks || finish_probe(d, stepped, y);
-}
-
-bool Locator::finish_probe(const core::Vector& d, const core::Vector& stepped,
-                           core::Vector& y) const {
-  const core::Vector f = factor();
-  const core::BorderedSystem on_plane(
-      problem_,
-      {core::BorderRow::hyperplane(d.cwiseProduct(f).normalized(), stepped.cwiseQuotient(f))});
-  core::Vector y_local = y.cwiseQuotient(f);
-  const core::NewtonSummary s = probe_finisher_->solve(on_plane, y_local);
-  if (!s.converged() || !y_local.allFinite()) return false;
-  y = y_local.cwiseProduct(f);
+  if (!by_chord && !oks) {
+    const core::BorderedSystem on_plane(
+        problem_,
+        {core::BorderRow::hyperplane(d.cwiseProduct(f).normalized(), stepped.cwiseQuotient(f))});
+    core::Vector y_local = y.cwiseQuotient(f);
+    const core::NewtonSummary s = probe_finisher_->solve(on_plane, y_local);
+    if (!s.converged() || !y_local.allFinite()) return false;
+    y = y_local.cwiseProduct(f);
+  }
   return true;
 }
 

@@ -176,9 +176,6 @@ class Locator {
   // whether the chord steps alone finished it. False when no corrector converged.
   bool probe(const Chord& chord, const core::Vector& d, const core::Vector& stepped,
              Probing& probing, core::Vector& y, bool& by_chord) const;
-  // The probe's last stage: the loop's corrector (fresh Jacobians) from y onto F = 0 and the
-  // hyperplane through stepped orthogonal to d. False when it does not converge.
-  bool finish_probe(const core::Vector& d, const core::Vector& stepped, core::Vector& y) const;
   // Adds to kinks the directions along which J(y) differs from J.
   void learn_kinks(const core::Vector& y, const core::Matrix& J, core::Matrix& kinks) const;
 

@@ -71,7 +71,7 @@ namespace {
 // locates on mode 1 at 40 intervals up to 3e-5 J is checked against it, and verified exactly
 // when p divides 80. A verified one lies at 2q/p to 1e-12 relative: the location finds the
 // root again on points whose components along the attached directions are the branch's
-// (locator.cpp, refine_on_branch); measured at most 2.5e-14 (T = 3.5), where the root on the
+// (locator.cpp, refine_on_branch); measured at most 1.0e-13 (T = 3.5), where the root on the
 // points the location corrected lies 2e-9 off (T = 3.6) on these steps of 0.05 of the
 // amplitude.
 TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
@@ -120,7 +120,7 @@ TEST(ModesCli, TheBranchPointsOfModeOneFollowTheLawOfAttachedPeriods) {
 // With the exact Jacobian the location takes its test function down to round-off
 // (continuation/README.md, 'Branch points'): on steps of 0.1 % of the amplitude every verified
 // branch point of mode 1 at 40 intervals up to 1.3e-5 J (T = 3.9 to 3.2, 13 families) lies at
-// the law's 2q/p. Measured: at most 8.9e-15 relative (T = 3.5). Without refine_on_branch the
+// the law's 2q/p. Measured: at most 1.6e-13 relative (T = 3.5). Without refine_on_branch the
 // root lies up to 5.9e-10 off (T = 3.75), and as far without the polishing chord steps of the
 // location's evaluations. The bound 5e-12 tells them apart with a margin.
 TEST(ModesCli, WithTheExactJacobianTheBranchPointsSitAtTheLawsPeriods) {
@@ -181,15 +181,14 @@ TEST(ModesCli, AFollowedFamilyEndsAtItsBoundary) {
 // Along a followed family every rank check reads the law's dimension ceil(N/p) - 1, on its
 // faces too (min_slope 0 on an interval: J there is the outside's, orbits/README.md 'Attached
 // families: the law', verified just inside with dimension_flag 3). Mode 1 at 40 intervals up
-// to 3e-5 J, every verified family followed for 61 points (rank checks at points 0, 10, ...,
-// 60); the case holds such points (checked; measured: three, on the family at T = 3.5 of
-// dimension 9).
+// to 3e-5 J, every verified family followed for 21 points (rank checks at points 0, 10, 20);
+// the case holds such points (checked), where J alone reads 2 for 4 and 5 for 7.
 TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
   const auto out = cli::scratch("modes_cli", "follow_dimension");
   const int n = 40;
   const cli::Run r = trace_paper(
       "--branch mode1 --shooting_elements 40 --detect_branch_points true --ds 0.05 --ds_max 0.05 "
-      "--energy_max 3e-5 --follow all --follow_max_points 61",
+      "--energy_max 3e-5 --follow all --follow_max_points 21",
       out);
   ASSERT_EQ(r.code, 0) << r.err;
   const Table points = Table::read_csv(out / "branch_points.csv");
@@ -243,10 +242,8 @@ TEST(ModesCli, EveryRankCheckAlongAFollowedFamilyReadsTheLawsDimension) {
 // at T = 9/7 (p = 14, q = 9: s = 7 g0, crest at 2/7 L) on 35 intervals, knot node 10, and at
 // T = 14/11 (p = 11, q = 7: s = 11 g0) on 77, knot node 21; mode 3 at T = 18/23 (p = 23,
 // q = 9: s = 23 g0, kinks at 5/23 and 13/23) on 46, nodes 10 and 26. Located at 2q/p to 1e-12
-// relative (measured at most 8.7e-16; the root on the points the location corrected lies
-// 1.1e-11 to 1.6e-10 off: locator.cpp, refine_on_branch), energy EA L s^2 / 2 to 1e-6. At 14/11 one
-// of the six probes' chord steps runs 14 probe steps away, and the loop's corrector from the
-// stepped point brings it back: the law's dimension 6, 5 without it.
+// relative (measured at most 5.7e-16; the root on the points the location corrected lies
+// 1.1e-11 to 1.6e-10 off: locator.cpp, refine_on_branch), energy EA L s^2 / 2 to 1e-6.
 TEST(ModesCli, TheLawLocatesTheFamiliesAttachedToModesTwoAndThree) {
   struct Case {
     const char* branch;
