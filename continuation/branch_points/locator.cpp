@@ -477,7 +477,8 @@ void Locator::refine_on_branch(Location& at) {
   const double s_a = std::max(at.best_s - delta, at.polyline.front().s);
   const double s_b = std::min(at.best_s + delta, at.polyline.back().s);
   if (!(s_b - s_a > o.location_tolerance)) return;
-  // Each from the located point along its tangent onto its hyperplane.
+  // Each from the located point along its tangent onto its hyperplane; its tangent to
+  // round-off (the interpolant's).
   std::vector<Sample> ends(2);
   core::Matrix J_a, J_b;
   const auto end = [&](double s, Sample& out, core::Matrix& J) {
@@ -486,9 +487,10 @@ void Locator::refine_on_branch(Location& at) {
     if (!(std::abs(along) >= 0.5)) return false;
     out.s = s;
     return correct_on_plane(
-        plane.normal, plane.through,
-        best.z + best.tangent * (plane.normal.dot(plane.through - best.z) / along), 0.0, nullptr,
-        out, J);
+               plane.normal, plane.through,
+               best.z + best.tangent * (plane.normal.dot(plane.through - best.z) / along), 0.0,
+               nullptr, out.z, J) &&
+           tangent_from_jacobian(J, plane.normal, 0.0, out.tangent) == core::EvalStatus::ok;
   };
   if (!end(s_a, ends[0], J_a) || !end(s_b, ends[1], J_b)) return;
   at.steps += 2;
@@ -515,17 +517,14 @@ void Locator::refine_on_branch(Location& at) {
     // From the interpolant, chord steps with the near-null directions dropped: they leave the
     // point's component along them at the interpolant's.
     const PlaneAt plane(ends, s);
-    Sample point;
     Evaluation e;
     ++at.steps;
     const core::Matrix& chord = found.empty() ? best.jacobian : found.back().jacobian;
     if (!correct_on_plane(plane.normal, plane.through, plane.hermite,
-                          options_.rank.relative_threshold, &chord, point, e.jacobian))
+                          options_.rank.relative_threshold, &chord, e.z, e.jacobian))
       break;
     e.ok = true;
     e.s = s;
-    e.z = std::move(point.z);
-    e.tangent = std::move(point.tangent);
     e.tau = bordered_test_function(e.jacobian, border, jacobian_scale_, &ends[0].tau, true);
     if (!e.tau.continued) {
       // At the root the left vector is the round-off's: a value far below every other is it.
@@ -554,6 +553,11 @@ void Locator::refine_on_branch(Location& at) {
     if (std::abs(found[k].tau.value) < std::abs(found[root].tau.value)) root = k;
   if (found.empty() || !(std::abs(found[root].tau.value) <= root_value)) return;
   Evaluation& e = found[root];
+  // The root's tangent, for the verification (the hyperplanes here are all orthogonal to the
+  // chord of the ends).
+  if (tangent_from_jacobian(e.jacobian, border, options_.rank.relative_threshold, e.tangent) !=
+      core::EvalStatus::ok)
+    return;
   at.best_z = e.z;
   at.best_tangent = e.tangent;
   at.best_s = e.s;
@@ -566,7 +570,7 @@ void Locator::refine_on_branch(Location& at) {
 
 bool Locator::correct_on_plane(const core::Vector& normal, const core::Vector& through,
                                core::Vector y, double cutoff, const core::Matrix* chord,
-                               Sample& out, core::Matrix& J_out) const {
+                               core::Vector& z, core::Matrix& J_out) const {
   const core::Vector f = factor();
   const core::Vector& rf = problem_.residual_factor();
   const double tolerance = options_.verification.corrector_options().residual_tolerance;
@@ -618,9 +622,8 @@ bool Locator::correct_on_plane(const core::Vector& normal, const core::Vector& t
     y += dx;
   }
   if (!converged) return false;
-  out.z = best_y;
-  if (!jacobian_at(out.z, J_out)) return false;
-  return tangent_from_jacobian(J_out, normal, cutoff, out.tangent) == core::EvalStatus::ok;
+  z = std::move(best_y);
+  return jacobian_at(z, J_out);
 }
 
 // The report's location (the best point, the sample it follows) and its verification there.

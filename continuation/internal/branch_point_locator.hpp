@@ -150,15 +150,14 @@ class Locator {
   // V-fit and golden-section minimisation of |tau| around the smallest value seen.
   void minimise_modulus(Location& at, double located_value);
   // With an exact Jacobian: the root again, on the interpolant of two points on either side
-  // corrected by Newton where J is far from singular (locator.cpp, refine_on_branch).
+  // corrected where J is not singular (locator.cpp, refine_on_branch).
   void refine_on_branch(Location& at);
   // Chord steps from y onto F = 0 and normal . (y - through) = 0 (unit scale) on one matrix,
   // chord (unit scale) or else J at y, pivots below cutoff times the largest dropped (0: at
-  // round-off): out.z, and J there (one Jacobian, or two without chord) with its null vector
-  // out.tangent to the same cut-off. False when they do not reach the verifier's corrector
-  // tolerance.
+  // round-off): the point z, and J there (one Jacobian, or two without chord). False when they
+  // do not reach the verifier's corrector tolerance.
   bool correct_on_plane(const core::Vector& normal, const core::Vector& through, core::Vector y,
-                        double cutoff, const core::Matrix* chord, Sample& out,
+                        double cutoff, const core::Matrix* chord, core::Vector& z,
                         core::Matrix& J) const;
   // The report's location fields, then verify() at the best point.
   void verify_best(Location& at, BranchPointReport& report);
